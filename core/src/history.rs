@@ -1,0 +1,435 @@
+//! Undo/redo as commands over the document (Fyrox/Graphite style).
+//!
+//! A [`Command`] stores what it changed as a [`DocumentDiff`]: for every changed bundle and
+//! column, the value before and after. Applying writes the "after" values, reverting writes
+//! the "before" values, so every edit — topology or property — is an exact swap and undo
+//! restores the document bit for bit. Edits are computed once (by [`crate::edit`]) and
+//! replayed from the diff on redo, so redo cannot drift from what the user saw.
+//!
+//! Groups apply their children in order and revert them in reverse. A drag is one
+//! [`Transaction`]: it records the document when the drag starts and becomes one command
+//! when it ends, or nothing if nothing changed.
+//!
+//! Reverting and applying check that the document holds the values the diff expects, so a
+//! tampered or mismatched history is reported instead of silently corrupting the document.
+
+use serde::{Deserialize, Serialize};
+
+use crate::document::Document;
+use crate::mesh::{Bundle, Column, WMode};
+
+/// Default number of undo steps kept.
+pub const DEFAULT_HISTORY_LIMIT: usize = 200;
+
+/// A change of one element of a vector: `None` means "not present" (the vector was shorter).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ElementChange<T> {
+    pub index: u32,
+    pub before: Option<T>,
+    pub after: Option<T>,
+}
+
+/// The changes between two versions of a vector.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VecDiff<T> {
+    pub len_before: u32,
+    pub len_after: u32,
+    pub changes: Vec<ElementChange<T>>,
+}
+
+impl<T> Default for VecDiff<T> {
+    fn default() -> Self {
+        Self {
+            len_before: 0,
+            len_after: 0,
+            changes: Vec::new(),
+        }
+    }
+}
+
+/// The history does not match the document it is applied to.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{path}: {message}")]
+pub struct HistoryMismatch {
+    pub path: String,
+    pub message: String,
+}
+
+impl<T: Clone + PartialEq> VecDiff<T> {
+    pub fn between(before: &[T], after: &[T]) -> Self {
+        let mut changes = Vec::new();
+        for i in 0..before.len().max(after.len()) {
+            let b = before.get(i);
+            let a = after.get(i);
+            if b != a {
+                changes.push(ElementChange {
+                    index: i as u32,
+                    before: b.cloned(),
+                    after: a.cloned(),
+                });
+            }
+        }
+        Self {
+            len_before: before.len() as u32,
+            len_after: after.len() as u32,
+            changes,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.changes.is_empty() && self.len_before == self.len_after
+    }
+
+    /// Writes the "after" side (`forward`) or the "before" side into `target`.
+    fn write(&self, target: &mut Vec<T>, forward: bool, path: &str) -> Result<(), HistoryMismatch> {
+        let (len_from, len_to) = if forward {
+            (self.len_before, self.len_after)
+        } else {
+            (self.len_after, self.len_before)
+        };
+        if target.len() != len_from as usize {
+            return Err(HistoryMismatch {
+                path: path.to_string(),
+                message: format!("expected {len_from} elements, found {}", target.len()),
+            });
+        }
+        for change in &self.changes {
+            let expected = if forward { &change.before } else { &change.after };
+            if target.get(change.index as usize) != expected.as_ref() {
+                return Err(HistoryMismatch {
+                    path: format!("{path}[{}]", change.index),
+                    message: "the document does not hold the value this history entry changed".into(),
+                });
+            }
+        }
+        // Shrinking first, then element writes in ascending order, then growth in order.
+        target.truncate(len_to as usize);
+        for change in &self.changes {
+            let value = if forward { &change.after } else { &change.before };
+            let index = change.index as usize;
+            match value {
+                Some(value) if index < target.len() => target[index] = value.clone(),
+                Some(value) if index == target.len() => target.push(value.clone()),
+                Some(_) => {
+                    return Err(HistoryMismatch {
+                        path: format!("{path}[{index}]"),
+                        message: "history entry leaves a gap".into(),
+                    });
+                }
+                None => {}
+            }
+        }
+        if target.len() != len_to as usize {
+            return Err(HistoryMismatch {
+                path: path.to_string(),
+                message: format!("history entry yields {} elements, expected {len_to}", target.len()),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A before/after pair of a small value.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Swap<T> {
+    pub before: T,
+    pub after: T,
+}
+
+/// Everything one command changed in a [`Document`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DocumentDiff {
+    #[serde(default)]
+    pub bundles: VecDiff<Bundle>,
+    #[serde(default)]
+    pub columns: VecDiff<Column>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub w_mode: Option<Swap<WMode>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<Swap<String>>,
+}
+
+impl DocumentDiff {
+    pub fn between(before: &Document, after: &Document) -> Self {
+        let swap = |b: &WMode, a: &WMode| (b != a).then(|| Swap { before: *b, after: *a });
+        Self {
+            bundles: VecDiff::between(&before.hair_mesh.bundles, &after.hair_mesh.bundles),
+            columns: VecDiff::between(&before.hair_mesh.columns, &after.hair_mesh.columns),
+            w_mode: swap(&before.hair_mesh.w_mode, &after.hair_mesh.w_mode),
+            name: (before.name != after.name).then(|| Swap {
+                before: before.name.clone(),
+                after: after.name.clone(),
+            }),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bundles.is_empty() && self.columns.is_empty() && self.w_mode.is_none() && self.name.is_none()
+    }
+
+    fn write(&self, document: &mut Document, forward: bool) -> Result<(), HistoryMismatch> {
+        // Check everything on a copy of the small fields first so a mismatch never leaves
+        // the document half-written: vectors are checked inside `write` before any change,
+        // and the small swaps are checked here before the vectors are touched.
+        if let Some(swap) = &self.w_mode {
+            let expected = if forward { swap.before } else { swap.after };
+            if document.hair_mesh.w_mode != expected {
+                return Err(HistoryMismatch {
+                    path: "hair_mesh.w_mode".into(),
+                    message: "the document does not hold the value this history entry changed".into(),
+                });
+            }
+        }
+        if let Some(swap) = &self.name {
+            let expected = if forward { &swap.before } else { &swap.after };
+            if &document.name != expected {
+                return Err(HistoryMismatch {
+                    path: "name".into(),
+                    message: "the document does not hold the value this history entry changed".into(),
+                });
+            }
+        }
+        let mut bundles = document.hair_mesh.bundles.clone();
+        self.bundles.write(&mut bundles, forward, "hair_mesh.bundles")?;
+        self.columns
+            .write(&mut document.hair_mesh.columns, forward, "hair_mesh.columns")?;
+        document.hair_mesh.bundles = bundles;
+        if let Some(swap) = &self.w_mode {
+            document.hair_mesh.w_mode = if forward { swap.after } else { swap.before };
+        }
+        if let Some(swap) = &self.name {
+            document.name = if forward { swap.after.clone() } else { swap.before.clone() };
+        }
+        Ok(())
+    }
+}
+
+/// One undoable step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum Command {
+    /// An edit recorded as a diff.
+    Edit { label: String, diff: DocumentDiff },
+    /// Several commands as one step: applied in order, reverted in reverse.
+    Group { label: String, children: Vec<Command> },
+}
+
+impl Command {
+    /// Records the change from `before` to `after`; `None` when nothing changed.
+    pub fn record(label: impl Into<String>, before: &Document, after: &Document) -> Option<Self> {
+        let diff = DocumentDiff::between(before, after);
+        (!diff.is_empty()).then(|| Self::Edit {
+            label: label.into(),
+            diff,
+        })
+    }
+
+    pub fn label(&self) -> &str {
+        match self {
+            Self::Edit { label, .. } | Self::Group { label, .. } => label,
+        }
+    }
+
+    pub fn apply(&self, document: &mut Document) -> Result<(), HistoryMismatch> {
+        match self {
+            Self::Edit { diff, .. } => diff.write(document, true),
+            Self::Group { children, .. } => {
+                for (i, child) in children.iter().enumerate() {
+                    if let Err(error) = child.apply(document) {
+                        // Roll back the children already applied: all or nothing.
+                        for done in children[..i].iter().rev() {
+                            let _ = done.revert(document);
+                        }
+                        return Err(error);
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    pub fn revert(&self, document: &mut Document) -> Result<(), HistoryMismatch> {
+        match self {
+            Self::Edit { diff, .. } => diff.write(document, false),
+            Self::Group { children, .. } => {
+                for (i, child) in children.iter().enumerate().rev() {
+                    if let Err(error) = child.revert(document) {
+                        for done in children[i + 1..].iter() {
+                            let _ = done.apply(document);
+                        }
+                        return Err(error);
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// The undo and redo stacks. Saved in project files.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct History {
+    /// Oldest first; the last entry is undone first.
+    pub undo: Vec<Command>,
+    /// The last entry is redone first.
+    pub redo: Vec<Command>,
+    /// Most undo steps kept; older ones are dropped.
+    pub limit: usize,
+}
+
+impl Default for History {
+    fn default() -> Self {
+        Self::with_limit(DEFAULT_HISTORY_LIMIT)
+    }
+}
+
+impl History {
+    pub fn with_limit(limit: usize) -> Self {
+        Self {
+            undo: Vec::new(),
+            redo: Vec::new(),
+            limit: limit.max(1),
+        }
+    }
+
+    /// Records an already-applied edit (the document is now `after`). Clears redo.
+    pub fn push(&mut self, command: Command) {
+        self.redo.clear();
+        self.undo.push(command);
+        if self.undo.len() > self.limit {
+            let excess = self.undo.len() - self.limit;
+            self.undo.drain(..excess);
+        }
+    }
+
+    /// Replaces `document` with `after` as one undoable step named `label`. Returns false
+    /// when nothing changed (no history entry is made).
+    pub fn commit(&mut self, document: &mut Document, label: &str, after: Document) -> bool {
+        match Command::record(label, document, &after) {
+            Some(command) => {
+                *document = after;
+                self.push(command);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Undoes the last step; `Ok(None)` when there is nothing to undo.
+    pub fn undo(&mut self, document: &mut Document) -> Result<Option<String>, HistoryMismatch> {
+        let Some(command) = self.undo.pop() else {
+            return Ok(None);
+        };
+        if let Err(error) = command.revert(document) {
+            self.undo.push(command);
+            return Err(error);
+        }
+        let label = command.label().to_string();
+        self.redo.push(command);
+        Ok(Some(label))
+    }
+
+    /// Redoes the last undone step; `Ok(None)` when there is nothing to redo.
+    pub fn redo(&mut self, document: &mut Document) -> Result<Option<String>, HistoryMismatch> {
+        let Some(command) = self.redo.pop() else {
+            return Ok(None);
+        };
+        if let Err(error) = command.apply(document) {
+            self.redo.push(command);
+            return Err(error);
+        }
+        let label = command.label().to_string();
+        self.undo.push(command);
+        Ok(Some(label))
+    }
+
+    /// Undoes or redoes until `undo.len() == position` (the history panel's "jump here").
+    pub fn jump_to(&mut self, document: &mut Document, position: usize) -> Result<(), HistoryMismatch> {
+        while self.undo.len() > position {
+            self.undo(document)?;
+        }
+        while self.undo.len() < position && !self.redo.is_empty() {
+            self.redo(document)?;
+        }
+        Ok(())
+    }
+
+    /// Checks that the whole history replays on `document`: undoing every step and redoing
+    /// them gives valid documents and ends where it began. Used when loading a project.
+    pub fn verify(&self, document: &Document) -> Result<(), HistoryMismatch> {
+        let mut scratch = document.clone();
+        let mut copy = self.clone();
+        let steps = copy.undo.len();
+        let redo_steps = copy.redo.len();
+        let check = |doc: &Document, what: &str| {
+            doc.validate().map_err(|e| HistoryMismatch {
+                path: format!("history ({what}): document.{}", e.path),
+                message: e.message,
+            })
+        };
+        for i in 0..redo_steps {
+            copy.redo(&mut scratch).map_err(|e| prefix(e, &format!("history.redo[{}]", redo_steps - 1 - i)))?;
+            check(&scratch, "after redo")?;
+        }
+        for i in 0..steps + redo_steps {
+            let index = steps + redo_steps - 1 - i;
+            copy.undo(&mut scratch).map_err(|e| prefix(e, &format!("history step {index}")))?;
+            check(&scratch, "after undo")?;
+        }
+        for _ in 0..steps {
+            copy.redo(&mut scratch).map_err(|e| prefix(e, "history (redo)"))?;
+        }
+        if &scratch != document {
+            return Err(HistoryMismatch {
+                path: "history".into(),
+                message: "undoing and redoing the history does not return to the saved document".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+fn prefix(error: HistoryMismatch, what: &str) -> HistoryMismatch {
+    HistoryMismatch {
+        path: format!("{what}: document.{}", error.path),
+        message: error.message,
+    }
+}
+
+/// A drag or other multi-step gesture that becomes one undo step.
+#[derive(Clone, Debug)]
+pub struct Transaction {
+    start: Document,
+    label: String,
+}
+
+impl Transaction {
+    /// Starts a transaction on the current document.
+    pub fn begin(document: &Document, label: impl Into<String>) -> Self {
+        Self {
+            start: document.clone(),
+            label: label.into(),
+        }
+    }
+
+    /// The document as it was when the transaction began (to preview edits from it).
+    pub fn start(&self) -> &Document {
+        &self.start
+    }
+
+    /// Ends the gesture: one history entry, or none if the document is unchanged.
+    pub fn commit(self, history: &mut History, document: &Document) -> bool {
+        match Command::record(self.label, &self.start, document) {
+            Some(command) => {
+                history.push(command);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Abandons the gesture and restores the document.
+    pub fn cancel(self, document: &mut Document) {
+        *document = self.start;
+    }
+}
