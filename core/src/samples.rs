@@ -1,1 +1,262 @@
-//! placeholder
+//! The bundled sample projects, built by code from the originals in `shared/data/`:
+//!
+//! - the real head scan "Infinite, 3D Head Scan" by Lee Perry-Smith (CC BY 3.0, based on a
+//!   work at www.triplegangers.com), whose scalp region becomes the root layer of three
+//!   hairstyles: short straight, long wavy and curly;
+//! - the Utah teapot (Newell 1975, public domain), tessellated and furred.
+//!
+//! `cargo run -p hairloom-core --example make_samples` rewrites `assets/samples/`; the
+//! builders are deterministic, so the files only change when this code does. Styling
+//! parameters (wave, curl) are added by the styling stage; the samples here fix the hair
+//! *shape* (the hair mesh).
+
+use glam::DVec3;
+
+use crate::document::{BodyMesh, Document};
+use crate::edit::{ExtrudeDirection, extrude};
+use crate::import::{ImportError, ImportOptions, import_slice};
+use crate::mesh::HairMesh;
+use crate::project::Project;
+use crate::{interior, uv};
+
+/// Attribution required by the head scan's licence; shipped in every head sample.
+pub const HEAD_CREDIT: &str = "Head: \"Infinite, 3D Head Scan\" by Lee Perry-Smith, licensed under CC BY 3.0 \
+(https://creativecommons.org/licenses/by/3.0/), based on a work at www.triplegangers.com.";
+/// Attribution of the teapot geometry.
+pub const TEAPOT_CREDIT: &str = "Utah teapot by Martin Newell (1975), public-domain geometry.";
+
+/// Model units (metres) per unit of the head scan file: the scan measures about 4.9 units
+/// from chin (y ≈ −0.9) to crown (y ≈ 3.98), and a head is about 0.22 m.
+pub const HEAD_SCALE: f64 = 0.045;
+/// Centre of the cranium in file units (the samples put it at the origin).
+pub const HEAD_CRANIUM_CENTER: DVec3 = DVec3::new(-0.08, 1.9, 0.1);
+/// Cranium ellipsoid radii in file units, used to keep sample hair outside the head.
+pub const HEAD_CRANIUM_RADII: DVec3 = DVec3::new(1.75, 2.1, 2.05);
+
+/// Which face of the head scan is scalp, from its centroid `p` and normal `n` in file units:
+/// above a hairline plane that rises from the nape (y ≈ 0.3 at the back) to the forehead
+/// (y ≈ 3.0 at the front), excluding the ears (far to the side and low) and faces that
+/// point down.
+pub fn is_head_scalp(p: DVec3, n: DVec3) -> bool {
+    let above_hairline = p.y > 1.6 + 0.69 * p.z;
+    let ear = p.x.abs() > 1.35 && p.y < 2.2;
+    above_hairline && !ear && n.y > -0.35
+}
+
+/// The head scan: its scalp as a hair mesh with generated uv (metres, cranium at the
+/// origin) and the whole scan as the body.
+pub fn head_scalp(glb: &[u8]) -> Result<(HairMesh, BodyMesh), ImportError> {
+    let options = ImportOptions {
+        scale: 1.0,
+        ..ImportOptions::default()
+    };
+    let mut imported = import_slice(glb, None, "LeePerrySmith.glb", &options)?;
+    let keep: Vec<bool> = imported
+        .faces
+        .iter()
+        .map(|face| {
+            let p: Vec<DVec3> = face.iter().map(|&v| imported.positions[v as usize]).collect();
+            let centroid = p.iter().copied().sum::<DVec3>() / p.len() as f64;
+            let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+            is_head_scalp(centroid, normal)
+        })
+        .collect();
+    let keep = largest_component(&imported.faces, &keep);
+    for p in &mut imported.positions {
+        *p = (*p - HEAD_CRANIUM_CENTER) * HEAD_SCALE;
+    }
+    let mut scalp = imported.to_hair_mesh(|f| keep[f]);
+    // The scan's texture layout has seams across the scalp; a seamless projection from
+    // above the crown, tilted back, gives smooth styling frames.
+    let axis = DVec3::new(0.0, 1.0, -0.35).normalize();
+    uv::generate_uv(&mut scalp, Some((DVec3::ZERO, axis, DVec3::X)));
+    Ok((scalp, imported.to_body()))
+}
+
+/// Keeps only the largest edge-connected group of kept faces (drops stray islands).
+fn largest_component(faces: &[Vec<u32>], keep: &[bool]) -> Vec<bool> {
+    let mut faces_of_vertex: std::collections::HashMap<u32, Vec<usize>> = std::collections::HashMap::new();
+    for (f, face) in faces.iter().enumerate() {
+        if keep[f] {
+            for &v in face {
+                faces_of_vertex.entry(v).or_default().push(f);
+            }
+        }
+    }
+    let mut label = vec![usize::MAX; faces.len()];
+    let mut sizes = Vec::new();
+    for start in 0..faces.len() {
+        if !keep[start] || label[start] != usize::MAX {
+            continue;
+        }
+        let id = sizes.len();
+        let mut size = 0;
+        let mut stack = vec![start];
+        label[start] = id;
+        while let Some(f) = stack.pop() {
+            size += 1;
+            for v in &faces[f] {
+                for &g in &faces_of_vertex[v] {
+                    if label[g] == usize::MAX {
+                        label[g] = id;
+                        stack.push(g);
+                    }
+                }
+            }
+        }
+        sizes.push(size);
+    }
+    let best = (0..sizes.len()).max_by_key(|&i| sizes[i]);
+    label.iter().map(|&l| Some(l) == best).collect()
+}
+
+/// A hairstyle's shape: how each layer moves away from the previous one.
+#[derive(Clone, Copy, Debug)]
+pub struct Growth {
+    /// Number of layers.
+    pub layers: u32,
+    /// Length of each layer step in metres.
+    pub step_m: f64,
+    /// 0 = straight out along the normal, 1 = hanging straight down by the last layer.
+    pub gravity: f64,
+    /// Minimum clearance from the cranium ellipsoid at the tip, as a fraction of its size.
+    pub volume: f64,
+}
+
+/// Grows `scalp` into a hair mesh: the first layer along the root normals, later layers
+/// bending toward −y by `growth.gravity` while staying outside the cranium ellipsoid
+/// (`radii_m` around the origin). Interior vertices are then placed by the regular method.
+pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
+    let all: Vec<u32> = (0..scalp.bundles.len() as u32).collect();
+    let mut mesh = scalp.clone();
+    for _ in 0..growth.layers {
+        match extrude(&mesh, &all, ExtrudeDirection::AlongNormal { distance: growth.step_m }) {
+            Ok(outcome) => mesh = outcome.mesh,
+            Err(_) => return mesh,
+        }
+    }
+    let normals = root_normals(&mesh);
+    for (c, column) in mesh.columns.iter_mut().enumerate() {
+        let n = normals[c];
+        let root = column.positions[0];
+        let mut previous = root;
+        for k in 1..column.positions.len() {
+            let fraction = k as f64 / growth.layers.max(1) as f64;
+            let bend = (growth.gravity * fraction * 1.3).min(1.0);
+            let outward = DVec3::new(n.x, 0.0, n.z).normalize_or_zero() * 0.3;
+            // Hair from the front of the scalp sweeps back instead of falling over the face.
+            let front = (root.z / radii_m.z).max(0.0);
+            let sweep_back = DVec3::new(0.0, 0.0, -1.2 * front);
+            let down = (-DVec3::Y + outward + sweep_back).normalize();
+            let direction = n.lerp(down, bend).normalize_or(n);
+            let mut p = previous + direction * growth.step_m;
+            // Keep clear of the head: push out of the inflated cranium ellipsoid.
+            let clearance = 1.0 + growth.volume * fraction.sqrt();
+            let q = p / radii_m;
+            if q.length() < clearance {
+                p = q.normalize_or(DVec3::Y) * clearance * radii_m;
+            }
+            column.positions[k] = p;
+            previous = p;
+        }
+    }
+    interior::place_interior(&mut mesh, None);
+    mesh.update_w();
+    mesh
+}
+
+/// Area-weighted root-layer vertex normals.
+fn root_normals(mesh: &HairMesh) -> Vec<DVec3> {
+    let mut normals = vec![DVec3::ZERO; mesh.columns.len()];
+    for bundle in &mesh.bundles {
+        let n = bundle.vertices.len();
+        for i in 0..n {
+            let at = |k: usize| mesh.columns[bundle.vertices[k % n] as usize].positions[0];
+            let normal = (at(i + 1) - at(i)).cross(at(i + n - 1) - at(i));
+            normals[bundle.vertices[i] as usize] += normal;
+        }
+    }
+    normals.into_iter().map(|n| n.normalize_or(DVec3::Y)).collect()
+}
+
+/// The three head hairstyles.
+pub const HEAD_STYLES: [(&str, Growth); 3] = [
+    (
+        "head_short_straight",
+        Growth { layers: 2, step_m: 0.012, gravity: 0.25, volume: 0.12 },
+    ),
+    (
+        "head_long_wavy",
+        Growth { layers: 6, step_m: 0.04, gravity: 1.0, volume: 0.18 },
+    ),
+    (
+        "head_curly",
+        Growth { layers: 4, step_m: 0.025, gravity: 0.5, volume: 0.3 },
+    ),
+];
+
+/// Builds the head sample projects from the scan's GLB bytes.
+pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> {
+    let (scalp, body) = head_scalp(glb)?;
+    let radii_m = HEAD_CRANIUM_RADII * HEAD_SCALE;
+    Ok(HEAD_STYLES
+        .iter()
+        .map(|(name, growth)| {
+            let mesh = grow(&scalp, *growth, radii_m);
+            let mut document = Document::new(*name, mesh);
+            document.source = HEAD_CREDIT.to_string();
+            document.body = body.clone();
+            (name.to_string(), Project::new(document))
+        })
+        .collect())
+}
+
+/// The furry teapot: the teapot tessellated 3×3 per patch, scaled to about 0.3 m across,
+/// with one layer of short fur. (One layer: the teapot is made of open patches whose few
+/// rims say little about a middle layer far from them, see `interior`.)
+pub fn teapot_project(teapot_text: &str) -> Result<Project, crate::teapot::TeapotError> {
+    let patches = crate::teapot::parse(teapot_text)?;
+    let mut scalp = crate::teapot::tessellate(&patches, 3);
+    let scale = 0.3 / 6.4; // the teapot is about 6.4 units from spout to handle
+    for column in &mut scalp.columns {
+        column.positions[0] *= scale;
+    }
+    let body = BodyMesh {
+        positions: scalp
+            .columns
+            .iter()
+            .map(|c| c.positions[0].as_vec3().to_array())
+            .collect(),
+        triangles: scalp
+            .bundles
+            .iter()
+            .flat_map(|b| {
+                let v = &b.vertices;
+                let mut t = vec![[v[0], v[1], v[2]]];
+                if v.len() == 4 {
+                    t.push([v[0], v[2], v[3]]);
+                }
+                t
+            })
+            .collect(),
+    };
+    let all: Vec<u32> = (0..scalp.bundles.len() as u32).collect();
+    let mut mesh = scalp;
+    if let Ok(outcome) = extrude(&mesh, &all, ExtrudeDirection::AlongNormal { distance: 0.012 }) {
+        mesh = outcome.mesh;
+    }
+    let mut document = Document::new("teapot_fur", mesh);
+    document.source = TEAPOT_CREDIT.to_string();
+    document.body = body;
+    Ok(Project::new(document))
+}
+
+/// Number of columns whose tip lies inside the cranium ellipsoid (`radii_m` around the
+/// origin); the samples keep hair outside the head, and tests check it.
+pub fn tips_inside_ellipsoid(mesh: &HairMesh, radii_m: DVec3) -> usize {
+    mesh.columns
+        .iter()
+        .filter(|c| c.positions.len() > 1)
+        .filter(|c| c.positions.last().is_some_and(|p| (*p / radii_m).length() < 0.98))
+        .count()
+}

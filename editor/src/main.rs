@@ -1,1 +1,202 @@
-fn main() {}
+//! `hairloom`: the Hairloom editor's binary and its command-line tools.
+//!
+//! Subcommands work headless: `check` validates a project (exit 0, or 2 with a message
+//! naming the problem), `info` prints counts, `import` turns a glTF scalp into a project,
+//! `adapters` lists the GPU adapters wgpu finds, and `bench` measures.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::{Parser, Subcommand};
+use hairloom_core::project;
+
+mod bench;
+
+#[derive(Parser)]
+#[command(name = "hairloom", version, about = "Hair-mesh modeling and styling editor")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate a project file: exit 0 when valid, 2 with a message naming the problem.
+    Check { file: PathBuf },
+    /// Print counts of a project: root faces, bundles, vertices, layers.
+    Info {
+        file: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Create a project from a glTF/GLB scalp (every face becomes a bare bundle).
+    Import {
+        scalp: PathBuf,
+        /// Project file to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Mesh to read when the file has several.
+        #[arg(long)]
+        mesh: Option<String>,
+        /// Model units per file unit.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Replace the file's uv with a seamless generated projection.
+        #[arg(long)]
+        generate_uv: bool,
+    },
+    /// List the GPU adapters wgpu can use and the one Hairloom would pick.
+    Adapters,
+    /// Measure performance; prints a table (see BENCHMARKS.md).
+    Bench {
+        #[command(subcommand)]
+        which: bench::Which,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => {
+            eprintln!(
+                "The interactive editor is not built yet; use a subcommand (see `hairloom --help`)."
+            );
+            return ExitCode::from(2);
+        }
+        Some(Command::Check { file }) => return check(&file),
+        Some(Command::Info { file, json }) => info(&file, json),
+        Some(Command::Import {
+            scalp,
+            out,
+            mesh,
+            scale,
+            generate_uv,
+        }) => import(&scalp, &out, mesh, scale, generate_uv),
+        Some(Command::Adapters) => adapters(),
+        Some(Command::Bench { which }) => bench::run(which),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn check(file: &Path) -> ExitCode {
+    match project::load(file) {
+        Ok(project) => {
+            let stats = project.document.hair_mesh.stats();
+            println!(
+                "{}: valid (format {}, {} bundles, {} vertices, {} undo steps)",
+                file.display(),
+                project.format_version,
+                stats.root_faces,
+                stats.vertices,
+                project.history.undo.len()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(error) => {
+            eprintln!("{error}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn info(file: &Path, json: bool) -> anyhow::Result<()> {
+    let project = project::load(file)?;
+    let document = &project.document;
+    let stats = document.hair_mesh.stats();
+    if json {
+        let value = serde_json::json!({
+            "name": document.name,
+            "stats": stats,
+            "body_triangles": document.body.triangles.len(),
+            "undo_steps": project.history.undo.len(),
+            "redo_steps": project.history.redo.len(),
+        });
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    println!("name:             {}", document.name);
+    if !document.source.is_empty() {
+        println!("source:           {}", document.source);
+    }
+    println!(
+        "root faces:       {} ({} quads, {} triangles, {} removed)",
+        stats.root_faces, stats.quads, stats.triangles, stats.removed_bundles
+    );
+    println!("bundles:          {} with hair", stats.hair_bundles);
+    println!("root vertices:    {}", stats.root_vertices);
+    println!(
+        "vertices:         {} ({} interior, placed automatically)",
+        stats.vertices, stats.interior_vertices
+    );
+    println!("layers:           {} to {}", stats.min_layers, stats.max_layers);
+    println!("body triangles:   {}", document.body.triangles.len());
+    println!(
+        "history:          {} undo, {} redo (limit {})",
+        project.history.undo.len(),
+        project.history.redo.len(),
+        project.history.limit
+    );
+    Ok(())
+}
+
+fn import(scalp: &Path, out: &Path, mesh: Option<String>, scale: f64, generate_uv: bool) -> anyhow::Result<()> {
+    use hairloom_core::import::{ImportOptions, import_file};
+    if !(scale.is_finite() && scale > 0.0) {
+        anyhow::bail!("--scale must be a positive number, got {scale}");
+    }
+    let options = ImportOptions {
+        mesh_name: mesh,
+        scale,
+        ..ImportOptions::default()
+    };
+    let imported = import_file(scalp, &options)?;
+    let mut hair_mesh = imported.to_hair_mesh(|_| true);
+    if generate_uv || !imported.has_uv {
+        hairloom_core::uv::generate_uv(&mut hair_mesh, None);
+    }
+    let name = scalp
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scalp".into());
+    let mut document = hairloom_core::Document::new(name, hair_mesh);
+    document.source = format!("imported from {}", scalp.display());
+    document.body = imported.to_body();
+    document
+        .validate()
+        .with_context(|| format!("{} produced an invalid document", scalp.display()))?;
+    project::save(out, &hairloom_core::Project::new(document))?;
+    println!(
+        "{} → {}: {} quads, {} triangles ({} source triangles, {} collapsed by welding){}",
+        scalp.display(),
+        out.display(),
+        imported.quad_count(),
+        imported.triangle_count(),
+        imported.source_triangles,
+        imported.degenerate_triangles,
+        if imported.has_uv { "" } else { "; uv generated (the file has no TEXCOORD_0)" }
+    );
+    Ok(())
+}
+
+fn adapters() -> anyhow::Result<()> {
+    let all = hairloom_render::device::list_adapters();
+    if all.is_empty() {
+        println!("no adapter found (install mesa-vulkan-drivers for the lavapipe software adapter)");
+    }
+    for info in &all {
+        println!("{}", hairloom_render::device::describe(info));
+    }
+    match hairloom_render::device::GpuContext::new_headless() {
+        Ok(context) => println!("chosen: {}", hairloom_render::device::describe(&context.adapter_info)),
+        Err(error) => println!("chosen: none ({error})"),
+    }
+    Ok(())
+}

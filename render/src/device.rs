@@ -1,0 +1,159 @@
+//! wgpu device setup for the editor and headless tools.
+//!
+//! Adapter choice: a real GPU when there is one (discrete before integrated before virtual),
+//! Mesa's lavapipe software rasteriser otherwise. `HAIRLOOM_ADAPTER` overrides it: `cpu`
+//! (software only), `gpu` (hardware only) or any other text, matched case-insensitively
+//! against adapter names (for example `llvmpipe` or `h100`).
+
+/// Environment variable that overrides the adapter choice.
+pub const ADAPTER_ENV: &str = "HAIRLOOM_ADAPTER";
+
+/// Why no device could be created.
+#[derive(Debug, thiserror::Error)]
+pub enum DeviceError {
+    #[error(
+        "no GPU adapter found; on Debian install mesa-vulkan-drivers and libvulkan1 for the lavapipe software adapter (`make test` does this)"
+    )]
+    NoAdapter,
+    #[error("no adapter matches {ADAPTER_ENV}={wanted:?}; available: {available}")]
+    NoMatch { wanted: String, available: String },
+    #[error("{adapter}: cannot create a device: {source}")]
+    RequestDevice {
+        adapter: String,
+        source: wgpu::RequestDeviceError,
+    },
+}
+
+/// An adapter, device and queue ready for headless work.
+pub struct GpuContext {
+    pub adapter: wgpu::Adapter,
+    pub adapter_info: wgpu::AdapterInfo,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
+fn instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
+}
+
+/// Preference rank of a device type: lower is better.
+fn rank(device_type: wgpu::DeviceType) -> u8 {
+    match device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+/// Picks an adapter index from `infos` according to `wanted` (the value of
+/// [`ADAPTER_ENV`], if set). Pure, so the policy is testable without a GPU.
+pub fn choose_adapter(infos: &[wgpu::AdapterInfo], wanted: Option<&str>) -> Result<usize, DeviceError> {
+    if infos.is_empty() {
+        return Err(DeviceError::NoAdapter);
+    }
+    let filter: Box<dyn Fn(&wgpu::AdapterInfo) -> bool> = match wanted.map(str::trim) {
+        None | Some("") => Box::new(|_| true),
+        Some(w) if w.eq_ignore_ascii_case("cpu") => Box::new(|i| i.device_type == wgpu::DeviceType::Cpu),
+        Some(w) if w.eq_ignore_ascii_case("gpu") => Box::new(|i| i.device_type != wgpu::DeviceType::Cpu),
+        Some(w) => {
+            let needle = w.to_lowercase();
+            Box::new(move |i| i.name.to_lowercase().contains(&needle))
+        }
+    };
+    (0..infos.len())
+        .filter(|&i| filter(&infos[i]))
+        // Prefer Vulkan/Metal/DX12 over GL for the same device type.
+        .min_by_key(|&i| (rank(infos[i].device_type), infos[i].backend == wgpu::Backend::Gl))
+        .ok_or_else(|| DeviceError::NoMatch {
+            wanted: wanted.unwrap_or_default().to_string(),
+            available: infos.iter().map(|i| i.name.clone()).collect::<Vec<_>>().join(", "),
+        })
+}
+
+/// Every adapter wgpu can see.
+pub fn list_adapters() -> Vec<wgpu::AdapterInfo> {
+    pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()))
+        .iter()
+        .map(|a| a.get_info())
+        .collect()
+}
+
+/// One line describing an adapter, for logs and benchmark headers.
+pub fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!(
+        "{} ({:?}, {:?}, driver {} {})",
+        info.name, info.backend, info.device_type, info.driver, info.driver_info
+    )
+}
+
+impl GpuContext {
+    /// Creates a device on the adapter chosen by [`choose_adapter`] with
+    /// `HAIRLOOM_ADAPTER` from the environment. Requests the adapter's optional features
+    /// that later stages use when it has them (timestamps, f32 filtering, f16).
+    pub fn new_headless() -> Result<Self, DeviceError> {
+        let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()));
+        let infos: Vec<wgpu::AdapterInfo> = adapters.iter().map(|a| a.get_info()).collect();
+        let wanted = std::env::var(ADAPTER_ENV).ok();
+        let index = choose_adapter(&infos, wanted.as_deref())?;
+        let adapter = adapters.into_iter().nth(index).ok_or(DeviceError::NoAdapter)?;
+        let adapter_info = adapter.get_info();
+        let optional = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::FLOAT32_FILTERABLE
+            | wgpu::Features::SHADER_F16;
+        let descriptor = wgpu::DeviceDescriptor {
+            label: Some("hairloom"),
+            required_features: adapter.features() & optional,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).map_err(|source| {
+            DeviceError::RequestDevice {
+                adapter: adapter_info.name.clone(),
+                source,
+            }
+        })?;
+        Ok(Self {
+            adapter,
+            adapter_info,
+            device,
+            queue,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn info(name: &str, device_type: wgpu::DeviceType, backend: wgpu::Backend) -> wgpu::AdapterInfo {
+        wgpu::AdapterInfo {
+            name: name.into(),
+            vendor: 0,
+            device: 0,
+            device_type,
+            device_pci_bus_id: String::new(),
+            driver: String::new(),
+            driver_info: String::new(),
+            backend,
+            subgroup_min_size: 4,
+            subgroup_max_size: 64,
+            transient_saves_memory: false,
+        }
+    }
+
+    #[test]
+    fn prefers_hardware_and_honours_the_override() {
+        let infos = vec![
+            info("llvmpipe (LLVM 19)", wgpu::DeviceType::Cpu, wgpu::Backend::Vulkan),
+            info("NVIDIA H100", wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Gl),
+            info("NVIDIA H100", wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Vulkan),
+        ];
+        assert_eq!(choose_adapter(&infos, None).ok(), Some(2));
+        assert_eq!(choose_adapter(&infos, Some("cpu")).ok(), Some(0));
+        assert_eq!(choose_adapter(&infos, Some("LLVMPIPE")).ok(), Some(0));
+        assert!(matches!(choose_adapter(&infos, Some("radeon")), Err(DeviceError::NoMatch { .. })));
+        assert!(matches!(choose_adapter(&[], None), Err(DeviceError::NoAdapter)));
+    }
+}
