@@ -121,7 +121,11 @@ pub fn curve_segments(points: &[DVec3]) -> Vec<[DVec3; 4]> {
             let p1 = points[k];
             let p2 = points[k + 1];
             let p0 = if k == 0 { 2.0 * p1 - p2 } else { points[k - 1] };
-            let p3 = if k + 2 < n { points[k + 2] } else { 2.0 * p2 - p1 };
+            let p3 = if k + 2 < n {
+                points[k + 2]
+            } else {
+                2.0 * p2 - p1
+            };
             centripetal_bezier(p0, p1, p2, p3)
         })
         .collect()
@@ -132,7 +136,11 @@ pub fn curve_point(segments: &[[DVec3; 4]], t: f64, form: SegmentForm) -> DVec3 
     let Some(last) = segments.len().checked_sub(1) else {
         return DVec3::ZERO;
     };
-    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, segments.len() as f64) };
+    let t = if t.is_nan() {
+        0.0
+    } else {
+        t.clamp(0.0, segments.len() as f64)
+    };
     let k = (t.floor() as usize).min(last);
     segment_point(&segments[k], t - k as f64, form)
 }
@@ -217,7 +225,11 @@ impl ReferenceStrand {
 
     /// Position at `t ∈ [0, layers]` (clamped).
     pub fn point(&self, t: f64, definition: CurveDefinition, form: SegmentForm) -> DVec3 {
-        let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, self.layers as f64) };
+        let t = if t.is_nan() {
+            0.0
+        } else {
+            t.clamp(0.0, self.layers as f64)
+        };
         match definition {
             CurveDefinition::ColumnBlend => self
                 .column_segments
@@ -230,7 +242,12 @@ impl ReferenceStrand {
     }
 
     /// `count ≥ 2` points evenly spaced in `t` from root to tip.
-    pub fn polyline(&self, count: usize, definition: CurveDefinition, form: SegmentForm) -> Vec<DVec3> {
+    pub fn polyline(
+        &self,
+        count: usize,
+        definition: CurveDefinition,
+        form: SegmentForm,
+    ) -> Vec<DVec3> {
         let count = count.max(2);
         (0..count)
             .map(|i| {
@@ -285,7 +302,12 @@ mod tests {
         // C¹ at the junction: equal derivatives 2(m − q0) and 2(q1 − m) scaled by 2.
         assert!((first[2] - first[1]).distance(second[1] - second[0]) < 1e-15);
         // End tangents match the cubic's direction.
-        assert!((first[1] - first[0]).normalize().distance((b[1] - b[0]).normalize()) < 1e-15);
+        assert!(
+            (first[1] - first[0])
+                .normalize()
+                .distance((b[1] - b[0]).normalize())
+                < 1e-15
+        );
         let worst = (0..=100)
             .map(|i| {
                 let t = i as f64 / 100.0;
@@ -319,7 +341,11 @@ mod tests {
         for i in 0..=30 {
             let t = i as f64 / 10.0;
             let a = strand.point(t, CurveDefinition::ColumnBlend, SegmentForm::ExactCubic);
-            let b = strand.point(t, CurveDefinition::PerStrandCentripetal, SegmentForm::ExactCubic);
+            let b = strand.point(
+                t,
+                CurveDefinition::PerStrandCentripetal,
+                SegmentForm::ExactCubic,
+            );
             assert!(a.distance(b) < 1e-12);
             assert!(a.distance(DVec3::new(0.3, 0.6, t)) < 1e-12);
         }
@@ -332,14 +358,26 @@ mod tests {
                 let t = i as f64 / 10.0;
                 strand
                     .point(t, CurveDefinition::ColumnBlend, SegmentForm::ExactCubic)
-                    .distance(strand.point(t, CurveDefinition::PerStrandCentripetal, SegmentForm::ExactCubic))
+                    .distance(strand.point(
+                        t,
+                        CurveDefinition::PerStrandCentripetal,
+                        SegmentForm::ExactCubic,
+                    ))
             })
             .fold(0.0, f64::max);
         assert!(gap > 1e-4, "{gap}");
         // Both still pass through the blended layer points.
         for k in 0..=3 {
-            let a = strand.point(k as f64, CurveDefinition::ColumnBlend, SegmentForm::ExactCubic);
-            let b = strand.point(k as f64, CurveDefinition::PerStrandCentripetal, SegmentForm::ExactCubic);
+            let a = strand.point(
+                k as f64,
+                CurveDefinition::ColumnBlend,
+                SegmentForm::ExactCubic,
+            );
+            let b = strand.point(
+                k as f64,
+                CurveDefinition::PerStrandCentripetal,
+                SegmentForm::ExactCubic,
+            );
             assert!(a.distance(b) < 1e-12);
         }
     }

@@ -10,6 +10,7 @@ use crate::mesh::{HairMesh, InvalidMesh};
 /// A triangle mesh drawn under the hair (the head, the teapot) and used for depth testing.
 /// Positions are `f32` because the body is display-only; the hair mesh is `f64`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BodyMesh {
     pub positions: Vec<[f32; 3]>,
     pub triangles: Vec<[u32; 3]>,
@@ -42,6 +43,7 @@ impl BodyMesh {
 
 /// Everything an artist makes, saved in a project file and edited through commands.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Document {
     /// A human-readable name (the sample's or imported file's name).
     pub name: String,

@@ -15,7 +15,7 @@ use std::collections::{BTreeSet, HashMap};
 use glam::{DMat3, DQuat, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::curve::{curve_segments, cubic_point};
+use crate::curve::{cubic_point, curve_segments};
 use crate::interior::place_interior;
 use crate::mesh::{Bundle, Column, HairMesh, Topology, VertexRef, WMode};
 
@@ -33,7 +33,11 @@ pub enum EditError {
     )]
     InteriorVertex { column: u32, layer: u32 },
     #[error("layer {layer} is not an extruded layer of bundle {bundle} (it has {layers})")]
-    LayerOutOfRange { bundle: u32, layer: u32, layers: u32 },
+    LayerOutOfRange {
+        bundle: u32,
+        layer: u32,
+        layers: u32,
+    },
     #[error("{what} must be finite, got {value}")]
     NotFinite { what: &'static str, value: String },
     #[error("the edit would leave an invalid mesh: {0}")]
@@ -63,18 +67,31 @@ pub enum ExtrudeDirection {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum VertexTransform {
-    Translate { offset: [f64; 3] },
+    Translate {
+        offset: [f64; 3],
+    },
     /// Rotation by `angle_rad` around `axis` through `pivot`.
-    Rotate { axis: [f64; 3], angle_rad: f64, pivot: [f64; 3] },
+    Rotate {
+        axis: [f64; 3],
+        angle_rad: f64,
+        pivot: [f64; 3],
+    },
     /// Per-axis scale around `pivot`.
-    Scale { factors: [f64; 3], pivot: [f64; 3] },
+    Scale {
+        factors: [f64; 3],
+        pivot: [f64; 3],
+    },
 }
 
 impl VertexTransform {
     fn check_finite(&self) -> Result<(), EditError> {
         let values: Vec<f64> = match *self {
             Self::Translate { offset } => offset.to_vec(),
-            Self::Rotate { axis, angle_rad, pivot } => {
+            Self::Rotate {
+                axis,
+                angle_rad,
+                pivot,
+            } => {
                 let mut v = axis.to_vec();
                 v.push(angle_rad);
                 v.extend(pivot);
@@ -96,7 +113,11 @@ impl VertexTransform {
     fn apply(&self, p: DVec3, weight: f64) -> DVec3 {
         match *self {
             Self::Translate { offset } => p + DVec3::from(offset) * weight,
-            Self::Rotate { axis, angle_rad, pivot } => {
+            Self::Rotate {
+                axis,
+                angle_rad,
+                pivot,
+            } => {
                 let Some(axis) = DVec3::from(axis).try_normalize() else {
                     return p;
                 };
@@ -139,7 +160,11 @@ fn check_bundles(mesh: &HairMesh, bundles: &[u32]) -> Result<(), EditError> {
     Ok(())
 }
 
-fn finish(mut mesh: HairMesh, affected: BTreeSet<u32>, layers: Option<&[usize]>) -> Result<EditOutcome, EditError> {
+fn finish(
+    mut mesh: HairMesh,
+    affected: BTreeSet<u32>,
+    layers: Option<&[usize]>,
+) -> Result<EditOutcome, EditError> {
     place_interior(&mut mesh, layers);
     mesh.update_w();
     mesh.validate()?;
@@ -152,7 +177,11 @@ fn finish(mut mesh: HairMesh, affected: BTreeSet<u32>, layers: Option<&[usize]>)
 /// Extrudes each bundle in `bundles` by one layer. A bundle with `n` layers gets layer
 /// `n + 1`; where a taller neighbour already has that vertex it is shared, elsewhere a new
 /// vertex is created from the vertex below it.
-pub fn extrude(mesh: &HairMesh, bundles: &[u32], direction: ExtrudeDirection) -> Result<EditOutcome, EditError> {
+pub fn extrude(
+    mesh: &HairMesh,
+    bundles: &[u32],
+    direction: ExtrudeDirection,
+) -> Result<EditOutcome, EditError> {
     check_bundles(mesh, bundles)?;
     let (distance, offset) = match direction {
         ExtrudeDirection::AlongNormal { distance } => (distance, DVec3::ZERO),
@@ -197,7 +226,9 @@ pub fn extrude(mesh: &HairMesh, bundles: &[u32], direction: ExtrudeDirection) ->
                         .get(&(v, top))
                         .and_then(|n| n.try_normalize())
                         .or_else(|| {
-                            (top > 0).then(|| (base - column.positions[top - 1]).try_normalize()).flatten()
+                            (top > 0)
+                                .then(|| (base - column.positions[top - 1]).try_normalize())
+                                .flatten()
                         })
                         .unwrap_or(DVec3::Z);
                     normal * distance
@@ -229,7 +260,8 @@ pub fn layer_closure(mesh: &HairMesh, bundles: &[u32], layer: usize) -> BTreeSet
         }
         for &v in &mesh.bundles[b as usize].vertices {
             for &other in &topology.bundles_of_column[v as usize] {
-                if !result.contains(&other) && mesh.bundles[other as usize].layers as usize >= layer {
+                if !result.contains(&other) && mesh.bundles[other as usize].layers as usize >= layer
+                {
                     stack.push(other);
                 }
             }
@@ -242,7 +274,11 @@ fn check_layer(mesh: &HairMesh, bundles: &[u32], layer: u32) -> Result<(), EditE
     for &b in bundles {
         let layers = mesh.bundles[b as usize].layers;
         if layer == 0 || layer > layers {
-            return Err(EditError::LayerOutOfRange { bundle: b, layer, layers });
+            return Err(EditError::LayerOutOfRange {
+                bundle: b,
+                layer,
+                layers,
+            });
         }
     }
     Ok(())
@@ -251,7 +287,11 @@ fn check_layer(mesh: &HairMesh, bundles: &[u32], layer: u32) -> Result<(), EditE
 /// Inserts a layer between layers `layer − 1` and `layer` (1 ≤ layer ≤ n) of `bundles`
 /// and every bundle sharing their columns at that height. New vertices sit at the middle of
 /// their column's curve segment; w is interpolated the same way.
-pub fn insert_layer(mesh: &HairMesh, bundles: &[u32], layer: u32) -> Result<EditOutcome, EditError> {
+pub fn insert_layer(
+    mesh: &HairMesh,
+    bundles: &[u32],
+    layer: u32,
+) -> Result<EditOutcome, EditError> {
     check_bundles(mesh, bundles)?;
     check_layer(mesh, bundles, layer)?;
     let affected = layer_closure(mesh, bundles, layer as usize);
@@ -280,7 +320,11 @@ pub fn insert_layer(mesh: &HairMesh, bundles: &[u32], layer: u32) -> Result<Edit
 
 /// Deletes layer `layer` (1 ≤ layer ≤ n) of `bundles` and every bundle sharing their
 /// columns at that height; the layers above move down by one.
-pub fn delete_layer(mesh: &HairMesh, bundles: &[u32], layer: u32) -> Result<EditOutcome, EditError> {
+pub fn delete_layer(
+    mesh: &HairMesh,
+    bundles: &[u32],
+    layer: u32,
+) -> Result<EditOutcome, EditError> {
     check_bundles(mesh, bundles)?;
     check_layer(mesh, bundles, layer)?;
     let affected = layer_closure(mesh, bundles, layer as usize);
@@ -304,7 +348,11 @@ pub fn delete_layer(mesh: &HairMesh, bundles: &[u32], layer: u32) -> Result<Edit
 }
 
 /// Removes (`removed = true`) or restores bundles. Geometry is kept either way.
-pub fn set_removed(mesh: &HairMesh, bundles: &[u32], removed: bool) -> Result<EditOutcome, EditError> {
+pub fn set_removed(
+    mesh: &HairMesh,
+    bundles: &[u32],
+    removed: bool,
+) -> Result<EditOutcome, EditError> {
     check_bundles(mesh, bundles)?;
     let mut out = mesh.clone();
     for &b in bundles {
@@ -393,17 +441,41 @@ pub fn subdivide(mesh: &HairMesh, bundles: &[u32]) -> Result<EditOutcome, EditEr
             out.columns.push(blended_column(mesh, v, len));
             let uv_center = uv.iter().copied().sum::<DVec2>() * 0.25;
             vec![
-                child(vec![v[0], mid[0], center, mid[3]], vec![uv[0], uv_mid[0], uv_center, uv_mid[3]]),
-                child(vec![mid[0], v[1], mid[1], center], vec![uv_mid[0], uv[1], uv_mid[1], uv_center]),
-                child(vec![center, mid[1], v[2], mid[2]], vec![uv_center, uv_mid[1], uv[2], uv_mid[2]]),
-                child(vec![mid[3], center, mid[2], v[3]], vec![uv_mid[3], uv_center, uv_mid[2], uv[3]]),
+                child(
+                    vec![v[0], mid[0], center, mid[3]],
+                    vec![uv[0], uv_mid[0], uv_center, uv_mid[3]],
+                ),
+                child(
+                    vec![mid[0], v[1], mid[1], center],
+                    vec![uv_mid[0], uv[1], uv_mid[1], uv_center],
+                ),
+                child(
+                    vec![center, mid[1], v[2], mid[2]],
+                    vec![uv_center, uv_mid[1], uv[2], uv_mid[2]],
+                ),
+                child(
+                    vec![mid[3], center, mid[2], v[3]],
+                    vec![uv_mid[3], uv_center, uv_mid[2], uv[3]],
+                ),
             ]
         } else {
             vec![
-                child(vec![v[0], mid[0], mid[2]], vec![uv[0], uv_mid[0], uv_mid[2]]),
-                child(vec![mid[0], v[1], mid[1]], vec![uv_mid[0], uv[1], uv_mid[1]]),
-                child(vec![mid[2], mid[1], v[2]], vec![uv_mid[2], uv_mid[1], uv[2]]),
-                child(vec![mid[0], mid[1], mid[2]], vec![uv_mid[0], uv_mid[1], uv_mid[2]]),
+                child(
+                    vec![v[0], mid[0], mid[2]],
+                    vec![uv[0], uv_mid[0], uv_mid[2]],
+                ),
+                child(
+                    vec![mid[0], v[1], mid[1]],
+                    vec![uv_mid[0], uv[1], uv_mid[1]],
+                ),
+                child(
+                    vec![mid[2], mid[1], v[2]],
+                    vec![uv_mid[2], uv_mid[1], uv[2]],
+                ),
+                child(
+                    vec![mid[0], mid[1], mid[2]],
+                    vec![uv_mid[0], uv_mid[1], uv_mid[2]],
+                ),
             ]
         };
         let mut children = children.into_iter();
@@ -457,7 +529,8 @@ pub fn transform_vertices(
     }
     let selected: BTreeSet<VertexRef> = vertices.iter().copied().collect();
     let includes_root = selected.iter().any(|v| v.layer == 0);
-    let selected_positions: Vec<DVec3> = selected.iter().filter_map(|v| mesh.position(*v)).collect();
+    let selected_positions: Vec<DVec3> =
+        selected.iter().filter_map(|v| mesh.position(*v)).collect();
     let mut out = mesh.clone();
     let mut layers: BTreeSet<usize> = BTreeSet::new();
     for (c, column) in mesh.columns.iter().enumerate() {
@@ -493,10 +566,18 @@ pub fn transform_vertices(
     finish(out, affected, if all_layers { None } else { Some(&layers) })
 }
 
-fn affected_bundles_of_columns(_mesh: &HairMesh, topology: &Topology, vertices: &BTreeSet<VertexRef>) -> BTreeSet<u32> {
+fn affected_bundles_of_columns(
+    _mesh: &HairMesh,
+    topology: &Topology,
+    vertices: &BTreeSet<VertexRef>,
+) -> BTreeSet<u32> {
     vertices
         .iter()
-        .flat_map(|v| topology.bundles_of_column[v.column as usize].iter().copied())
+        .flat_map(|v| {
+            topology.bundles_of_column[v.column as usize]
+                .iter()
+                .copied()
+        })
         .collect()
 }
 
@@ -538,7 +619,10 @@ pub fn set_w_mode(mesh: &HairMesh, mode: WMode) -> Result<EditOutcome, EditError
 }
 
 /// Sets the uv of face corners: `(bundle, corner, uv)`.
-pub fn set_corner_uvs(mesh: &HairMesh, changes: &[(u32, u32, DVec2)]) -> Result<EditOutcome, EditError> {
+pub fn set_corner_uvs(
+    mesh: &HairMesh,
+    changes: &[(u32, u32, DVec2)],
+) -> Result<EditOutcome, EditError> {
     if changes.is_empty() {
         return Err(EditError::EmptySelection);
     }
@@ -582,13 +666,31 @@ mod tests {
     #[test]
     fn extrude_adds_one_layer_and_shares_taller_columns() {
         let mesh = grid(3, 1, 1, 1.0);
-        let out = extrude(&mesh, &[1], ExtrudeDirection::AlongNormal { distance: 0.5 }).expect("extrude");
+        let out =
+            extrude(&mesh, &[1], ExtrudeDirection::AlongNormal { distance: 0.5 }).expect("extrude");
         assert_eq!(out.mesh.bundles[1].layers, 2);
         assert_eq!(out.mesh.bundles[0].layers, 1);
         // Extruding the neighbour now reuses the shared column's vertex at layer 2.
-        let before = out.mesh.columns.iter().map(|c| c.positions.len()).sum::<usize>();
-        let again = extrude(&out.mesh, &[0], ExtrudeDirection::Vector { offset: [0.0, 0.0, 0.5] }).expect("extrude");
-        let after = again.mesh.columns.iter().map(|c| c.positions.len()).sum::<usize>();
+        let before = out
+            .mesh
+            .columns
+            .iter()
+            .map(|c| c.positions.len())
+            .sum::<usize>();
+        let again = extrude(
+            &out.mesh,
+            &[0],
+            ExtrudeDirection::Vector {
+                offset: [0.0, 0.0, 0.5],
+            },
+        )
+        .expect("extrude");
+        let after = again
+            .mesh
+            .columns
+            .iter()
+            .map(|c| c.positions.len())
+            .sum::<usize>();
         assert_eq!(after - before, 2, "two shared columns get no new vertex");
         assert!((again.mesh.columns[1].positions[2].z - 1.5).abs() < 1e-12);
     }
@@ -626,31 +728,67 @@ mod tests {
     #[test]
     fn interior_vertices_cannot_be_moved_and_bad_input_is_refused() {
         let mesh = grid(3, 3, 2, 0.5);
-        let interior = VertexRef { column: 5, layer: 1 };
-        let error = transform_vertices(&mesh, &[interior], VertexTransform::Translate { offset: [1.0, 0.0, 0.0] }, 0.0)
-            .expect_err("interior");
+        let interior = VertexRef {
+            column: 5,
+            layer: 1,
+        };
+        let error = transform_vertices(
+            &mesh,
+            &[interior],
+            VertexTransform::Translate {
+                offset: [1.0, 0.0, 0.0],
+            },
+            0.0,
+        )
+        .expect_err("interior");
         assert!(matches!(error, EditError::InteriorVertex { .. }), "{error}");
         let nan = transform_vertices(
             &mesh,
-            &[VertexRef { column: 0, layer: 1 }],
-            VertexTransform::Translate { offset: [f64::NAN, 0.0, 0.0] },
+            &[VertexRef {
+                column: 0,
+                layer: 1,
+            }],
+            VertexTransform::Translate {
+                offset: [f64::NAN, 0.0, 0.0],
+            },
             0.0,
         );
         assert!(matches!(nan, Err(EditError::NotFinite { .. })));
         assert!(matches!(
-            extrude(&mesh, &[99], ExtrudeDirection::AlongNormal { distance: 1.0 }),
+            extrude(
+                &mesh,
+                &[99],
+                ExtrudeDirection::AlongNormal { distance: 1.0 }
+            ),
             Err(EditError::BundleOutOfRange { index: 99, .. })
         ));
-        assert!(matches!(delete_layer(&mesh, &[0], 3), Err(EditError::LayerOutOfRange { .. })));
+        assert!(matches!(
+            delete_layer(&mesh, &[0], 3),
+            Err(EditError::LayerOutOfRange { .. })
+        ));
     }
 
     #[test]
     fn moving_the_rim_moves_interior_and_soft_selection_falls_off() {
         let mesh = grid(4, 4, 2, 0.5);
-        let rim: Vec<VertexRef> = (0..5).map(|i| VertexRef { column: i, layer: 1 }).collect();
-        let out = transform_vertices(&mesh, &rim, VertexTransform::Translate { offset: [0.0, 0.0, 1.0] }, 2.5)
-            .expect("move");
-        let moved = |c: usize, k: usize| out.mesh.columns[c].positions[k].z - mesh.columns[c].positions[k].z;
+        let rim: Vec<VertexRef> = (0..5)
+            .map(|i| VertexRef {
+                column: i,
+                layer: 1,
+            })
+            .collect();
+        let out = transform_vertices(
+            &mesh,
+            &rim,
+            VertexTransform::Translate {
+                offset: [0.0, 0.0, 1.0],
+            },
+            2.5,
+        )
+        .expect("move");
+        let moved = |c: usize, k: usize| {
+            out.mesh.columns[c].positions[k].z - mesh.columns[c].positions[k].z
+        };
         assert!((moved(0, 1) - 1.0).abs() < 1e-12);
         // Rim vertex two rows away (exterior) moves by the falloff weight.
         let expected = falloff_weight(2.0, 2.5);

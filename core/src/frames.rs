@@ -215,7 +215,11 @@ mod tests {
         // Per-bundle axes on each side differ, the shared frame lies between them.
         let side = |b: usize| {
             let bundle = &mesh.bundles[b];
-            let p: Vec<DVec3> = bundle.vertices.iter().map(|&v| mesh.columns[v as usize].positions[0]).collect();
+            let p: Vec<DVec3> = bundle
+                .vertices
+                .iter()
+                .map(|&v| mesh.columns[v as usize].positions[0])
+                .collect();
             (p[1] - p[0]).normalize()
         };
         let (left, right) = (side(1), side(2));

@@ -94,18 +94,27 @@ impl<T: Clone + PartialEq> VecDiff<T> {
             });
         }
         for change in &self.changes {
-            let expected = if forward { &change.before } else { &change.after };
+            let expected = if forward {
+                &change.before
+            } else {
+                &change.after
+            };
             if target.get(change.index as usize) != expected.as_ref() {
                 return Err(HistoryMismatch {
                     path: format!("{path}[{}]", change.index),
-                    message: "the document does not hold the value this history entry changed".into(),
+                    message: "the document does not hold the value this history entry changed"
+                        .into(),
                 });
             }
         }
         // Shrinking first, then element writes in ascending order, then growth in order.
         target.truncate(len_to as usize);
         for change in &self.changes {
-            let value = if forward { &change.after } else { &change.before };
+            let value = if forward {
+                &change.after
+            } else {
+                &change.before
+            };
             let index = change.index as usize;
             match value {
                 Some(value) if index < target.len() => target[index] = value.clone(),
@@ -122,7 +131,10 @@ impl<T: Clone + PartialEq> VecDiff<T> {
         if target.len() != len_to as usize {
             return Err(HistoryMismatch {
                 path: path.to_string(),
-                message: format!("history entry yields {} elements, expected {len_to}", target.len()),
+                message: format!(
+                    "history entry yields {} elements, expected {len_to}",
+                    target.len()
+                ),
             });
         }
         Ok(())
@@ -151,7 +163,12 @@ pub struct DocumentDiff {
 
 impl DocumentDiff {
     pub fn between(before: &Document, after: &Document) -> Self {
-        let swap = |b: &WMode, a: &WMode| (b != a).then(|| Swap { before: *b, after: *a });
+        let swap = |b: &WMode, a: &WMode| {
+            (b != a).then_some(Swap {
+                before: *b,
+                after: *a,
+            })
+        };
         Self {
             bundles: VecDiff::between(&before.hair_mesh.bundles, &after.hair_mesh.bundles),
             columns: VecDiff::between(&before.hair_mesh.columns, &after.hair_mesh.columns),
@@ -164,7 +181,10 @@ impl DocumentDiff {
     }
 
     pub fn is_empty(&self) -> bool {
-        self.bundles.is_empty() && self.columns.is_empty() && self.w_mode.is_none() && self.name.is_none()
+        self.bundles.is_empty()
+            && self.columns.is_empty()
+            && self.w_mode.is_none()
+            && self.name.is_none()
     }
 
     fn write(&self, document: &mut Document, forward: bool) -> Result<(), HistoryMismatch> {
@@ -176,7 +196,8 @@ impl DocumentDiff {
             if document.hair_mesh.w_mode != expected {
                 return Err(HistoryMismatch {
                     path: "hair_mesh.w_mode".into(),
-                    message: "the document does not hold the value this history entry changed".into(),
+                    message: "the document does not hold the value this history entry changed"
+                        .into(),
                 });
             }
         }
@@ -185,20 +206,29 @@ impl DocumentDiff {
             if &document.name != expected {
                 return Err(HistoryMismatch {
                     path: "name".into(),
-                    message: "the document does not hold the value this history entry changed".into(),
+                    message: "the document does not hold the value this history entry changed"
+                        .into(),
                 });
             }
         }
         let mut bundles = document.hair_mesh.bundles.clone();
-        self.bundles.write(&mut bundles, forward, "hair_mesh.bundles")?;
-        self.columns
-            .write(&mut document.hair_mesh.columns, forward, "hair_mesh.columns")?;
+        self.bundles
+            .write(&mut bundles, forward, "hair_mesh.bundles")?;
+        self.columns.write(
+            &mut document.hair_mesh.columns,
+            forward,
+            "hair_mesh.columns",
+        )?;
         document.hair_mesh.bundles = bundles;
         if let Some(swap) = &self.w_mode {
             document.hair_mesh.w_mode = if forward { swap.after } else { swap.before };
         }
         if let Some(swap) = &self.name {
-            document.name = if forward { swap.after.clone() } else { swap.before.clone() };
+            document.name = if forward {
+                swap.after.clone()
+            } else {
+                swap.before.clone()
+            };
         }
         Ok(())
     }
@@ -211,7 +241,10 @@ pub enum Command {
     /// An edit recorded as a diff.
     Edit { label: String, diff: DocumentDiff },
     /// Several commands as one step: applied in order, reverted in reverse.
-    Group { label: String, children: Vec<Command> },
+    Group {
+        label: String,
+        children: Vec<Command>,
+    },
 }
 
 impl Command {
@@ -344,7 +377,11 @@ impl History {
     }
 
     /// Undoes or redoes until `undo.len() == position` (the history panel's "jump here").
-    pub fn jump_to(&mut self, document: &mut Document, position: usize) -> Result<(), HistoryMismatch> {
+    pub fn jump_to(
+        &mut self,
+        document: &mut Document,
+        position: usize,
+    ) -> Result<(), HistoryMismatch> {
         while self.undo.len() > position {
             self.undo(document)?;
         }
@@ -368,21 +405,25 @@ impl History {
             })
         };
         for i in 0..redo_steps {
-            copy.redo(&mut scratch).map_err(|e| prefix(e, &format!("history.redo[{}]", redo_steps - 1 - i)))?;
+            copy.redo(&mut scratch)
+                .map_err(|e| prefix(e, &format!("history.redo[{}]", redo_steps - 1 - i)))?;
             check(&scratch, "after redo")?;
         }
         for i in 0..steps + redo_steps {
             let index = steps + redo_steps - 1 - i;
-            copy.undo(&mut scratch).map_err(|e| prefix(e, &format!("history step {index}")))?;
+            copy.undo(&mut scratch)
+                .map_err(|e| prefix(e, &format!("history step {index}")))?;
             check(&scratch, "after undo")?;
         }
         for _ in 0..steps {
-            copy.redo(&mut scratch).map_err(|e| prefix(e, "history (redo)"))?;
+            copy.redo(&mut scratch)
+                .map_err(|e| prefix(e, "history (redo)"))?;
         }
         if &scratch != document {
             return Err(HistoryMismatch {
                 path: "history".into(),
-                message: "undoing and redoing the history does not return to the saved document".into(),
+                message: "undoing and redoing the history does not return to the saved document"
+                    .into(),
             });
         }
         Ok(())

@@ -49,7 +49,10 @@ impl Default for ImportOptions {
 #[derive(Debug, thiserror::Error)]
 pub enum ImportError {
     #[error("{file}: cannot read: {source}")]
-    Read { file: String, source: std::io::Error },
+    Read {
+        file: String,
+        source: std::io::Error,
+    },
     #[error("{file}: not a valid glTF file: {message}")]
     Gltf { file: String, message: String },
     #[error("{file}: {message}")]
@@ -61,7 +64,9 @@ pub enum ImportError {
         primitive: usize,
         message: String,
     },
-    #[error("{file}: mesh \"{mesh}\", primitive {primitive}, accessor {accessor} ({semantic}): {message}")]
+    #[error(
+        "{file}: mesh \"{mesh}\", primitive {primitive}, accessor {accessor} ({semantic}): {message}"
+    )]
     Accessor {
         file: String,
         mesh: String,
@@ -177,12 +182,13 @@ pub fn import_slice(
     let document = &gltf.document;
     let meshes: Vec<gltf::Mesh> = document.meshes().collect();
     let mesh = match &options.mesh_name {
-        Some(name) => meshes.iter().find(|m| m.name() == Some(name.as_str())).ok_or_else(|| {
-            ImportError::NoMesh {
+        Some(name) => meshes
+            .iter()
+            .find(|m| m.name() == Some(name.as_str()))
+            .ok_or_else(|| ImportError::NoMesh {
                 file: file.to_string(),
                 message: format!("no mesh named \"{name}\" (meshes: {})", mesh_names(&meshes)),
-            }
-        })?,
+            })?,
         None => match meshes.as_slice() {
             [] => {
                 return Err(ImportError::NoMesh {
@@ -206,7 +212,8 @@ pub fn import_slice(
         .name()
         .map(str::to_string)
         .unwrap_or_else(|| format!("mesh {}", mesh.index()));
-    let transform = node_transform(document, mesh.index()) * DMat4::from_scale(DVec3::splat(options.scale));
+    let transform =
+        node_transform(document, mesh.index()) * DMat4::from_scale(DVec3::splat(options.scale));
     let normal_transform = transform.inverse().transpose();
 
     let mut positions: Vec<DVec3> = Vec::new();
@@ -286,7 +293,10 @@ pub fn import_slice(
                     return Err(context.error(
                         &accessor,
                         "indices",
-                        format!("{} indices is not a whole number of triangles", indices.len()),
+                        format!(
+                            "{} indices is not a whole number of triangles",
+                            indices.len()
+                        ),
                     ));
                 }
                 indices
@@ -333,8 +343,12 @@ pub fn import_slice(
         positions.extend(world);
     }
     let source_triangles = triangles.len();
-    let (positions, triangles, corner_uvs, degenerate) =
-        weld(&positions, &triangles, &corner_uvs, options.weld_tolerance_relative);
+    let (positions, triangles, corner_uvs, degenerate) = weld(
+        &positions,
+        &triangles,
+        &corner_uvs,
+        options.weld_tolerance_relative,
+    );
     if triangles.is_empty() {
         return Err(ImportError::Empty {
             file: file.to_string(),
@@ -342,7 +356,12 @@ pub fn import_slice(
         });
     }
     let (faces, uvs) = if options.pair_quads {
-        pair_quads(&positions, &triangles, &corner_uvs, options.max_quad_fold_deg)
+        pair_quads(
+            &positions,
+            &triangles,
+            &corner_uvs,
+            options.max_quad_fold_deg,
+        )
     } else {
         (
             triangles.iter().map(|t| t.to_vec()).collect(),
@@ -363,7 +382,11 @@ pub fn import_slice(
 fn mesh_names(meshes: &[gltf::Mesh]) -> String {
     meshes
         .iter()
-        .map(|m| m.name().map(|n| format!("\"{n}\"")).unwrap_or_else(|| format!("#{}", m.index())))
+        .map(|m| {
+            m.name()
+                .map(|n| format!("\"{n}\""))
+                .unwrap_or_else(|| format!("#{}", m.index()))
+        })
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -382,7 +405,8 @@ fn node_transform(document: &gltf::Document, mesh: usize) -> DMat4 {
         if node.mesh().is_some_and(|m| m.index() == mesh) {
             return Some(world);
         }
-        node.children().find_map(|child| visit(child, world, mesh, depth + 1))
+        node.children()
+            .find_map(|child| visit(child, world, mesh, depth + 1))
     }
     let scenes: Vec<gltf::Scene> = document
         .default_scene()
@@ -391,7 +415,11 @@ fn node_transform(document: &gltf::Document, mesh: usize) -> DMat4 {
         .collect();
     scenes
         .into_iter()
-        .find_map(|scene| scene.nodes().find_map(|node| visit(node, DMat4::IDENTITY, mesh, 0)))
+        .find_map(|scene| {
+            scene
+                .nodes()
+                .find_map(|node| visit(node, DMat4::IDENTITY, mesh, 0))
+        })
         .filter(|m| m.is_finite())
         .unwrap_or(DMat4::IDENTITY)
 }
@@ -418,7 +446,12 @@ impl AccessorContext<'_> {
     /// Reads an accessor of `components` components per element into f64 values, with
     /// normalised integers mapped to [0, 1] / [−1, 1]. Every read is bounds-checked and
     /// every value must be finite.
-    fn read_vec(&self, accessor: &gltf::Accessor, semantic: &str, components: usize) -> Result<Vec<Vec<f64>>, ImportError> {
+    fn read_vec(
+        &self,
+        accessor: &gltf::Accessor,
+        semantic: &str,
+        components: usize,
+    ) -> Result<Vec<Vec<f64>>, ImportError> {
         use gltf::accessor::{DataType, Dimensions};
         let fail = |message: String| self.error(accessor, semantic, message);
         let dims = match accessor.dimensions() {
@@ -429,7 +462,9 @@ impl AccessorContext<'_> {
             other => return Err(fail(format!("unsupported element type {other:?}"))),
         };
         if dims != components {
-            return Err(fail(format!("expected {components} components per element, found {dims}")));
+            return Err(fail(format!(
+                "expected {components} components per element, found {dims}"
+            )));
         }
         if accessor.sparse().is_some() {
             return Err(fail("sparse accessors are not supported".into()));
@@ -442,7 +477,9 @@ impl AccessorContext<'_> {
         let element_size = component_size * dims;
         let stride = view.stride().unwrap_or(element_size);
         if stride < element_size {
-            return Err(fail(format!("byte stride {stride} is smaller than the element ({element_size} bytes)")));
+            return Err(fail(format!(
+                "byte stride {stride} is smaller than the element ({element_size} bytes)"
+            )));
         }
         let Some(buffer) = self.buffers.get(view.buffer().index()) else {
             return Err(fail(format!("buffer {} is missing", view.buffer().index())));
@@ -465,7 +502,7 @@ impl AccessorContext<'_> {
         } else {
             accessor
                 .offset()
-                .checked_add(stride.checked_mul(count - 1).unwrap_or(usize::MAX))
+                .checked_add(stride.saturating_mul(count - 1))
                 .and_then(|v| v.checked_add(element_size))
                 .unwrap_or(usize::MAX)
         };
@@ -493,7 +530,11 @@ impl AccessorContext<'_> {
                     }
                     DataType::I16 => {
                         let v = i16::from_le_bytes([b[0], b[1]]) as f64;
-                        if normalized { (v / 32767.0).max(-1.0) } else { v }
+                        if normalized {
+                            (v / 32767.0).max(-1.0)
+                        } else {
+                            v
+                        }
                     }
                     DataType::U8 => {
                         let v = b[0] as f64;
@@ -505,7 +546,9 @@ impl AccessorContext<'_> {
                     }
                 };
                 if !value.is_finite() {
-                    return Err(fail(format!("element {i} component {c} is not finite ({value})")));
+                    return Err(fail(format!(
+                        "element {i} component {c} is not finite ({value})"
+                    )));
                 }
                 element.push(value);
             }
@@ -517,7 +560,10 @@ impl AccessorContext<'_> {
 
 /// Merges vertices closer than `relative_tolerance × bounding-box diagonal`, keeps corner uv
 /// and drops triangles that collapse. Returns (positions, triangles, uvs, dropped).
-#[expect(clippy::type_complexity, reason = "a private helper returning four parallel results")]
+#[expect(
+    clippy::type_complexity,
+    reason = "a private helper returning four parallel results"
+)]
 fn weld(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
@@ -528,7 +574,11 @@ fn weld(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
     );
-    let diagonal = if positions.is_empty() { 0.0 } else { (max - min).length() };
+    let diagonal = if positions.is_empty() {
+        0.0
+    } else {
+        (max - min).length()
+    };
     let tolerance = relative_tolerance.max(0.0) * diagonal;
     let cell = if tolerance > 0.0 { tolerance } else { 1.0 };
     let key = |p: DVec3| {
@@ -615,11 +665,18 @@ fn try_pair(
         }
         // The shared corners must carry the same uv on both sides (no seam on the diagonal).
         let uv_tolerance = 1e-9;
-        if a_uv[i].distance(b_uv[(j + 1) % 3]) > uv_tolerance || a_uv[(i + 1) % 3].distance(b_uv[j]) > uv_tolerance {
+        if a_uv[i].distance(b_uv[(j + 1) % 3]) > uv_tolerance
+            || a_uv[(i + 1) % 3].distance(b_uv[j]) > uv_tolerance
+        {
             return None;
         }
         let quad = [q, r, p, d];
-        let quad_uv = [a_uv[(i + 1) % 3], a_uv[(i + 2) % 3], a_uv[i], b_uv[(j + 2) % 3]];
+        let quad_uv = [
+            a_uv[(i + 1) % 3],
+            a_uv[(i + 2) % 3],
+            a_uv[i],
+            b_uv[(j + 2) % 3],
+        ];
         let at = |k: usize| positions[quad[k] as usize];
         let n_a = (at(1) - at(0)).cross(at(2) - at(0));
         let n_b = (at(2) - at(0)).cross(at(3) - at(0));
@@ -644,7 +701,10 @@ fn try_pair(
 /// Pairs triangles into quads: first consecutive triangles (exporters write a quad as two
 /// consecutive triangles), then any remaining neighbours across the longest edge of both
 /// (the quad's diagonal is its longest edge in well-shaped quads).
-#[expect(clippy::type_complexity, reason = "a private helper returning parallel face and uv lists")]
+#[expect(
+    clippy::type_complexity,
+    reason = "a private helper returning parallel face and uv lists"
+)]
 fn pair_quads(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
@@ -657,7 +717,14 @@ fn pair_quads(
     let mut paired = vec![false; count];
     let mut t = 0;
     while t + 1 < count {
-        if let Some((quad, quad_uv)) = try_pair(positions, triangles[t], uvs[t], triangles[t + 1], uvs[t + 1], min_fold_cos) {
+        if let Some((quad, quad_uv)) = try_pair(
+            positions,
+            triangles[t],
+            uvs[t],
+            triangles[t + 1],
+            uvs[t + 1],
+            min_fold_cos,
+        ) {
             partner[t] = Some((t + 1, quad, quad_uv));
             paired[t] = true;
             paired[t + 1] = true;
@@ -669,7 +736,9 @@ fn pair_quads(
     let longest_edge = |tri: [u32; 3]| {
         (0..3)
             .max_by(|&i, &j| {
-                let len = |k: usize| positions[tri[k] as usize].distance(positions[tri[(k + 1) % 3] as usize]);
+                let len = |k: usize| {
+                    positions[tri[k] as usize].distance(positions[tri[(k + 1) % 3] as usize])
+                };
                 len(i).total_cmp(&len(j))
             })
             .map(|i| {
@@ -681,7 +750,10 @@ fn pair_quads(
     let mut by_diagonal: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
     for t in 0..count {
         if !paired[t] {
-            by_diagonal.entry(longest_edge(triangles[t])).or_default().push(t);
+            by_diagonal
+                .entry(longest_edge(triangles[t]))
+                .or_default()
+                .push(t);
         }
     }
     for t in 0..count {
@@ -695,7 +767,14 @@ fn pair_quads(
             if other == t || paired[other] {
                 continue;
             }
-            if let Some((quad, quad_uv)) = try_pair(positions, triangles[t], uvs[t], triangles[other], uvs[other], min_fold_cos) {
+            if let Some((quad, quad_uv)) = try_pair(
+                positions,
+                triangles[t],
+                uvs[t],
+                triangles[other],
+                uvs[other],
+                min_fold_cos,
+            ) {
                 partner[t] = Some((other, quad, quad_uv));
                 paired[t] = true;
                 paired[other] = true;
@@ -739,17 +818,29 @@ mod tests {
         let tris = vec![[0, 1, 2], [0, 2, 3]];
         let uvs: Vec<[DVec2; 3]> = tris.iter().map(|t: &[u32; 3]| t.map(uv)).collect();
         let (faces, face_uvs) = pair_quads(&positions, &tris, &uvs, 30.0);
-        assert_eq!(faces, vec![vec![1, 2, 0, 3]]);
-        assert_eq!(face_uvs[0][0], DVec2::X);
+        assert_eq!(faces, vec![vec![0, 1, 2, 3]]);
+        assert_eq!(face_uvs[0][1], DVec2::X);
         // Fold the quad by 90°: stays two triangles.
-        let folded = vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::new(0.0, 1.0, -1.0)];
+        let folded = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, -1.0),
+        ];
         let (faces, _) = pair_quads(&folded, &tris, &uvs, 30.0);
         assert_eq!(faces.len(), 2);
     }
 
     #[test]
     fn weld_merges_close_vertices_and_drops_collapsed_triangles() {
-        let positions = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::X * (1.0 + 1e-9), DVec3::new(1.0, 1.0, 0.0), DVec3::Y * 1e-12];
+        let positions = vec![
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::X * (1.0 + 1e-9),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::Y * 1e-12,
+        ];
         let tris = vec![[0, 1, 2], [3, 4, 2], [0, 5, 1]];
         let uvs = vec![[DVec2::ZERO; 3]; 3];
         let (p, t, _, dropped) = weld(&positions, &tris, &uvs, 1e-6);

@@ -70,7 +70,10 @@ pub fn fit_affine(from: &[DVec3], to: &[DVec3]) -> AffineMap {
     // Work in units of each side's RMS spread so that huge (1e300) and tiny (1e-300)
     // coordinates neither overflow nor underflow in the products below.
     let rms = |points: &[DVec3], mean: DVec3| {
-        let sum: f64 = points.iter().map(|p| ((*p - mean) / (1.0 + mean.abs().max_element())).length_squared()).sum();
+        let sum: f64 = points
+            .iter()
+            .map(|p| ((*p - mean) / (1.0 + mean.abs().max_element())).length_squared())
+            .sum();
         (sum / count as f64).sqrt() * (1.0 + mean.abs().max_element())
     };
     let scale_from = rms(&from[..count], mean_from);
@@ -82,7 +85,11 @@ pub fn fit_affine(from: &[DVec3], to: &[DVec3]) -> AffineMap {
             translation: mean_to - mean_from,
         };
     }
-    let scale_to = if scale_to > 0.0 && scale_to.is_finite() { scale_to } else { 1.0 };
+    let scale_to = if scale_to > 0.0 && scale_to.is_finite() {
+        scale_to
+    } else {
+        1.0
+    };
     // Covariance XᵀX and cross term XᵀY of centred, normalised data (column-major DMat3).
     let mut xtx = DMat3::ZERO;
     let mut xty = DMat3::ZERO;
@@ -135,6 +142,10 @@ fn outer(a: DVec3, b: DVec3) -> DMat3 {
 
 /// Eigen-decomposition of a symmetric 3×3 matrix by cyclic Jacobi rotations. Returns
 /// eigenvalues in descending order and the matching unit eigenvectors as columns.
+#[expect(
+    clippy::needless_range_loop,
+    reason = "a Jacobi rotation updates rows and columns p and q in lockstep; indices mirror the textbook form"
+)]
 pub fn symmetric_eigen(matrix: DMat3) -> (DVec3, DMat3) {
     let mut a = matrix.to_cols_array_2d(); // a[col][row]; symmetric so a[i][j] == a[j][i]
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -176,7 +187,11 @@ pub fn symmetric_eigen(matrix: DMat3) -> (DVec3, DMat3) {
     // v[row][col]: eigenvector j is (v[0][j], v[1][j], v[2][j]).
     let mut order = [0usize, 1, 2];
     order.sort_by(|&i, &j| a[j][j].total_cmp(&a[i][i]));
-    let values = DVec3::new(a[order[0]][order[0]], a[order[1]][order[1]], a[order[2]][order[2]]);
+    let values = DVec3::new(
+        a[order[0]][order[0]],
+        a[order[1]][order[1]],
+        a[order[2]][order[2]],
+    );
     let column = |j: usize| DVec3::new(v[0][j], v[1][j], v[2][j]);
     let vectors = DMat3::from_cols(column(order[0]), column(order[1]), column(order[2]));
     (values, vectors)
@@ -229,9 +244,7 @@ fn place_layer(mesh: &mut HairMesh, topology: &Topology, layer: usize) {
     if !interior_flags.iter().any(|&f| f) {
         return;
     }
-    let exterior: Vec<usize> = (0..members.len())
-        .filter(|&s| !interior_flags[s])
-        .collect();
+    let exterior: Vec<usize> = (0..members.len()).filter(|&s| !interior_flags[s]).collect();
     let from: Vec<DVec3> = exterior
         .iter()
         .map(|&s| mesh.columns[members[s]].positions[0])
@@ -367,7 +380,12 @@ fn solve_harmonic(
 
 /// Linear interpolation along a column between the nearest exterior vertices below and
 /// above `layer`, by layer index.
-fn column_interpolation(mesh: &HairMesh, topology: &Topology, column: usize, layer: usize) -> DVec3 {
+fn column_interpolation(
+    mesh: &HairMesh,
+    topology: &Topology,
+    column: usize,
+    layer: usize,
+) -> DVec3 {
     let positions = &mesh.columns[column].positions;
     let below = (0..layer)
         .rev()
@@ -391,7 +409,9 @@ mod tests {
     fn random_affine(seed: u64) -> AffineMap {
         let mut state = seed;
         let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         };
         let linear = DMat3::from_cols(
@@ -467,12 +487,19 @@ mod tests {
             vec![DVec3::ONE; 5],
             (0..5).map(|i| DVec3::X * i as f64).collect(),
             vec![DVec3::splat(1e300), DVec3::splat(-1e300)],
-            vec![DVec3::splat(1e-300), DVec3::ZERO, DVec3::new(0.0, 1e-300, 0.0)],
+            vec![
+                DVec3::splat(1e-300),
+                DVec3::ZERO,
+                DVec3::new(0.0, 1e-300, 0.0),
+            ],
         ];
         for from in cases {
             let to: Vec<DVec3> = from.iter().map(|p| *p * 2.0 + DVec3::Y).collect();
             let fit = fit_affine(&from, &to);
-            assert!(fit.linear.is_finite() && fit.translation.is_finite(), "{from:?}");
+            assert!(
+                fit.linear.is_finite() && fit.translation.is_finite(),
+                "{from:?}"
+            );
         }
     }
 
@@ -498,7 +525,10 @@ mod tests {
                 let placed = mesh.columns[c].positions[2];
                 if mesh.is_interior(&topology, c, 2) {
                     let expected = map.apply(mesh.columns[c].positions[0]);
-                    assert!(placed.distance(expected) < 1e-9, "column {c}: {placed} vs {expected}");
+                    assert!(
+                        placed.distance(expected) < 1e-9,
+                        "column {c}: {placed} vs {expected}"
+                    );
                 } else {
                     assert_eq!(placed, before.columns[c].positions[2], "exterior moved");
                 }
@@ -528,7 +558,10 @@ mod tests {
                 .zip(&base.columns)
                 .map(|(a, b)| a.positions[1].distance(b.positions[1]))
                 .fold(0.0, f64::max);
-            assert!(change <= 10.0 * epsilon, "change {change} for push {epsilon}");
+            assert!(
+                change <= 10.0 * epsilon,
+                "change {change} for push {epsilon}"
+            );
             assert!(change < previous_change);
             previous_change = change;
         }
@@ -539,9 +572,9 @@ mod tests {
         let mut mesh = saddle(5, 3);
         let topology = Topology::build(&mesh);
         let cases: [fn(DVec3, usize) -> DVec3; 4] = [
-            |_, _| DVec3::new(1.0, 2.0, 3.0),                 // all exterior coincident
-            |r, _| DVec3::new(r.x + r.y, 0.0, 0.0),           // collinear
-            |r, _| DVec3::new(r.x, r.y, 0.0),                 // coplanar (flattened)
+            |_, _| DVec3::new(1.0, 2.0, 3.0),       // all exterior coincident
+            |r, _| DVec3::new(r.x + r.y, 0.0, 0.0), // collinear
+            |r, _| DVec3::new(r.x, r.y, 0.0),       // coplanar (flattened)
             |r, c| r * if c % 2 == 0 { 1e-12 } else { 1e12 }, // wild scales
         ];
         for case in cases {
@@ -564,7 +597,11 @@ mod tests {
             }
         }
         place_interior(&mut mesh, None);
-        assert!(mesh.columns.iter().all(|c| c.positions.iter().all(|p| p.is_finite())));
+        assert!(
+            mesh.columns
+                .iter()
+                .all(|c| c.positions.iter().all(|p| p.is_finite()))
+        );
     }
 
     #[test]
@@ -582,7 +619,10 @@ mod tests {
             vec![0, 4, 6, 2],
             vec![1, 3, 7, 5],
         ];
-        let uvs = faces.iter().map(|f| vec![glam::DVec2::ZERO; f.len()]).collect::<Vec<_>>();
+        let uvs = faces
+            .iter()
+            .map(|f| vec![glam::DVec2::ZERO; f.len()])
+            .collect::<Vec<_>>();
         let mut mesh = HairMesh::from_scalp(&positions, &faces, &uvs);
         let center = DVec3::splat(0.5);
         for column in &mut mesh.columns {

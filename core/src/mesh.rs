@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 /// One root face and the bundle extruded from it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Bundle {
     /// Column (root vertex) indices, counter-clockwise seen from outside: 3 or 4 entries.
     pub vertices: Vec<u32>,
@@ -50,6 +51,7 @@ impl Bundle {
 
 /// The vertices of one root vertex on successive layers.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Column {
     /// Object-space position per layer; index 0 is the root (scalp) vertex.
     pub positions: Vec<DVec3>,
@@ -80,6 +82,7 @@ pub struct VertexRef {
 
 /// The hair mesh document data.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct HairMesh {
     pub bundles: Vec<Bundle>,
     pub columns: Vec<Column>,
@@ -378,8 +381,16 @@ impl HairMesh {
         }
         MeshStats {
             root_faces: self.bundles.len(),
-            quads: self.bundles.iter().filter(|b| b.vertices.len() == 4).count(),
-            triangles: self.bundles.iter().filter(|b| b.vertices.len() == 3).count(),
+            quads: self
+                .bundles
+                .iter()
+                .filter(|b| b.vertices.len() == 4)
+                .count(),
+            triangles: self
+                .bundles
+                .iter()
+                .filter(|b| b.vertices.len() == 3)
+                .count(),
             removed_bundles: self.bundles.iter().filter(|b| b.removed).count(),
             hair_bundles: self
                 .bundles

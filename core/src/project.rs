@@ -48,23 +48,38 @@ impl Project {
 #[derive(Debug, thiserror::Error)]
 pub enum ProjectError {
     #[error("{path}: cannot read: {source}")]
-    Read { path: PathBuf, source: std::io::Error },
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{path}: cannot write: {source}")]
-    Write { path: PathBuf, source: std::io::Error },
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{path}: not a Hairloom project: {message}")]
     NotAProject { path: PathBuf, message: String },
     #[error(
         "{path}: written by a newer Hairloom (format version {found}; this build reads up to {supported}); update Hairloom to open it"
     )]
-    NewerVersion { path: PathBuf, found: u64, supported: u32 },
+    NewerVersion {
+        path: PathBuf,
+        found: u64,
+        supported: u32,
+    },
     #[error("{path}: at {json_path}: {message}")]
-    Invalid { path: PathBuf, json_path: String, message: String },
+    Invalid {
+        path: PathBuf,
+        json_path: String,
+        message: String,
+    },
 }
 
 /// Serialises a project to the bytes of a project file.
 pub fn to_bytes(project: &Project) -> Vec<u8> {
     let mut bytes = Vec::new();
-    let mut serializer = serde_json::Serializer::with_formatter(&mut bytes, ProjectFormatter::default());
+    let mut serializer =
+        serde_json::Serializer::with_formatter(&mut bytes, ProjectFormatter::default());
     // Serialising plain data into memory cannot fail: every map key is a string and
     // non-finite floats are written as null (and refused again by validation on load).
     if project.serialize(&mut serializer).is_err() {
@@ -86,7 +101,8 @@ pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Project, ProjectError> {
     struct VersionOnly {
         format_version: Option<serde_json::Value>,
     }
-    let version: VersionOnly = serde_json::from_slice(bytes).map_err(|e| not_a_project(e.to_string()))?;
+    let version: VersionOnly =
+        serde_json::from_slice(bytes).map_err(|e| not_a_project(e.to_string()))?;
     let Some(version) = version.format_version else {
         return Err(not_a_project("missing \"format_version\"".into()));
     };
@@ -112,16 +128,20 @@ pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Project, ProjectError> {
         });
     }
     let deserializer = &mut serde_json::Deserializer::from_slice(bytes);
-    let project: Project = serde_path_to_error::deserialize(deserializer).map_err(|e| ProjectError::Invalid {
-        path: path.to_path_buf(),
-        json_path: e.path().to_string(),
-        message: e.inner().to_string(),
-    })?;
-    project.document.validate().map_err(|e| ProjectError::Invalid {
-        path: path.to_path_buf(),
-        json_path: format!("document.{}", e.path),
-        message: e.message,
-    })?;
+    let project: Project =
+        serde_path_to_error::deserialize(deserializer).map_err(|e| ProjectError::Invalid {
+            path: path.to_path_buf(),
+            json_path: e.path().to_string(),
+            message: e.inner().to_string(),
+        })?;
+    project
+        .document
+        .validate()
+        .map_err(|e| ProjectError::Invalid {
+            path: path.to_path_buf(),
+            json_path: format!("document.{}", e.path),
+            message: e.message,
+        })?;
     if project.history.limit == 0 {
         return Err(ProjectError::Invalid {
             path: path.to_path_buf(),
@@ -129,11 +149,14 @@ pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Project, ProjectError> {
             message: "the history limit must be at least 1".into(),
         });
     }
-    project.history.verify(&project.document).map_err(|e| ProjectError::Invalid {
-        path: path.to_path_buf(),
-        json_path: e.path,
-        message: e.message,
-    })?;
+    project
+        .history
+        .verify(&project.document)
+        .map_err(|e| ProjectError::Invalid {
+            path: path.to_path_buf(),
+            json_path: e.path,
+            message: e.message,
+        })?;
     Ok(project)
 }
 
@@ -164,14 +187,18 @@ pub const WRITE_CHUNK_BYTES: usize = 64 * 1024;
 ///
 /// `after_chunk(bytes_written_so_far)` runs after every [`WRITE_CHUNK_BYTES`]; tests use it
 /// to crash a writer halfway.
-pub fn write_atomic(path: &Path, bytes: &[u8], mut after_chunk: impl FnMut(usize)) -> std::io::Result<()> {
+pub fn write_atomic(
+    path: &Path,
+    bytes: &[u8],
+    mut after_chunk: impl FnMut(usize),
+) -> std::io::Result<()> {
     let folder = match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path names no file"))?;
+    let file_name = path.file_name().ok_or_else(|| {
+        std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path names no file")
+    })?;
     let temp_path = folder.join(format!(
         ".{}.tmp-{}",
         file_name.to_string_lossy(),
@@ -250,7 +277,11 @@ impl serde_json::ser::Formatter for ProjectFormatter {
         writer.write_all(b"]")
     }
 
-    fn begin_array_value<W: ?Sized + Write>(&mut self, writer: &mut W, first: bool) -> std::io::Result<()> {
+    fn begin_array_value<W: ?Sized + Write>(
+        &mut self,
+        writer: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
         if !first {
             writer.write_all(b",")?;
             if let Some(frame) = self.stack.last()
@@ -298,7 +329,11 @@ impl serde_json::ser::Formatter for ProjectFormatter {
         writer.write_all(b"}")
     }
 
-    fn begin_object_key<W: ?Sized + Write>(&mut self, writer: &mut W, first: bool) -> std::io::Result<()> {
+    fn begin_object_key<W: ?Sized + Write>(
+        &mut self,
+        writer: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
         if !first {
             writer.write_all(b",")?;
         }

@@ -55,7 +55,10 @@ pub fn head_scalp(glb: &[u8]) -> Result<(HairMesh, BodyMesh), ImportError> {
         .faces
         .iter()
         .map(|face| {
-            let p: Vec<DVec3> = face.iter().map(|&v| imported.positions[v as usize]).collect();
+            let p: Vec<DVec3> = face
+                .iter()
+                .map(|&v| imported.positions[v as usize])
+                .collect();
             let centroid = p.iter().copied().sum::<DVec3>() / p.len() as f64;
             let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
             is_head_scalp(centroid, normal)
@@ -75,7 +78,8 @@ pub fn head_scalp(glb: &[u8]) -> Result<(HairMesh, BodyMesh), ImportError> {
 
 /// Keeps only the largest edge-connected group of kept faces (drops stray islands).
 fn largest_component(faces: &[Vec<u32>], keep: &[bool]) -> Vec<bool> {
-    let mut faces_of_vertex: std::collections::HashMap<u32, Vec<usize>> = std::collections::HashMap::new();
+    let mut faces_of_vertex: std::collections::HashMap<u32, Vec<usize>> =
+        std::collections::HashMap::new();
     for (f, face) in faces.iter().enumerate() {
         if keep[f] {
             for &v in face {
@@ -130,7 +134,13 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
     let all: Vec<u32> = (0..scalp.bundles.len() as u32).collect();
     let mut mesh = scalp.clone();
     for _ in 0..growth.layers {
-        match extrude(&mesh, &all, ExtrudeDirection::AlongNormal { distance: growth.step_m }) {
+        match extrude(
+            &mesh,
+            &all,
+            ExtrudeDirection::AlongNormal {
+                distance: growth.step_m,
+            },
+        ) {
             Ok(outcome) => mesh = outcome.mesh,
             Err(_) => return mesh,
         }
@@ -176,22 +186,40 @@ fn root_normals(mesh: &HairMesh) -> Vec<DVec3> {
             normals[bundle.vertices[i] as usize] += normal;
         }
     }
-    normals.into_iter().map(|n| n.normalize_or(DVec3::Y)).collect()
+    normals
+        .into_iter()
+        .map(|n| n.normalize_or(DVec3::Y))
+        .collect()
 }
 
 /// The three head hairstyles.
 pub const HEAD_STYLES: [(&str, Growth); 3] = [
     (
         "head_short_straight",
-        Growth { layers: 2, step_m: 0.012, gravity: 0.25, volume: 0.12 },
+        Growth {
+            layers: 2,
+            step_m: 0.012,
+            gravity: 0.25,
+            volume: 0.12,
+        },
     ),
     (
         "head_long_wavy",
-        Growth { layers: 6, step_m: 0.04, gravity: 1.0, volume: 0.18 },
+        Growth {
+            layers: 6,
+            step_m: 0.04,
+            gravity: 1.0,
+            volume: 0.18,
+        },
     ),
     (
         "head_curly",
-        Growth { layers: 4, step_m: 0.025, gravity: 0.5, volume: 0.3 },
+        Growth {
+            layers: 4,
+            step_m: 0.025,
+            gravity: 0.5,
+            volume: 0.3,
+        },
     ),
 ];
 
@@ -242,7 +270,11 @@ pub fn teapot_project(teapot_text: &str) -> Result<Project, crate::teapot::Teapo
     };
     let all: Vec<u32> = (0..scalp.bundles.len() as u32).collect();
     let mut mesh = scalp;
-    if let Ok(outcome) = extrude(&mesh, &all, ExtrudeDirection::AlongNormal { distance: 0.012 }) {
+    if let Ok(outcome) = extrude(
+        &mesh,
+        &all,
+        ExtrudeDirection::AlongNormal { distance: 0.012 },
+    ) {
         mesh = outcome.mesh;
     }
     let mut document = Document::new("teapot_fur", mesh);
@@ -257,6 +289,10 @@ pub fn tips_inside_ellipsoid(mesh: &HairMesh, radii_m: DVec3) -> usize {
     mesh.columns
         .iter()
         .filter(|c| c.positions.len() > 1)
-        .filter(|c| c.positions.last().is_some_and(|p| (*p / radii_m).length() < 0.98))
+        .filter(|c| {
+            c.positions
+                .last()
+                .is_some_and(|p| (*p / radii_m).length() < 0.98)
+        })
         .count()
 }

@@ -29,47 +29,78 @@ pub fn parse(text: &str) -> Result<Patches, TeapotError> {
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let header = |lines: &mut dyn Iterator<Item = (usize, &str)>, word: &str| -> Result<usize, TeapotError> {
+    let header = |lines: &mut dyn Iterator<Item = (usize, &str)>,
+                  word: &str|
+     -> Result<usize, TeapotError> {
         let (line, text) = lines.next().ok_or(TeapotError {
             line: 0,
             message: format!("missing \"{word}\" header"),
         })?;
         let mut parts = text.split_whitespace();
         if parts.next() != Some(word) {
-            return Err(TeapotError { line, message: format!("expected \"{word} N\"") });
+            return Err(TeapotError {
+                line,
+                message: format!("expected \"{word} N\""),
+            });
         }
         parts
             .next()
             .and_then(|n| n.parse().ok())
-            .ok_or(TeapotError { line, message: format!("bad count after \"{word}\"") })
+            .ok_or(TeapotError {
+                line,
+                message: format!("bad count after \"{word}\""),
+            })
     };
     let patch_count = header(&mut lines, "patches")?;
     let mut patches = Vec::with_capacity(patch_count);
     for _ in 0..patch_count {
-        let (line, text) = lines.next().ok_or(TeapotError { line: 0, message: "missing patch rows".into() })?;
+        let (line, text) = lines.next().ok_or(TeapotError {
+            line: 0,
+            message: "missing patch rows".into(),
+        })?;
         let values: Vec<usize> = text
             .split_whitespace()
-            .map(|v| v.parse().map_err(|_| TeapotError { line, message: format!("bad index \"{v}\"") }))
+            .map(|v| {
+                v.parse().map_err(|_| TeapotError {
+                    line,
+                    message: format!("bad index \"{v}\""),
+                })
+            })
             .collect::<Result<_, _>>()?;
-        let patch: [usize; 16] = values
-            .try_into()
-            .map_err(|_| TeapotError { line, message: "a patch needs 16 indices".into() })?;
+        let patch: [usize; 16] = values.try_into().map_err(|_| TeapotError {
+            line,
+            message: "a patch needs 16 indices".into(),
+        })?;
         patches.push(patch);
     }
     let point_count = header(&mut lines, "points")?;
     let mut points = Vec::with_capacity(point_count);
     for _ in 0..point_count {
-        let (line, text) = lines.next().ok_or(TeapotError { line: 0, message: "missing point rows".into() })?;
+        let (line, text) = lines.next().ok_or(TeapotError {
+            line: 0,
+            message: "missing point rows".into(),
+        })?;
         let values: Vec<f64> = text
             .split_whitespace()
-            .map(|v| v.parse().map_err(|_| TeapotError { line, message: format!("bad number \"{v}\"") }))
+            .map(|v| {
+                v.parse().map_err(|_| TeapotError {
+                    line,
+                    message: format!("bad number \"{v}\""),
+                })
+            })
             .collect::<Result<_, _>>()?;
         let [x, y, z] = values[..] else {
-            return Err(TeapotError { line, message: "a point needs 3 numbers".into() });
+            return Err(TeapotError {
+                line,
+                message: "a point needs 3 numbers".into(),
+            });
         };
         let p = DVec3::new(x, y, z);
         if !p.is_finite() {
-            return Err(TeapotError { line, message: "point is not finite".into() });
+            return Err(TeapotError {
+                line,
+                message: "point is not finite".into(),
+            });
         }
         points.push(p);
     }
@@ -77,7 +108,10 @@ pub fn parse(text: &str) -> Result<Patches, TeapotError> {
         if let Some(&bad) = patch.iter().find(|&&v| v >= points.len()) {
             return Err(TeapotError {
                 line: 0,
-                message: format!("patch {i} uses point {bad}, but there are {} points", points.len()),
+                message: format!(
+                    "patch {i} uses point {bad}, but there are {} points",
+                    points.len()
+                ),
             });
         }
     }
@@ -98,9 +132,15 @@ pub fn tessellate(patches: &Patches, n: usize) -> HairMesh {
     let mut positions: Vec<DVec3> = Vec::new();
     let mut faces: Vec<Vec<u32>> = Vec::new();
     let mut uvs: Vec<Vec<DVec2>> = Vec::new();
-    let scale = patches.points.iter().map(|p| p.abs().max_element()).fold(0.0, f64::max).max(1.0);
+    let scale = patches
+        .points
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0, f64::max)
+        .max(1.0);
     let tolerance = 1e-9 * scale;
-    let mut lookup: std::collections::HashMap<(i64, i64, i64), u32> = std::collections::HashMap::new();
+    let mut lookup: std::collections::HashMap<(i64, i64, i64), u32> =
+        std::collections::HashMap::new();
     let mut vertex = |p: DVec3, positions: &mut Vec<DVec3>| {
         let q = (p / tolerance).round();
         let key = (q.x as i64, q.y as i64, q.z as i64);
@@ -141,7 +181,10 @@ pub fn tessellate(patches: &Patches, n: usize) -> HairMesh {
                     let v = grid[a * (n + 1) + b];
                     if face.last() != Some(&v) && face.first() != Some(&v) {
                         face.push(v);
-                        face_uv.push((atlas + DVec2::new(b as f64, a as f64) / n as f64) / DVec2::new(8.0, 4.0));
+                        face_uv.push(
+                            (atlas + DVec2::new(b as f64, a as f64) / n as f64)
+                                / DVec2::new(8.0, 4.0),
+                        );
                     }
                 }
                 if face.len() >= 3 {

@@ -62,7 +62,11 @@ fn default_projection(mesh: &HairMesh) -> (DVec3, DVec3, DVec3) {
         .map(|c| c.positions[0].distance(centroid))
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
-    (centroid - axis * radius, axis, axis.any_orthonormal_vector())
+    (
+        centroid - axis * radius,
+        axis,
+        axis.any_orthonormal_vector(),
+    )
 }
 
 #[cfg(test)]

@@ -42,7 +42,12 @@ fn cap(n: usize, layers: u32) -> anyhow::Result<HairMesh> {
     let mut uvs = Vec::new();
     for j in 0..n {
         for i in 0..n {
-            let face = vec![index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)];
+            let face = vec![
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            ];
             uvs.push(
                 face.iter()
                     .map(|&v| positions[v as usize].truncate() * 5.0)
@@ -54,7 +59,12 @@ fn cap(n: usize, layers: u32) -> anyhow::Result<HairMesh> {
     let mut mesh = HairMesh::from_scalp(&positions, &faces, &uvs);
     let all: Vec<u32> = (0..mesh.bundles.len() as u32).collect();
     for _ in 0..layers {
-        mesh = extrude(&mesh, &all, ExtrudeDirection::AlongNormal { distance: 0.02 })?.mesh;
+        mesh = extrude(
+            &mesh,
+            &all,
+            ExtrudeDirection::AlongNormal { distance: 0.02 },
+        )?
+        .mesh;
     }
     Ok(mesh)
 }
@@ -75,13 +85,20 @@ fn interior(repeat: usize) -> anyhow::Result<()> {
         let mesh = cap(n, layers)?;
         let topology = Topology::build(&mesh);
         let interior_count = (0..mesh.columns.len())
-            .map(|c| (0..mesh.columns[c].positions.len()).filter(|&k| mesh.is_interior(&topology, c, k)).count())
+            .map(|c| {
+                (0..mesh.columns[c].positions.len())
+                    .filter(|&k| mesh.is_interior(&topology, c, k))
+                    .count()
+            })
             .sum::<usize>();
         let mut all_layers = Vec::new();
         let mut one_layer = Vec::new();
         let mut drag = Vec::new();
         // A rim vertex on layer 2 moved as in an interactive drag (transform + placement).
-        let rim = VertexRef { column: 0, layer: 2 };
+        let rim = VertexRef {
+            column: 0,
+            layer: 2,
+        };
         for r in 0..repeat {
             let mut scratch = mesh.clone();
             let start = Instant::now();
@@ -92,7 +109,8 @@ fn interior(repeat: usize) -> anyhow::Result<()> {
             one_layer.push(start.elapsed().as_secs_f64() * 1e3);
             let offset = [0.001 * (r as f64 + 1.0), 0.0, 0.0];
             let start = Instant::now();
-            let _edited = transform_vertices(&mesh, &[rim], VertexTransform::Translate { offset }, 0.05)?;
+            let _edited =
+                transform_vertices(&mesh, &[rim], VertexTransform::Translate { offset }, 0.05)?;
             drag.push(start.elapsed().as_secs_f64() * 1e3);
         }
         println!(
@@ -119,6 +137,8 @@ pub fn machine() -> String {
                 .map(|s| s.trim().to_string())
         })
         .unwrap_or_else(|| std::env::consts::ARCH.to_string());
-    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
     format!("{model}, {cores} cores")
 }

@@ -14,7 +14,11 @@ use hairloom_core::project;
 mod bench;
 
 #[derive(Parser)]
-#[command(name = "hairloom", version, about = "Hair-mesh modeling and styling editor")]
+#[command(
+    name = "hairloom",
+    version,
+    about = "Hair-mesh modeling and styling editor"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -136,7 +140,10 @@ fn info(file: &Path, json: bool) -> anyhow::Result<()> {
         "vertices:         {} ({} interior, placed automatically)",
         stats.vertices, stats.interior_vertices
     );
-    println!("layers:           {} to {}", stats.min_layers, stats.max_layers);
+    println!(
+        "layers:           {} to {}",
+        stats.min_layers, stats.max_layers
+    );
     println!("body triangles:   {}", document.body.triangles.len());
     println!(
         "history:          {} undo, {} redo (limit {})",
@@ -147,7 +154,13 @@ fn info(file: &Path, json: bool) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn import(scalp: &Path, out: &Path, mesh: Option<String>, scale: f64, generate_uv: bool) -> anyhow::Result<()> {
+fn import(
+    scalp: &Path,
+    out: &Path,
+    mesh: Option<String>,
+    scale: f64,
+    generate_uv: bool,
+) -> anyhow::Result<()> {
     use hairloom_core::import::{ImportOptions, import_file};
     if !(scale.is_finite() && scale > 0.0) {
         anyhow::bail!("--scale must be a positive number, got {scale}");
@@ -181,7 +194,11 @@ fn import(scalp: &Path, out: &Path, mesh: Option<String>, scale: f64, generate_u
         imported.triangle_count(),
         imported.source_triangles,
         imported.degenerate_triangles,
-        if imported.has_uv { "" } else { "; uv generated (the file has no TEXCOORD_0)" }
+        if imported.has_uv {
+            ""
+        } else {
+            "; uv generated (the file has no TEXCOORD_0)"
+        }
     );
     Ok(())
 }
@@ -189,13 +206,18 @@ fn import(scalp: &Path, out: &Path, mesh: Option<String>, scale: f64, generate_u
 fn adapters() -> anyhow::Result<()> {
     let all = hairloom_render::device::list_adapters();
     if all.is_empty() {
-        println!("no adapter found (install mesa-vulkan-drivers for the lavapipe software adapter)");
+        println!(
+            "no adapter found (install mesa-vulkan-drivers for the lavapipe software adapter)"
+        );
     }
     for info in &all {
         println!("{}", hairloom_render::device::describe(info));
     }
     match hairloom_render::device::GpuContext::new_headless() {
-        Ok(context) => println!("chosen: {}", hairloom_render::device::describe(&context.adapter_info)),
+        Ok(context) => println!(
+            "chosen: {}",
+            hairloom_render::device::describe(&context.adapter_info)
+        ),
         Err(error) => println!("chosen: none ({error})"),
     }
     Ok(())

@@ -49,14 +49,21 @@ fn rank(device_type: wgpu::DeviceType) -> u8 {
 
 /// Picks an adapter index from `infos` according to `wanted` (the value of
 /// [`ADAPTER_ENV`], if set). Pure, so the policy is testable without a GPU.
-pub fn choose_adapter(infos: &[wgpu::AdapterInfo], wanted: Option<&str>) -> Result<usize, DeviceError> {
+pub fn choose_adapter(
+    infos: &[wgpu::AdapterInfo],
+    wanted: Option<&str>,
+) -> Result<usize, DeviceError> {
     if infos.is_empty() {
         return Err(DeviceError::NoAdapter);
     }
     let filter: Box<dyn Fn(&wgpu::AdapterInfo) -> bool> = match wanted.map(str::trim) {
         None | Some("") => Box::new(|_| true),
-        Some(w) if w.eq_ignore_ascii_case("cpu") => Box::new(|i| i.device_type == wgpu::DeviceType::Cpu),
-        Some(w) if w.eq_ignore_ascii_case("gpu") => Box::new(|i| i.device_type != wgpu::DeviceType::Cpu),
+        Some(w) if w.eq_ignore_ascii_case("cpu") => {
+            Box::new(|i| i.device_type == wgpu::DeviceType::Cpu)
+        }
+        Some(w) if w.eq_ignore_ascii_case("gpu") => {
+            Box::new(|i| i.device_type != wgpu::DeviceType::Cpu)
+        }
         Some(w) => {
             let needle = w.to_lowercase();
             Box::new(move |i| i.name.to_lowercase().contains(&needle))
@@ -65,10 +72,19 @@ pub fn choose_adapter(infos: &[wgpu::AdapterInfo], wanted: Option<&str>) -> Resu
     (0..infos.len())
         .filter(|&i| filter(&infos[i]))
         // Prefer Vulkan/Metal/DX12 over GL for the same device type.
-        .min_by_key(|&i| (rank(infos[i].device_type), infos[i].backend == wgpu::Backend::Gl))
+        .min_by_key(|&i| {
+            (
+                rank(infos[i].device_type),
+                infos[i].backend == wgpu::Backend::Gl,
+            )
+        })
         .ok_or_else(|| DeviceError::NoMatch {
             wanted: wanted.unwrap_or_default().to_string(),
-            available: infos.iter().map(|i| i.name.clone()).collect::<Vec<_>>().join(", "),
+            available: infos
+                .iter()
+                .map(|i| i.name.clone())
+                .collect::<Vec<_>>()
+                .join(", "),
         })
 }
 
@@ -97,7 +113,10 @@ impl GpuContext {
         let infos: Vec<wgpu::AdapterInfo> = adapters.iter().map(|a| a.get_info()).collect();
         let wanted = std::env::var(ADAPTER_ENV).ok();
         let index = choose_adapter(&infos, wanted.as_deref())?;
-        let adapter = adapters.into_iter().nth(index).ok_or(DeviceError::NoAdapter)?;
+        let adapter = adapters
+            .into_iter()
+            .nth(index)
+            .ok_or(DeviceError::NoAdapter)?;
         let adapter_info = adapter.get_info();
         let optional = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::FLOAT32_FILTERABLE
@@ -108,12 +127,13 @@ impl GpuContext {
             required_limits: adapter.limits(),
             ..Default::default()
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&descriptor)).map_err(|source| {
-            DeviceError::RequestDevice {
-                adapter: adapter_info.name.clone(),
-                source,
-            }
-        })?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&descriptor)).map_err(|source| {
+                DeviceError::RequestDevice {
+                    adapter: adapter_info.name.clone(),
+                    source,
+                }
+            })?;
         Ok(Self {
             adapter,
             adapter_info,
@@ -127,7 +147,11 @@ impl GpuContext {
 mod tests {
     use super::*;
 
-    fn info(name: &str, device_type: wgpu::DeviceType, backend: wgpu::Backend) -> wgpu::AdapterInfo {
+    fn info(
+        name: &str,
+        device_type: wgpu::DeviceType,
+        backend: wgpu::Backend,
+    ) -> wgpu::AdapterInfo {
         wgpu::AdapterInfo {
             name: name.into(),
             vendor: 0,
@@ -139,21 +163,40 @@ mod tests {
             backend,
             subgroup_min_size: 4,
             subgroup_max_size: 64,
-            transient_saves_memory: false,
+            transient_saves_memory: None,
+            limit_bucket: None,
         }
     }
 
     #[test]
     fn prefers_hardware_and_honours_the_override() {
         let infos = vec![
-            info("llvmpipe (LLVM 19)", wgpu::DeviceType::Cpu, wgpu::Backend::Vulkan),
-            info("NVIDIA H100", wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Gl),
-            info("NVIDIA H100", wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Vulkan),
+            info(
+                "llvmpipe (LLVM 19)",
+                wgpu::DeviceType::Cpu,
+                wgpu::Backend::Vulkan,
+            ),
+            info(
+                "NVIDIA H100",
+                wgpu::DeviceType::DiscreteGpu,
+                wgpu::Backend::Gl,
+            ),
+            info(
+                "NVIDIA H100",
+                wgpu::DeviceType::DiscreteGpu,
+                wgpu::Backend::Vulkan,
+            ),
         ];
         assert_eq!(choose_adapter(&infos, None).ok(), Some(2));
         assert_eq!(choose_adapter(&infos, Some("cpu")).ok(), Some(0));
         assert_eq!(choose_adapter(&infos, Some("LLVMPIPE")).ok(), Some(0));
-        assert!(matches!(choose_adapter(&infos, Some("radeon")), Err(DeviceError::NoMatch { .. })));
-        assert!(matches!(choose_adapter(&[], None), Err(DeviceError::NoAdapter)));
+        assert!(matches!(
+            choose_adapter(&infos, Some("radeon")),
+            Err(DeviceError::NoMatch { .. })
+        ));
+        assert!(matches!(
+            choose_adapter(&[], None),
+            Err(DeviceError::NoAdapter)
+        ));
     }
 }

@@ -1,1 +1,182 @@
+//! Helpers for Hairloom's cross-crate tests: small meshes, crafted glTF files, paths to the
+//! bundled assets.
 
+use std::path::PathBuf;
+
+use glam::{DVec2, DVec3};
+use hairloom_core::HairMesh;
+
+/// The repository's `assets/` folder.
+pub fn assets_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets")
+}
+
+/// Every bundled sample project.
+pub fn sample_paths() -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(assets_dir().join("samples"))
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "hairloom"))
+                .collect()
+        })
+        .unwrap_or_default();
+    paths.sort();
+    paths
+}
+
+/// A gently curved `nx × ny` quad scalp with uv = grid position, extruded `layers` times
+/// by `step` along +z (all columns equally tall).
+pub fn grid_mesh(nx: usize, ny: usize, layers: u32, step: f64) -> HairMesh {
+    let mut positions = Vec::new();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            let (x, y) = (i as f64, j as f64);
+            positions.push(DVec3::new(x, y, 0.05 * (x * x + y * y)));
+        }
+    }
+    let index = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut faces = Vec::new();
+    let mut uvs = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let face = vec![
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            ];
+            uvs.push(
+                face.iter()
+                    .map(|&v| {
+                        let p = positions[v as usize];
+                        DVec2::new(p.x / nx as f64, p.y / ny as f64)
+                    })
+                    .collect(),
+            );
+            faces.push(face);
+        }
+    }
+    let mut mesh = HairMesh::from_scalp(&positions, &faces, &uvs);
+    for column in &mut mesh.columns {
+        let root = column.positions[0];
+        column.positions = (0..=layers)
+            .map(|k| root + DVec3::Z * step * k as f64)
+            .collect();
+    }
+    for bundle in &mut mesh.bundles {
+        bundle.layers = layers;
+    }
+    mesh.update_w();
+    mesh
+}
+
+/// Builds small glTF files for importer tests. Accessors are tightly packed in one buffer.
+#[derive(Default)]
+pub struct GltfBuilder {
+    pub bin: Vec<u8>,
+    pub views: Vec<serde_json::Value>,
+    pub accessors: Vec<serde_json::Value>,
+    pub meshes: Vec<serde_json::Value>,
+}
+
+impl GltfBuilder {
+    /// Adds f32 data as an accessor of `type_name` ("VEC3", "VEC2", …); returns its index.
+    pub fn add_f32(&mut self, values: &[f32], type_name: &str, count: usize) -> usize {
+        let offset = self.bin.len();
+        for v in values {
+            self.bin.extend_from_slice(&v.to_le_bytes());
+        }
+        self.views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": values.len() * 4}),
+        );
+        let mut accessor = serde_json::json!({
+            "bufferView": self.views.len() - 1, "componentType": 5126, "count": count, "type": type_name
+        });
+        if type_name == "VEC3" {
+            // glTF requires min/max on POSITION accessors.
+            let mut min = [f32::INFINITY; 3];
+            let mut max = [f32::NEG_INFINITY; 3];
+            for (i, v) in values.iter().enumerate().filter(|(_, v)| v.is_finite()) {
+                min[i % 3] = min[i % 3].min(*v);
+                max[i % 3] = max[i % 3].max(*v);
+            }
+            accessor["min"] = serde_json::json!(min.map(|v| if v.is_finite() { v } else { 0.0 }));
+            accessor["max"] = serde_json::json!(max.map(|v| if v.is_finite() { v } else { 0.0 }));
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    /// Adds u32 indices; returns the accessor index.
+    pub fn add_indices(&mut self, indices: &[u32]) -> usize {
+        let offset = self.bin.len();
+        for v in indices {
+            self.bin.extend_from_slice(&v.to_le_bytes());
+        }
+        self.views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": indices.len() * 4}),
+        );
+        self.accessors.push(serde_json::json!({
+            "bufferView": self.views.len() - 1, "componentType": 5125, "count": indices.len(), "type": "SCALAR"
+        }));
+        self.accessors.len() - 1
+    }
+
+    /// A unit quad (two triangles) with uv, as a mesh named `name`.
+    pub fn add_quad_mesh(&mut self, name: &str) -> usize {
+        let positions = [
+            0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0,
+        ];
+        let uvs = [0.0f32, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0];
+        let p = self.add_f32(&positions, "VEC3", 4);
+        let t = self.add_f32(&uvs, "VEC2", 4);
+        let i = self.add_indices(&[0, 1, 2, 0, 2, 3]);
+        self.meshes.push(serde_json::json!({
+            "name": name,
+            "primitives": [{"attributes": {"POSITION": p, "TEXCOORD_0": t}, "indices": i, "mode": 4}]
+        }));
+        self.meshes.len() - 1
+    }
+
+    /// The glTF JSON document (buffer 0 is the GLB binary chunk).
+    pub fn json(&self) -> serde_json::Value {
+        let nodes: Vec<serde_json::Value> = (0..self.meshes.len())
+            .map(|m| serde_json::json!({"mesh": m}))
+            .collect();
+        serde_json::json!({
+            "asset": {"version": "2.0"},
+            "scene": 0,
+            "scenes": [{"nodes": (0..self.meshes.len()).collect::<Vec<_>>()}],
+            "nodes": nodes,
+            "meshes": self.meshes,
+            "accessors": self.accessors,
+            "bufferViews": self.views,
+            "buffers": [{"byteLength": self.bin.len()}],
+        })
+    }
+
+    /// A GLB file from `json` and this builder's binary chunk.
+    pub fn glb(&self, json: &serde_json::Value) -> Vec<u8> {
+        let mut json_bytes = serde_json::to_vec(json).unwrap_or_default();
+        while !json_bytes.len().is_multiple_of(4) {
+            json_bytes.push(b' ');
+        }
+        let mut bin = self.bin.clone();
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
+        let mut out = Vec::with_capacity(total);
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&json_bytes);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        out
+    }
+}

@@ -1,0 +1,215 @@
+//! Project files: round trips, validation errors that name the JSON path, version checks,
+//! and atomic saves that survive a writer killed mid-write.
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use hairloom_core::project::{self, ProjectError};
+use hairloom_core::{Document, History, Project};
+use hairloom_tests::{grid_mesh, sample_paths};
+
+#[test]
+fn every_sample_loads_validates_and_round_trips_exactly() {
+    let paths = sample_paths();
+    assert!(paths.len() >= 4, "samples: {paths:?}");
+    let dir = tempfile::tempdir().expect("temp dir");
+    for path in paths {
+        let project = project::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let copy = dir.path().join("copy.hairloom");
+        project::save(&copy, &project).expect("save");
+        let again = project::load(&copy).expect("reload");
+        assert_eq!(again, project, "{}", path.display());
+        // Saving is deterministic: the committed sample is exactly what we write.
+        assert_eq!(
+            std::fs::read(&copy).expect("read"),
+            std::fs::read(&path).expect("read")
+        );
+    }
+}
+
+fn corrupt(edit: impl FnOnce(&mut serde_json::Value)) -> Result<Project, ProjectError> {
+    let mesh = grid_mesh(3, 2, 2, 0.5);
+    let project = Project::new(Document::new("grid", mesh));
+    let mut value: serde_json::Value =
+        serde_json::from_slice(&project::to_bytes(&project)).expect("json");
+    edit(&mut value);
+    let bytes = serde_json::to_vec_pretty(&value).expect("json");
+    project::from_bytes(&bytes, Path::new("corrupt.hairloom"))
+}
+
+fn invalid_at(result: Result<Project, ProjectError>) -> (String, String) {
+    match result {
+        Err(ProjectError::Invalid {
+            json_path, message, ..
+        }) => (json_path, message),
+        Err(other) => panic!("expected a validation error, got: {other}"),
+        Ok(_) => panic!("corrupted project was accepted"),
+    }
+}
+
+#[test]
+fn validation_names_the_json_path() {
+    let (path, message) = invalid_at(corrupt(|v| {
+        v["document"]["hair_mesh"]["bundles"][4]["vertices"][2] = 999.into()
+    }));
+    assert_eq!(path, "document.hair_mesh.bundles[4].vertices[2]");
+    assert!(message.contains("out of range"), "{message}");
+
+    let (path, _) = invalid_at(corrupt(|v| {
+        v["document"]["hair_mesh"]["columns"][3]["w"][1] = "tall".into()
+    }));
+    assert_eq!(path, "document.hair_mesh.columns[3].w[1]");
+
+    let (path, message) = invalid_at(corrupt(|v| {
+        v["document"]["hair_mesh"]["bundles"][0]["layers"] = 7.into();
+    }));
+    assert!(path.starts_with("document.hair_mesh.columns["), "{path}");
+    assert!(message.contains("tallest bundle"), "{message}");
+
+    let (path, message) = invalid_at(corrupt(|v| {
+        v["document"]["hair_mesh"]["columns"][2]["w"][2] = serde_json::json!(-1.0);
+    }));
+    assert_eq!(path, "document.hair_mesh.columns[2].w[2]");
+    assert!(message.contains("decreases"), "{message}");
+
+    let (path, _) = invalid_at(corrupt(|v| {
+        v["document"]["hair_mesh"]["columns"][0]["positions"][0] =
+            serde_json::json!([0.0, null, 1.0]);
+    }));
+    assert_eq!(path, "document.hair_mesh.columns[0].positions[0][1]");
+
+    let (path, _) = invalid_at(corrupt(|v| {
+        v["document"]["surprise"] = true.into();
+    }));
+    assert!(path.starts_with("document"), "{path}");
+}
+
+#[test]
+fn non_finite_numbers_are_refused() {
+    let mesh = grid_mesh(2, 2, 1, 0.5);
+    let text = String::from_utf8(project::to_bytes(&Project::new(Document::new("g", mesh))))
+        .expect("utf8");
+    // JSON has no NaN; an overflowing literal is the way a file can carry infinity.
+    let first_number =
+        text.find("\"positions\": [[").expect("positions") + "\"positions\": [[".len();
+    let end = first_number + text[first_number..].find(',').expect("comma");
+    let broken = format!("{}1e999{}", &text[..first_number], &text[end..]);
+    let error =
+        project::from_bytes(broken.as_bytes(), Path::new("inf.hairloom")).expect_err("infinite");
+    assert!(error.to_string().contains("inf.hairloom"), "{error}");
+}
+
+#[test]
+fn versions_and_garbage() {
+    let newer = corrupt(|v| v["format_version"] = 99.into()).expect_err("newer");
+    assert!(
+        matches!(newer, ProjectError::NewerVersion { found: 99, .. }),
+        "{newer}"
+    );
+    assert!(newer.to_string().contains("newer Hairloom"), "{newer}");
+    let missing = corrupt(|v| {
+        v.as_object_mut().expect("object").remove("format_version");
+    })
+    .expect_err("missing version");
+    assert!(missing.to_string().contains("format_version"), "{missing}");
+    for garbage in [
+        &b""[..],
+        b"{",
+        b"[1,2]",
+        b"\x00\x01binary",
+        b"{\"format_version\": 1}",
+    ] {
+        let error =
+            project::from_bytes(garbage, Path::new("garbage.hairloom")).expect_err("garbage");
+        assert!(error.to_string().starts_with("garbage.hairloom"), "{error}");
+    }
+}
+
+#[test]
+fn tampered_history_is_refused() {
+    let mesh = grid_mesh(3, 2, 2, 0.5);
+    let mut document = Document::new("grid", mesh);
+    let mut history = History::default();
+    let edited = hairloom_core::edit::extrude(
+        &document.hair_mesh,
+        &[0, 1],
+        hairloom_core::edit::ExtrudeDirection::AlongNormal { distance: 0.3 },
+    )
+    .expect("extrude");
+    let mut after = document.clone();
+    after.hair_mesh = edited.mesh;
+    assert!(history.commit(&mut document, "Extrude", after));
+    let project = Project {
+        history,
+        ..Project::new(document)
+    };
+    let mut value: serde_json::Value =
+        serde_json::from_slice(&project::to_bytes(&project)).expect("json");
+    project::from_bytes(
+        &serde_json::to_vec(&value).expect("json"),
+        Path::new("ok.hairloom"),
+    )
+    .expect("intact history loads");
+    // Change the document under the history (still a valid document on its own): the
+    // extrusion's record no longer matches what the document holds.
+    value["document"]["hair_mesh"]["columns"][0]["positions"][0][0] = serde_json::json!(0.25);
+    let error = project::from_bytes(
+        &serde_json::to_vec(&value).expect("json"),
+        Path::new("t.hairloom"),
+    )
+    .expect_err("tampered");
+    assert!(error.to_string().contains("history"), "{error}");
+}
+
+#[test]
+fn a_writer_killed_mid_save_leaves_the_previous_file_intact() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("work.hairloom");
+    let original = Project::new(Document::new("original", grid_mesh(4, 4, 2, 0.5)));
+    project::save(&path, &original).expect("first save");
+    let before = std::fs::read(&path).expect("read");
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_slow_save"))
+        .arg(&path)
+        .arg("200")
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("spawn slow_save");
+    let stdout = child.stdout.take().expect("stdout");
+    let mut lines = BufReader::new(stdout).lines();
+    // Wait until at least two chunks are in the temporary file, then kill the writer.
+    let mut chunks = 0;
+    for line in lines.by_ref() {
+        let line = line.expect("line");
+        assert!(line.starts_with("wrote"), "{line}");
+        chunks += 1;
+        if chunks == 2 {
+            break;
+        }
+    }
+    child.kill().expect("kill");
+    let status = child.wait().expect("wait");
+    assert!(
+        !status.success(),
+        "the writer finished before it was killed"
+    );
+
+    // The temporary file exists and is partial: the kill really happened mid-write.
+    let temps: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("list")
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert_eq!(temps.len(), 1, "expected one partial temporary file");
+    assert!(temps[0].metadata().expect("meta").len() >= 2 * project::WRITE_CHUNK_BYTES as u64);
+
+    assert_eq!(
+        std::fs::read(&path).expect("read"),
+        before,
+        "the previous file changed"
+    );
+    assert_eq!(project::load(&path).expect("still loads"), original);
+    // A later save still succeeds next to the leftover temporary file.
+    project::save(&path, &original).expect("save again");
+}
