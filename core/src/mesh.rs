@@ -447,46 +447,10 @@ pub(crate) mod test_meshes {
     /// A `nx × ny` grid of unit quads in the xy plane with uv = position / size, extruded
     /// `layers` times along +z by `step`.
     pub fn grid(nx: usize, ny: usize, layers: u32, step: f64) -> HairMesh {
-        let mut positions = Vec::new();
-        for j in 0..=ny {
-            for i in 0..=nx {
-                positions.push(DVec3::new(i as f64, j as f64, 0.0));
-            }
-        }
-        let index = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-        let mut faces = Vec::new();
-        let mut uvs = Vec::new();
-        for j in 0..ny {
-            for i in 0..nx {
-                let face = vec![
-                    index(i, j),
-                    index(i + 1, j),
-                    index(i + 1, j + 1),
-                    index(i, j + 1),
-                ];
-                uvs.push(
-                    face.iter()
-                        .map(|&v| {
-                            let p = positions[v as usize];
-                            DVec2::new(p.x / nx as f64, p.y / ny as f64)
-                        })
-                        .collect(),
-                );
-                faces.push(face);
-            }
-        }
-        let mut mesh = HairMesh::from_scalp(&positions, &faces, &uvs);
-        for column in &mut mesh.columns {
-            let root = column.positions[0];
-            column.positions = (0..=layers)
-                .map(|k| root + DVec3::Z * step * k as f64)
-                .collect();
-        }
-        for bundle in &mut mesh.bundles {
-            bundle.layers = layers;
-        }
-        mesh.update_w();
-        mesh
+        let scalp = crate::samples::grid_scalp(nx, ny, |s, t| {
+            DVec3::new(s * nx as f64, t * ny as f64, 0.0)
+        });
+        crate::samples::straight_layers(scalp, layers, DVec3::Z * step)
     }
 }
 

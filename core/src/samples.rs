@@ -296,3 +296,59 @@ pub fn tips_inside_ellipsoid(mesh: &HairMesh, radii_m: DVec3) -> usize {
         })
         .count()
 }
+
+/// A scalp of `nx × ny` quads over the unit square: `position(s, t)` places the vertex at
+/// grid coordinates `s, t ∈ [0, 1]`, and its uv is `(s, t)`. Used by tests and benchmarks.
+pub fn grid_scalp(nx: usize, ny: usize, position: impl Fn(f64, f64) -> DVec3) -> HairMesh {
+    let (nx, ny) = (nx.max(1), ny.max(1));
+    let index = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let coords = |v: u32| {
+        let v = v as usize;
+        (
+            (v % (nx + 1)) as f64 / nx as f64,
+            (v / (nx + 1)) as f64 / ny as f64,
+        )
+    };
+    let positions: Vec<DVec3> = (0..(nx + 1) * (ny + 1))
+        .map(|v| {
+            let (s, t) = coords(v as u32);
+            position(s, t)
+        })
+        .collect();
+    let mut faces = Vec::with_capacity(nx * ny);
+    let mut uvs = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let face = vec![
+                index(i, j),
+                index(i + 1, j),
+                index(i + 1, j + 1),
+                index(i, j + 1),
+            ];
+            uvs.push(
+                face.iter()
+                    .map(|&v| {
+                        let (s, t) = coords(v);
+                        glam::DVec2::new(s, t)
+                    })
+                    .collect(),
+            );
+            faces.push(face);
+        }
+    }
+    HairMesh::from_scalp(&positions, &faces, &uvs)
+}
+
+/// Gives every bundle `layers` layers whose columns go straight up from the root by `step`
+/// per layer (a quick hair mesh for tests; real tools extrude along normals).
+pub fn straight_layers(mut mesh: HairMesh, layers: u32, step: DVec3) -> HairMesh {
+    for column in &mut mesh.columns {
+        let root = column.positions[0];
+        column.positions = (0..=layers).map(|k| root + step * k as f64).collect();
+    }
+    for bundle in &mut mesh.bundles {
+        bundle.layers = layers;
+    }
+    mesh.update_w();
+    mesh
+}

@@ -28,35 +28,10 @@ pub fn run(which: Which) -> anyhow::Result<()> {
 /// A curved `n × n` scalp (a spherical cap) extruded `layers` times, shaped like hair: each
 /// layer is offset along the normal and bent, so interior vertices have real work to do.
 fn cap(n: usize, layers: u32) -> anyhow::Result<HairMesh> {
-    let mut positions = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let x = i as f64 / n as f64 * 2.0 - 1.0;
-            let y = j as f64 / n as f64 * 2.0 - 1.0;
-            let z = (4.0 - x * x - y * y).sqrt();
-            positions.push(DVec3::new(x, y, z) * 0.1);
-        }
-    }
-    let index = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut faces = Vec::new();
-    let mut uvs = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let face = vec![
-                index(i, j),
-                index(i + 1, j),
-                index(i + 1, j + 1),
-                index(i, j + 1),
-            ];
-            uvs.push(
-                face.iter()
-                    .map(|&v| positions[v as usize].truncate() * 5.0)
-                    .collect(),
-            );
-            faces.push(face);
-        }
-    }
-    let mut mesh = HairMesh::from_scalp(&positions, &faces, &uvs);
+    let mut mesh = hairloom_core::samples::grid_scalp(n, n, |s, t| {
+        let (x, y) = (s * 2.0 - 1.0, t * 2.0 - 1.0);
+        DVec3::new(x, y, (4.0 - x * x - y * y).sqrt()) * 0.1
+    });
     let all: Vec<u32> = (0..mesh.bundles.len() as u32).collect();
     for _ in 0..layers {
         mesh = extrude(

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use hairloom_core::HairMesh;
 
 /// The repository's `assets/` folder.
@@ -28,47 +28,11 @@ pub fn sample_paths() -> Vec<PathBuf> {
 /// A gently curved `nx × ny` quad scalp with uv = grid position, extruded `layers` times
 /// by `step` along +z (all columns equally tall).
 pub fn grid_mesh(nx: usize, ny: usize, layers: u32, step: f64) -> HairMesh {
-    let mut positions = Vec::new();
-    for j in 0..=ny {
-        for i in 0..=nx {
-            let (x, y) = (i as f64, j as f64);
-            positions.push(DVec3::new(x, y, 0.05 * (x * x + y * y)));
-        }
-    }
-    let index = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut faces = Vec::new();
-    let mut uvs = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            let face = vec![
-                index(i, j),
-                index(i + 1, j),
-                index(i + 1, j + 1),
-                index(i, j + 1),
-            ];
-            uvs.push(
-                face.iter()
-                    .map(|&v| {
-                        let p = positions[v as usize];
-                        DVec2::new(p.x / nx as f64, p.y / ny as f64)
-                    })
-                    .collect(),
-            );
-            faces.push(face);
-        }
-    }
-    let mut mesh = HairMesh::from_scalp(&positions, &faces, &uvs);
-    for column in &mut mesh.columns {
-        let root = column.positions[0];
-        column.positions = (0..=layers)
-            .map(|k| root + DVec3::Z * step * k as f64)
-            .collect();
-    }
-    for bundle in &mut mesh.bundles {
-        bundle.layers = layers;
-    }
-    mesh.update_w();
-    mesh
+    let scalp = hairloom_core::samples::grid_scalp(nx, ny, |s, t| {
+        let (x, y) = (s * nx as f64, t * ny as f64);
+        DVec3::new(x, y, 0.05 * (x * x + y * y))
+    });
+    hairloom_core::samples::straight_layers(scalp, layers, DVec3::Z * step)
 }
 
 /// Builds small glTF files for importer tests. Accessors are tightly packed in one buffer.
