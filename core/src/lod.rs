@@ -63,7 +63,8 @@ pub fn strand_count(level: f64, strands: u32, delta: f64) -> u32 {
 /// Equals `N` as `L → 0` and 1 for `L = 1`.
 pub fn thickness_factor(level: f64, strands: u32) -> f64 {
     let cap = strands.max(1) as f64;
-    if !(level > 0.0) {
+    // NaN and non-positive levels: the bundle is (nearly) gone, use the full compensation.
+    if level.is_nan() || level <= 0.0 {
         return cap;
     }
     (1.0 / level).min(cap).max(1.0)
