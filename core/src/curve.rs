@@ -189,9 +189,14 @@ pub struct ReferenceStrand {
 impl ReferenceStrand {
     /// Prepares a strand. Returns `None` for an out-of-range bundle index.
     pub fn new(mesh: &HairMesh, bundle_index: usize, coord: FaceCoord) -> Option<Self> {
+        let corners = mesh.bundles.get(bundle_index)?.vertices.len();
+        Self::with_weights(mesh, bundle_index, coord.weights(corners))
+    }
+
+    /// Prepares the strand whose bundle-corner weights are `weights` (summing to 1; entries
+    /// past the bundle's corner count are ignored).
+    pub fn with_weights(mesh: &HairMesh, bundle_index: usize, weights: [f64; 4]) -> Option<Self> {
         let bundle = mesh.bundles.get(bundle_index)?;
-        let corners = bundle.vertices.len();
-        let weights = coord.weights(corners);
         let layers = bundle.layers as usize;
         let column_segments: Vec<Vec<[DVec3; 4]>> = bundle
             .vertices

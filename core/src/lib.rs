@@ -5,6 +5,7 @@
 //! [`curve`]) → runtime data. This crate has no GPU or UI dependency; the f64 code here is
 //! the reference every faster path is measured against.
 
+pub mod atlas;
 pub mod curve;
 pub mod document;
 pub mod edit;
@@ -17,6 +18,7 @@ pub mod mesh;
 pub mod project;
 pub mod random;
 pub mod roots;
+pub mod runtime;
 pub mod samples;
 pub mod teapot;
 pub mod uv;

@@ -1,0 +1,431 @@
+//! The runtime textures of seed 000 Table 1, built from a hair mesh.
+//!
+//! | texture | dim | texel | slices along r |
+//! |---|---|---|---|
+//! | hair mesh | 3D | object-space position | root, then per segment 3 intermediate + 1 layer slice |
+//! | uv | 2D | root uv | — |
+//! | w | 3D | w | one per layer |
+//! | u, v | 3D | styling directions û, v̂ | one per layer |
+//!
+//! Hair-mesh slices of segment `k` (layer `k` → `k+1`): `4k` = `p_k`, `4k+1` = `q0`,
+//! `4k+2` = `m`, `4k+3` = `q1`, `4k+4` = `p_{k+1}`, where `(p_k, q0, m)` and `(m, q1, p_{k+1})`
+//! are the two quadratics of the column's cubic segment (`curve::cubic_to_quadratics`).
+//! A quadratic at parameter `q` is `lerp(fetch(a + q), fetch(a + 1 + q), q)` with `a` its first
+//! slice: two filtered fetches and one lerp.
+//!
+//! Texels are stored as RGBA (3D textures have no 3-channel formats). The `f16` variant stores
+//! positions relative to [`RuntimeTextures::position_offset`] (the bounding-box centre) so that
+//! half precision is spent on the hair, not on the distance from the origin.
+
+use glam::{DVec3, Vec2, Vec3, Vec4};
+
+use crate::atlas::{Atlas, build_atlas};
+use crate::curve::{cubic_to_quadratics, curve_segments};
+use crate::frames::layer_frames;
+use crate::mesh::HairMesh;
+
+/// Slices of the hair-mesh texture per segment (3 intermediate + 1 layer).
+pub const SLICES_PER_SEGMENT: u32 = 4;
+/// Largest region side in the atlas.
+pub const MAX_REGION_SIDE: usize = 64;
+
+/// Texel precision of the 3D position and direction textures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Precision {
+    F32,
+    F16,
+}
+
+/// A 3D texture of RGBA texels, x fastest, then y, then slice.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture3d {
+    pub width: u32,
+    pub height: u32,
+    pub depth: u32,
+    pub texels: Vec<Vec4>,
+}
+
+impl Texture3d {
+    fn new(width: u32, height: u32, depth: u32) -> Self {
+        Self {
+            width,
+            height,
+            depth,
+            texels: vec![Vec4::ZERO; (width * height * depth) as usize],
+        }
+    }
+
+    pub fn index(&self, x: u32, y: u32, z: u32) -> usize {
+        ((z * self.height + y) * self.width + x) as usize
+    }
+
+    pub fn get(&self, x: u32, y: u32, z: u32) -> Vec4 {
+        self.texels[self.index(x, y, z)]
+    }
+
+    fn set(&mut self, x: u32, y: u32, z: u32, value: Vec4) {
+        let i = self.index(x, y, z);
+        self.texels[i] = value;
+    }
+}
+
+/// The five textures plus the layout needed to sample them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuntimeTextures {
+    pub atlas: Atlas,
+    pub precision: Precision,
+    /// Added back to sampled hair-mesh positions (zero for f32).
+    pub position_offset: Vec3,
+    /// Positions: `1 + 4·max_layers` slices.
+    pub hair_mesh: Texture3d,
+    /// Root uv (x, y used), one slice.
+    pub uv: Texture3d,
+    /// w (x used), `1 + max_layers` slices.
+    pub w: Texture3d,
+    /// û (xyz), `1 + max_layers` slices.
+    pub u: Texture3d,
+    /// v̂ (xyz), `1 + max_layers` slices.
+    pub v: Texture3d,
+}
+
+/// Round-to-nearest-even conversion to IEEE half precision and back (what an f16 texture
+/// stores), with overflow to ±∞ clamped to the largest finite half.
+pub fn round_to_f16(value: f32) -> f32 {
+    if !value.is_finite() {
+        return if value.is_nan() {
+            0.0
+        } else {
+            value.signum() * 65504.0
+        };
+    }
+    let magnitude = value.abs();
+    if magnitude >= 65504.0 {
+        return value.signum() * 65504.0;
+    }
+    // Spacing of halves near `magnitude`: 2^(e − 10), with subnormals at 2^-24.
+    let exponent = if magnitude < 6.103_515_6e-5 {
+        -14
+    } else {
+        magnitude.log2().floor() as i32
+    };
+    let step = 2f32.powi(exponent - 10);
+    let quotient = magnitude / step;
+    let rounded = quotient.round();
+    // Ties to even (dividing by a power of two is exact, so a tie is exactly .5).
+    let rounded = if quotient - quotient.floor() == 0.5 && rounded % 2.0 != 0.0 {
+        rounded - 1.0
+    } else {
+        rounded
+    };
+    value.signum() * rounded * step
+}
+
+fn quantize(v: Vec4, precision: Precision) -> Vec4 {
+    match precision {
+        Precision::F32 => v,
+        Precision::F16 => Vec4::new(
+            round_to_f16(v.x),
+            round_to_f16(v.y),
+            round_to_f16(v.z),
+            round_to_f16(v.w),
+        ),
+    }
+}
+
+impl RuntimeTextures {
+    /// Builds every texture for the bundles that grow hair.
+    pub fn build(mesh: &HairMesh, precision: Precision) -> Self {
+        let atlas = build_atlas(mesh, MAX_REGION_SIDE);
+        let max_layers = atlas.blocks.iter().map(|b| b.layers).max().unwrap_or(0);
+        let (width, height) = (atlas.width, atlas.height);
+        let (lo, hi) = mesh.columns.iter().flat_map(|c| c.positions.iter()).fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let offset = match precision {
+            Precision::F32 => DVec3::ZERO,
+            Precision::F16 if lo.is_finite() && hi.is_finite() => (lo + hi) * 0.5,
+            Precision::F16 => DVec3::ZERO,
+        };
+        let mut hair_mesh = Texture3d::new(width, height, 1 + SLICES_PER_SEGMENT * max_layers);
+        let mut uv = Texture3d::new(width, height, 1);
+        let mut w = Texture3d::new(width, height, 1 + max_layers);
+        let mut u = Texture3d::new(width, height, 1 + max_layers);
+        let mut v = Texture3d::new(width, height, 1 + max_layers);
+        let frames: Vec<_> = (0..=max_layers as usize)
+            .map(|k| layer_frames(mesh, k))
+            .collect();
+        let segments: Vec<_> = mesh
+            .columns
+            .iter()
+            .map(|c| curve_segments(&c.positions))
+            .collect();
+        let position = |p: DVec3| quantize((p - offset).as_vec3().extend(0.0), precision);
+        for y in 0..height {
+            for x in 0..width {
+                let Some(source) = atlas.texels[(y * width + x) as usize] else {
+                    continue;
+                };
+                let c = source.column as usize;
+                let column = &mesh.columns[c];
+                uv.set(
+                    x,
+                    y,
+                    0,
+                    Vec4::new(source.uv.x as f32, source.uv.y as f32, 0.0, 0.0),
+                );
+                let last = column.positions.len() - 1;
+                for k in 0..=max_layers as usize {
+                    // Slices past the column's tip repeat the tip (never sampled by a bundle).
+                    let layer = k.min(last);
+                    hair_mesh.set(
+                        x,
+                        y,
+                        SLICES_PER_SEGMENT * k as u32,
+                        position(column.positions[layer]),
+                    );
+                    w.set(
+                        x,
+                        y,
+                        k as u32,
+                        quantize(Vec4::new(column.w[layer] as f32, 0.0, 0.0, 0.0), precision),
+                    );
+                    let frame =
+                        frames[layer][c].unwrap_or_else(|| crate::frames::fallback_frame(DVec3::Y));
+                    u.set(
+                        x,
+                        y,
+                        k as u32,
+                        quantize(frame.u.as_vec3().extend(0.0), precision),
+                    );
+                    v.set(
+                        x,
+                        y,
+                        k as u32,
+                        quantize(frame.v.as_vec3().extend(0.0), precision),
+                    );
+                    if k < max_layers as usize {
+                        let base = SLICES_PER_SEGMENT * k as u32;
+                        let [first, second] = match segments[c].get(k) {
+                            Some(segment) => cubic_to_quadratics(segment),
+                            None => [[column.positions[last]; 3]; 2],
+                        };
+                        hair_mesh.set(x, y, base + 1, position(first[1]));
+                        hair_mesh.set(x, y, base + 2, position(first[2]));
+                        hair_mesh.set(x, y, base + 3, position(second[1]));
+                    }
+                }
+            }
+        }
+        Self {
+            atlas,
+            precision,
+            position_offset: offset.as_vec3(),
+            hair_mesh,
+            uv,
+            w,
+            u,
+            v,
+        }
+    }
+
+    /// Bytes the five textures take on the GPU: RGBA hair mesh, u and v (4 channels), RG uv,
+    /// R w, at 4 bytes (f32) or 2 bytes (f16) per channel.
+    pub fn gpu_bytes(&self) -> usize {
+        let channel = match self.precision {
+            Precision::F32 => 4,
+            Precision::F16 => 2,
+        };
+        let texels = |t: &Texture3d| (t.width * t.height * t.depth) as usize;
+        channel
+            * (4 * texels(&self.hair_mesh)
+                + 4 * texels(&self.u)
+                + 4 * texels(&self.v)
+                + 2 * texels(&self.uv)
+                + texels(&self.w))
+    }
+}
+
+/// Texture filtering as the texture-path mirror performs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Filtering {
+    /// f32 weights (manual filtering in the shader).
+    Exact,
+    /// Weights quantised to 8 fractional bits, as GPU texture units do.
+    Hardware8Bit,
+}
+
+/// Trilinear sample at continuous texel coordinates (texel centres at `i + 0.5`), clamped
+/// to the edge: the CPU mirror of a filtered `textureSampleLevel`.
+pub fn sample_trilinear(texture: &Texture3d, coord: Vec3, filtering: Filtering) -> Vec4 {
+    let axis = |c: f32, size: u32| {
+        let x = (c - 0.5).clamp(0.0, (size - 1) as f32);
+        let i0 = (x.floor() as u32).min(size.saturating_sub(2));
+        let mut frac = x - i0 as f32;
+        if filtering == Filtering::Hardware8Bit {
+            frac = (frac * 256.0).round() / 256.0;
+        }
+        let i1 = (i0 + 1).min(size - 1);
+        (i0, i1, frac)
+    };
+    let (x0, x1, fx) = axis(coord.x, texture.width);
+    let (y0, y1, fy) = axis(coord.y, texture.height);
+    let (z0, z1, fz) = axis(coord.z, texture.depth);
+    let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
+    let plane = |z: u32| {
+        let bottom = lerp(texture.get(x0, y0, z), texture.get(x1, y0, z), fx);
+        let top = lerp(texture.get(x0, y1, z), texture.get(x1, y1, z), fx);
+        lerp(bottom, top, fy)
+    };
+    lerp(plane(z0), plane(z1), fz)
+}
+
+/// The texture-path mirror: a strand position computed exactly as the strand-generation
+/// shader will, from the textures alone, in f32.
+pub struct TexturePath<'a> {
+    pub textures: &'a RuntimeTextures,
+    pub filtering: Filtering,
+}
+
+impl TexturePath<'_> {
+    /// Position of the strand of atlas block `block` at block coordinates `(s, t)` and
+    /// curve parameter `tau ∈ [0, layers]` (layer units).
+    pub fn position(&self, block: usize, s: f32, t: f32, tau: f32) -> Vec3 {
+        let block = &self.textures.atlas.blocks[block];
+        let texel = Vec2::new(
+            block.origin[0] as f32 + 0.5 + s,
+            block.origin[1] as f32 + 0.5 + t,
+        );
+        let layers = block.layers.max(1) as f32;
+        let tau = tau.clamp(0.0, layers);
+        let segment = (tau.floor() as u32).min(block.layers.saturating_sub(1));
+        let local = tau - segment as f32;
+        // Which quadratic, and its parameter.
+        let (first_slice, q) = if local < 0.5 {
+            (SLICES_PER_SEGMENT * segment, local * 2.0)
+        } else {
+            (SLICES_PER_SEGMENT * segment + 2, local * 2.0 - 1.0)
+        };
+        let fetch = |slice: f32| {
+            sample_trilinear(
+                &self.textures.hair_mesh,
+                texel.extend(slice + 0.5),
+                self.filtering,
+            )
+            .truncate()
+        };
+        let a = fetch(first_slice as f32 + q);
+        let b = fetch(first_slice as f32 + 1.0 + q);
+        a + (b - a) * q + self.textures.position_offset
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::atlas::Atlas;
+    use crate::curve::{ReferenceStrand, SegmentForm};
+    use crate::mesh::test_meshes::grid;
+
+    fn curved_mesh() -> HairMesh {
+        let mut mesh = grid(4, 3, 3, 0.4);
+        for column in &mut mesh.columns {
+            let r = column.positions[0];
+            for (k, p) in column.positions.iter_mut().enumerate() {
+                let k = k as f64;
+                *p += DVec3::new(0.2 * k * k, 0.1 * (r.x + k).sin(), 0.05 * r.y * k);
+            }
+        }
+        mesh.update_w();
+        mesh
+    }
+
+    #[test]
+    fn half_rounding_matches_ieee() {
+        assert_eq!(round_to_f16(1.0), 1.0);
+        assert_eq!(round_to_f16(1.0 + 1.0 / 2048.0), 1.0, "tie rounds to even");
+        assert_eq!(round_to_f16(1.0 + 3.0 / 2048.0), 1.0 + 2.0 / 1024.0);
+        assert_eq!(round_to_f16(0.1), 0.099_975_586);
+        assert_eq!(round_to_f16(1e6), 65504.0);
+        assert_eq!(round_to_f16(-2.0e-8), -0.0);
+        assert_eq!(
+            round_to_f16(3.0e-8),
+            2f32.powi(-24),
+            "rounds up to the smallest subnormal"
+        );
+        assert_eq!(round_to_f16(f32::NAN), 0.0);
+    }
+
+    #[test]
+    fn texture_path_matches_the_f64_reference() {
+        let mesh = curved_mesh();
+        let textures = RuntimeTextures::build(&mesh, Precision::F32);
+        let size = 5.0f32;
+        for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
+            let path = TexturePath {
+                textures: &textures,
+                filtering,
+            };
+            let mut worst = 0.0f64;
+            for (index, block) in textures.atlas.blocks.iter().enumerate() {
+                for (s, t) in [(0.0, 0.0), (0.3, 0.7), (0.91, 0.12), (1.0, 1.0), (0.5, 0.5)] {
+                    let weights = Atlas::corner_weights(block, s, t);
+                    let reference =
+                        ReferenceStrand::with_weights(&mesh, block.bundle as usize, weights)
+                            .expect("bundle");
+                    for i in 0..=30 {
+                        let tau = i as f64 / 10.0;
+                        let expected = reference.point(
+                            tau,
+                            crate::curve::CurveDefinition::ColumnBlend,
+                            SegmentForm::TwoQuadratics,
+                        );
+                        let got = path.position(index, s as f32, t as f32, tau as f32);
+                        worst = worst.max(got.as_dvec3().distance(expected));
+                    }
+                }
+            }
+            match filtering {
+                // f32 rounding only.
+                Filtering::Exact => assert!(worst < 1e-6 * size as f64, "exact: {worst}"),
+                // 8-bit weights: at most half a step (1/512) of the largest texel difference
+                // per axis; this mesh's neighbouring control points are ≤ 1.6 apart.
+                Filtering::Hardware8Bit => {
+                    assert!(worst > 1e-6, "quantisation must show");
+                    assert!(worst < 3.0 * 1.6 / 512.0, "hardware: {worst}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn f16_textures_round_positions_within_half_precision() {
+        let mesh = curved_mesh();
+        let full = RuntimeTextures::build(&mesh, Precision::F32);
+        let half = RuntimeTextures::build(&mesh, Precision::F16);
+        assert!(half.gpu_bytes() * 2 == full.gpu_bytes());
+        let exact = TexturePath {
+            textures: &full,
+            filtering: Filtering::Exact,
+        };
+        let rounded = TexturePath {
+            textures: &half,
+            filtering: Filtering::Exact,
+        };
+        let extent = 4.0f32; // largest |p − centre| component is below 4 here
+        let mut worst = 0.0f32;
+        for index in 0..full.atlas.blocks.len() {
+            for i in 0..=12 {
+                let tau = i as f32 / 4.0;
+                worst = worst.max(
+                    exact
+                        .position(index, 0.4, 0.6, tau)
+                        .distance(rounded.position(index, 0.4, 0.6, tau)),
+                );
+            }
+        }
+        assert!(worst > 0.0 && worst < extent * 2f32.powi(-10), "{worst}");
+    }
+}
