@@ -95,13 +95,12 @@ pub fn build_atlas(mesh: &HairMesh, max_region_side: usize) -> Atlas {
             );
         }
     }
-    let corner = |b: u32, r: u8, block_corner: usize| -> usize { (block_corner + r as usize) % 4 };
+    let corner = |r: u8, block_corner: usize| -> usize { (block_corner + r as usize) % 4 };
     let vertex = |b: u32, r: u8, block_corner: usize| {
-        mesh.bundles[b as usize].vertices[corner(b, r, block_corner)]
+        mesh.bundles[b as usize].vertices[corner(r, block_corner)]
     };
-    let uv = |b: u32, r: u8, block_corner: usize| {
-        mesh.bundles[b as usize].uvs[corner(b, r, block_corner)]
-    };
+    let uv =
+        |b: u32, r: u8, block_corner: usize| mesh.bundles[b as usize].uvs[corner(r, block_corner)];
     // Neighbour across the block edge from block corner `from` to `to`, with its rotation
     // such that the shared edge is its block edge `from' → to'`.
     let neighbour =
@@ -206,7 +205,7 @@ pub fn build_atlas(mesh: &HairMesh, max_region_side: usize) -> Atlas {
                 let corner_of_block: [u8; 4] = if region.triangle {
                     [0, 1, 2, 2]
                 } else {
-                    [0, 1, 2, 3].map(|bc| corner(b, r, bc) as u8)
+                    [0, 1, 2, 3].map(|bc| corner(r, bc) as u8)
                 };
                 let bundle = &mesh.bundles[b as usize];
                 for (bc, offset) in [[0u32, 0u32], [1, 0], [1, 1], [0, 1]].iter().enumerate() {
