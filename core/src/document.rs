@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::mesh::{HairMesh, InvalidMesh};
+use crate::styling::StylingSet;
 
 /// A triangle mesh drawn under the hair (the head, the teapot) and used for depth testing.
 /// Positions are `f32` because the body is display-only; the hair mesh is `f64`.
@@ -53,6 +54,9 @@ pub struct Document {
     pub hair_mesh: HairMesh,
     #[serde(default)]
     pub body: BodyMesh,
+    /// Styling parameters: global values with per-bundle-group overrides.
+    #[serde(default)]
+    pub styling: StylingSet,
 }
 
 /// A validation problem anywhere in a document, with the JSON path of the value.
@@ -70,6 +74,7 @@ impl Document {
             source: String::new(),
             hair_mesh,
             body: BodyMesh::default(),
+            styling: StylingSet::default(),
         }
     }
 
@@ -82,6 +87,13 @@ impl Document {
         self.body.validate().map_err(|e| InvalidDocument {
             path: format!("body.{}", e.path),
             message: e.message,
+        })?;
+        self.styling.validate().map_err(|message| {
+            let (path, message) = message.split_once(": ").unwrap_or(("", &message));
+            InvalidDocument {
+                path: format!("styling.{path}"),
+                message: message.to_string(),
+            }
         })
     }
 }

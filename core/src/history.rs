@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::document::Document;
 use crate::mesh::{Bundle, Column, WMode};
+use crate::styling::StylingSet;
 
 /// Default number of undo steps kept.
 pub const DEFAULT_HISTORY_LIMIT: usize = 200;
@@ -159,6 +160,8 @@ pub struct DocumentDiff {
     pub w_mode: Option<Swap<WMode>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<Swap<String>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub styling: Option<Swap<StylingSet>>,
 }
 
 impl DocumentDiff {
@@ -176,6 +179,10 @@ impl DocumentDiff {
             name: (before.name != after.name).then(|| Swap {
                 before: before.name.clone(),
                 after: after.name.clone(),
+            }),
+            styling: (before.styling != after.styling).then(|| Swap {
+                before: before.styling.clone(),
+                after: after.styling.clone(),
             }),
         }
     }
@@ -206,6 +213,16 @@ impl DocumentDiff {
             if &document.name != expected {
                 return Err(HistoryMismatch {
                     path: "name".into(),
+                    message: "the document does not hold the value this history entry changed"
+                        .into(),
+                });
+            }
+        }
+        if let Some(swap) = &self.styling {
+            let expected = if forward { &swap.before } else { &swap.after };
+            if &document.styling != expected {
+                return Err(HistoryMismatch {
+                    path: "styling".into(),
                     message: "the document does not hold the value this history entry changed"
                         .into(),
                 });

@@ -20,6 +20,8 @@ pub mod random;
 pub mod roots;
 pub mod runtime;
 pub mod samples;
+pub mod strands;
+pub mod styling;
 pub mod teapot;
 pub mod uv;
 

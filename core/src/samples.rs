@@ -17,6 +17,7 @@ use crate::edit::{ExtrudeDirection, extrude};
 use crate::import::{ImportError, ImportOptions, import_slice};
 use crate::mesh::HairMesh;
 use crate::project::Project;
+use crate::styling::{Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Wave};
 use crate::{interior, uv};
 
 /// Attribution required by the head scan's licence; shipped in every head sample.
@@ -223,6 +224,58 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
     ),
 ];
 
+/// The styling of each head sample.
+pub fn head_style(name: &str) -> StylingParams {
+    let base = StylingParams {
+        noise: Noise {
+            amplitude_m: 0.0015,
+            frequency_per_m: 12.0,
+            octaves: 2,
+        },
+        clump: Clump {
+            strength: 0.35,
+            clumps_per_uv: 60.0,
+            radius_m: 0.006,
+            tightening: 1.5,
+        },
+        length: LengthVariation { fraction: 0.15 },
+        ..StylingParams::default()
+    };
+    match name {
+        "head_long_wavy" => StylingParams {
+            wave: Wave {
+                amplitude_m: 0.008,
+                frequency_per_m: 9.0,
+                direction_rad: 0.0,
+                phase_spread: 0.1,
+                ramp_in_m: 0.05,
+            },
+            ..base
+        },
+        "head_curly" => StylingParams {
+            curl: Curl {
+                radius_m: 0.006,
+                turns_per_m: 45.0,
+                ramp_in_m: 0.01,
+                radius_jitter: 0.35,
+            },
+            frizz: Frizz {
+                amplitude_m: 0.0015,
+                frequency_per_m: 150.0,
+                fraction: 0.25,
+            },
+            clump: Clump {
+                strength: 0.5,
+                clumps_per_uv: 80.0,
+                radius_m: 0.005,
+                tightening: 1.0,
+            },
+            ..base
+        },
+        _ => base,
+    }
+}
+
 /// Builds the head sample projects from the scan's GLB bytes.
 pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> {
     let (scalp, body) = head_scalp(glb)?;
@@ -232,6 +285,7 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
         .map(|(name, growth)| {
             let mesh = grow(&scalp, *growth, radii_m);
             let mut document = Document::new(*name, mesh);
+            document.styling.global = head_style(name);
             document.source = HEAD_CREDIT.to_string();
             document.body = body.clone();
             (name.to_string(), Project::new(document))
@@ -278,6 +332,15 @@ pub fn teapot_project(teapot_text: &str) -> Result<Project, crate::teapot::Teapo
         mesh = outcome.mesh;
     }
     let mut document = Document::new("teapot_fur", mesh);
+    document.styling.global = StylingParams {
+        frizz: Frizz {
+            amplitude_m: 0.002,
+            frequency_per_m: 200.0,
+            fraction: 0.6,
+        },
+        length: LengthVariation { fraction: 0.4 },
+        ..StylingParams::default()
+    };
     document.source = TEAPOT_CREDIT.to_string();
     document.body = body;
     Ok(Project::new(document))
