@@ -161,7 +161,8 @@ pub struct DocumentDiff {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<Swap<String>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub styling: Option<Swap<StylingSet>>,
+    /// Boxed: a styling set is large and most commands do not change it.
+    pub styling: Option<Box<Swap<StylingSet>>>,
 }
 
 impl DocumentDiff {
@@ -180,9 +181,11 @@ impl DocumentDiff {
                 before: before.name.clone(),
                 after: after.name.clone(),
             }),
-            styling: (before.styling != after.styling).then(|| Swap {
-                before: before.styling.clone(),
-                after: after.styling.clone(),
+            styling: (before.styling != after.styling).then(|| {
+                Box::new(Swap {
+                    before: before.styling.clone(),
+                    after: after.styling.clone(),
+                })
             }),
         }
     }
