@@ -104,6 +104,7 @@ fn op_strategy() -> impl Strategy<Value = Op> {
             .prop_map(|(bundle, corner, uv)| Op::Uv { bundle, corner, uv }),
         (0usize..10_000, 2usize..5).prop_map(|(vertex, steps)| Op::Drag { vertex, steps }),
         (0usize..1000, 0usize..1000).prop_map(|(a, b)| Op::Group { a, b }),
+        (0.0f64..0.01).prop_map(|radius_m| Op::Styling { radius_m }),
     ]
 }
 
@@ -225,6 +226,11 @@ fn edited(document: &Document, op: &Op) -> Option<Document> {
             let b = pick(*bundle);
             let corner = (*corner % mesh.bundles[b as usize].vertices.len()) as u32;
             edit::set_corner_uvs(mesh, &[(b, corner, DVec2::from(*uv))])
+        }
+        Op::Styling { radius_m } => {
+            let mut after = document.clone();
+            after.styling.global.curl.radius_m = *radius_m;
+            return Some(after);
         }
         Op::Drag { .. } | Op::Group { .. } => return None,
     };
