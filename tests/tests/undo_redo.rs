@@ -72,6 +72,10 @@ enum Op {
         a: usize,
         b: usize,
     },
+    /// A styling slider (curl radius) moved.
+    Styling {
+        radius_m: f64,
+    },
 }
 
 fn op_strategy() -> impl Strategy<Value = Op> {
