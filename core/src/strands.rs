@@ -200,6 +200,67 @@ pub fn generate(document: &Document, options: &StrandOptions) -> Vec<Strand> {
     strands
 }
 
+/// [`generate`] on `threads` threads (bundles split into contiguous chunks); the result is
+/// identical to the single-threaded one, in the same order.
+pub fn generate_parallel(
+    document: &Document,
+    options: &StrandOptions,
+    threads: usize,
+) -> Vec<Strand> {
+    let threads = threads.max(1);
+    let bundle_count = document.hair_mesh.bundles.len();
+    if threads == 1 || bundle_count < 2 {
+        return generate(document, options);
+    }
+    let context = StrandContext::new(document);
+    let count = options.strands_per_bundle as usize;
+    let set = sample_set_size(options.strands_per_bundle);
+    let quad_samples = progressive_samples(set, SampleDomain::Square, options.sample_seed);
+    let triangle_samples = progressive_samples(set, SampleDomain::Triangle, options.sample_seed);
+    let vertex_count = (1usize << options.vertices_log2.min(16)) + 1;
+    let chunk = bundle_count.div_ceil(threads);
+    let context = &context;
+    let (quad_samples, triangle_samples) = (&quad_samples, &triangle_samples);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..bundle_count)
+            .step_by(chunk)
+            .map(|start| {
+                scope.spawn(move || {
+                    let mut strands = Vec::new();
+                    for index in start..(start + chunk).min(bundle_count) {
+                        let bundle = &context.document.hair_mesh.bundles[index];
+                        let samples = if bundle.vertices.len() == 3 {
+                            triangle_samples
+                        } else {
+                            quad_samples
+                        };
+                        for sample in &samples[..count.min(set)] {
+                            let coord = FaceCoord {
+                                s: sample.x,
+                                t: sample.y,
+                            };
+                            if let Some(strand) =
+                                context.strand(index, coord, vertex_count, options)
+                            {
+                                strands.push(strand);
+                            }
+                        }
+                    }
+                    strands
+                })
+            })
+            .collect();
+        // A worker panic is a bug: re-raise it here instead of returning fewer strands.
+        handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+            })
+            .collect()
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -384,6 +445,19 @@ mod tests {
             let r_straight = d.points[k].distance(b.points[k]);
             assert!((r_twisted - r_straight).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn parallel_generation_equals_serial() {
+        let document = styled(everything_but_twist());
+        let options = StrandOptions {
+            strands_per_bundle: 10,
+            ..StrandOptions::default()
+        };
+        assert_eq!(
+            generate_parallel(&document, &options, 4),
+            generate(&document, &options)
+        );
     }
 
     #[test]

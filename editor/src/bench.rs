@@ -17,11 +17,34 @@ pub enum Which {
         #[arg(long, default_value_t = 15)]
         repeat: usize,
     },
+    /// Error and time of every accuracy switch against the f64 reference; writes CSV.
+    Accuracy {
+        /// Project to measure (default: the long wavy head sample).
+        #[arg(long)]
+        project: Option<std::path::PathBuf>,
+        /// Folder for accuracy.csv.
+        #[arg(long, default_value = "target/bench")]
+        out: std::path::PathBuf,
+        /// Strands per bundle measured.
+        #[arg(long, default_value_t = 8)]
+        strands: u32,
+    },
+    /// Styled strand vertices per second on all cores at 10K and 100K strands.
+    Cpu {
+        #[arg(long)]
+        project: Option<std::path::PathBuf>,
+    },
 }
 
 pub fn run(which: Which) -> anyhow::Result<()> {
     match which {
         Which::Interior { repeat } => interior(repeat.max(1)),
+        Which::Accuracy {
+            project,
+            out,
+            strands,
+        } => crate::accuracy::run(project, &out, strands.max(1)),
+        Which::Cpu { project } => crate::accuracy::cpu(project),
     }
 }
 

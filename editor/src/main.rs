@@ -11,6 +11,7 @@ use anyhow::Context;
 use clap::{Parser, Subcommand};
 use hairloom_core::project;
 
+mod accuracy;
 mod bench;
 
 #[derive(Parser)]
