@@ -308,7 +308,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 12, max_shrink_iters: 200, ..ProptestConfig::default() })]
 
     #[test]
-    fn random_command_sequences_undo_and_redo_exactly(ops in prop::collection::vec(op_strategy(), 70..85), save_at in 0usize..50) {
+    fn random_command_sequences_undo_and_redo_exactly(ops in prop::collection::vec(op_strategy(), 90..110), save_at in 0usize..50) {
         let start = Document::new("grid", grid_mesh(3, 3, 2, 0.4));
         let start_json = json(&start);
         let mut document = start.clone();
