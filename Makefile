@@ -7,11 +7,16 @@ CARGO ?= cargo
 SAMPLE ?= assets/samples/head_long_wavy.hairloom
 # wgpu's Vulkan loader wants a writable runtime dir; headless machines often have none.
 export XDG_RUNTIME_DIR ?= /tmp/hairloom-runtime
-# Tests that need a GPU adapter fail (instead of skipping) under `make test`, where
-# lavapipe is installed.
+# Tests that need a GPU adapter or the export validators fail (instead of skipping) under
+# `make test`, which installs them.
 export HAIRLOOM_REQUIRE_GPU ?= 1
+export HAIRLOOM_REQUIRE_VALIDATORS ?= 1
 
 APT_PACKAGES := mesa-vulkan-drivers libvulkan1
+# Third-party validators of the exports: Khronos glTF-Validator and ktx-parse (npm, pinned in
+# tools/validate/package-lock.json) and Pixar's USD (PyPI usd-core) in a private venv.
+VALIDATE_VENV := target/validate-venv
+USD_CORE := usd-core==26.11
 
 .PHONY: run test deps toolchain lint samples bench
 
@@ -34,6 +39,14 @@ deps:
 	    echo "warning: missing$$missing (install them as root for the software GPU adapter)"; \
 	  fi; \
 	fi
+	@tools=""; command -v npm >/dev/null || tools="$$tools nodejs npm"; \
+	python3 -c 'import venv, ensurepip' 2>/dev/null || tools="$$tools python3-venv"; \
+	if [ -n "$$tools" ] && command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
+	  echo "installing:$$tools"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$tools >/dev/null; \
+	fi
+	@[ -d tools/validate/node_modules/gltf-validator ] || (cd tools/validate && npm ci --no-audit --no-fund --loglevel=error)
+	@$(VALIDATE_VENV)/bin/python -c 'import pxr' 2>/dev/null || \
+	  { python3 -m venv $(VALIDATE_VENV) && $(VALIDATE_VENV)/bin/pip install -q --disable-pip-version-check $(USD_CORE); }
 
 run: toolchain
 	$(CARGO) build --release -p hairloom-editor

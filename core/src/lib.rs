@@ -9,6 +9,7 @@ pub mod atlas;
 pub mod curve;
 pub mod document;
 pub mod edit;
+pub mod export;
 pub mod frames;
 pub mod history;
 pub mod import;

@@ -13,6 +13,7 @@ use hairloom_core::project;
 
 mod accuracy;
 mod bench;
+mod export;
 
 #[derive(Parser)]
 #[command(
@@ -52,6 +53,25 @@ enum Command {
         #[arg(long)]
         generate_uv: bool,
     },
+    /// Export the runtime bundle (manifest + KTX2 textures) and/or strands for other tools.
+    Export {
+        project: PathBuf,
+        /// Folder for the runtime bundle.
+        #[arg(long)]
+        runtime: Option<PathBuf>,
+        /// Strand file; the format follows the extension: .hair, .usda or .glb.
+        #[arg(long)]
+        strands: Vec<PathBuf>,
+        /// Strands per bundle.
+        #[arg(long, default_value_t = 64)]
+        strands_per_bundle: u32,
+        /// Strands have 2^N + 1 vertices.
+        #[arg(long, default_value_t = 5)]
+        vertices_log2: u32,
+        /// Runtime texture precision: f32 or f16.
+        #[arg(long, default_value = "f32")]
+        precision: String,
+    },
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
     Adapters,
     /// Measure performance; prints a table (see BENCHMARKS.md).
@@ -79,6 +99,21 @@ fn main() -> ExitCode {
             scale,
             generate_uv,
         }) => import(&scalp, &out, mesh, scale, generate_uv),
+        Some(Command::Export {
+            project,
+            runtime,
+            strands,
+            strands_per_bundle,
+            vertices_log2,
+            precision,
+        }) => export::run(
+            &project,
+            runtime.as_deref(),
+            &strands,
+            strands_per_bundle,
+            vertices_log2,
+            &precision,
+        ),
         Some(Command::Adapters) => adapters(),
         Some(Command::Bench { which }) => bench::run(which),
     };

@@ -153,3 +153,109 @@ fn import_writes_a_valid_project() {
     assert_eq!(code, 2);
     assert!(stderr.contains("missing.glb"), "{stderr}");
 }
+
+/// Runs a validator; `None` when it is not installed (allowed outside `make test`).
+fn validator(program: &Path, args: &[&Path], cwd: &Path) -> Option<(i32, String)> {
+    if !program.exists() && program.components().count() > 1 {
+        return None;
+    }
+    let output = Command::new(program)
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .ok()?;
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    Some((output.status.code().unwrap_or(-1), text))
+}
+
+#[test]
+fn exports_of_every_sample_pass_third_party_validators() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let tools = root.join("tools/validate");
+    let required = std::env::var("HAIRLOOM_REQUIRE_VALIDATORS").as_deref() == Ok("1");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut glbs = Vec::new();
+    let mut ktx2s = Vec::new();
+    let mut usdas = Vec::new();
+    for (i, sample) in samples().iter().enumerate() {
+        let name = sample
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let runtime = dir.path().join(format!("{name}_runtime"));
+        let files: Vec<PathBuf> = ["hair", "usda", "glb"]
+            .iter()
+            .map(|e| dir.path().join(format!("{name}.{e}")))
+            .collect();
+        let precision = if i % 2 == 0 { "f32" } else { "f16" };
+        let mut command = hairloom();
+        command
+            .arg("export")
+            .arg(sample)
+            .arg("--runtime")
+            .arg(&runtime);
+        for file in &files {
+            command.arg("--strands").arg(file);
+        }
+        command.args([
+            "--strands-per-bundle",
+            "3",
+            "--vertices-log2",
+            "3",
+            "--precision",
+            precision,
+        ]);
+        let (code, stdout, stderr) = run(&mut command);
+        assert_eq!(code, 0, "{name}: {stderr}");
+        assert!(stdout.contains("runtime bundle, 6 files"), "{stdout}");
+        // Our own reading of the .hair header: counts match what was generated.
+        let hair = std::fs::read(&files[0]).expect("hair file");
+        assert_eq!(&hair[..4], b"HAIR");
+        let count = |at: usize| {
+            u32::from_le_bytes([hair[at], hair[at + 1], hair[at + 2], hair[at + 3]]) as usize
+        };
+        let (strands, points, segments) = (count(4), count(8), count(16));
+        assert_eq!(points, strands * (segments + 1));
+        assert_eq!(hair.len(), 128 + points * 12);
+        usdas.push(files[1].clone());
+        glbs.push(files[2].clone());
+        for texture in ["hair_mesh", "uv", "w", "u", "v"] {
+            ktx2s.push(runtime.join(format!("{texture}.ktx2")));
+        }
+    }
+    let mut node_args: Vec<&Path> = vec![Path::new("validate.mjs")];
+    node_args.extend(glbs.iter().map(PathBuf::as_path));
+    node_args.extend(ktx2s.iter().map(PathBuf::as_path));
+    let node = if tools.join("node_modules/gltf-validator").exists() {
+        validator(Path::new("node"), &node_args, &tools)
+    } else {
+        None
+    };
+    let python = root.join("target/validate-venv/bin/python");
+    let mut usd_args: Vec<&Path> = vec![Path::new("check_usd.py")];
+    usd_args.extend(usdas.iter().map(PathBuf::as_path));
+    let usd = validator(&python, &usd_args, &tools);
+    for (what, result) in [
+        ("glTF-Validator/ktx-parse (npm)", node),
+        ("usd-core (PyPI)", usd),
+    ] {
+        match result {
+            Some((code, text)) => {
+                eprintln!("{text}");
+                assert_eq!(code, 0, "{what} rejected an export:\n{text}");
+                assert!(
+                    !text.contains("MISMATCH") && !text.contains("INCONSISTENT"),
+                    "{text}"
+                );
+            }
+            None if required => {
+                panic!("{what} is not installed; `make test` installs it (make deps)")
+            }
+            None => eprintln!("skipped {what}: not installed (run `make deps`)"),
+        }
+    }
+}
