@@ -174,27 +174,36 @@ pub fn build_atlas(mesh: &HairMesh, max_region_side: usize) -> Atlas {
         });
     }
 
-    // Shelf packing, tallest first.
+    // Skyline bottom-left packing, tallest first: each region goes where the skyline under
+    // it is lowest (leftmost on ties). Width ≈ √area, so the slice stays near square.
     let size = |r: &Region| (r.cells[0].len() as u32 + 1, r.cells.len() as u32 + 1);
     let total: u32 = regions.iter().map(|r| size(r).0 * size(r).1).sum();
     let widest = regions.iter().map(|r| size(r).0).max().unwrap_or(2);
-    let width = ((total as f64).sqrt() * 1.05).ceil().max(widest as f64) as u32;
+    let width = ((total as f64).sqrt() * 1.02).ceil().max(widest as f64) as u32;
     let mut order: Vec<usize> = (0..regions.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse((size(&regions[i]).1, size(&regions[i]).0)));
     let mut placements = vec![[0u32; 2]; regions.len()];
-    let (mut x, mut y, mut shelf) = (0u32, 0u32, 0u32);
+    let mut skyline = vec![0u32; width as usize];
     for &i in &order {
         let (w, h) = size(&regions[i]);
-        if x + w > width {
-            x = 0;
-            y += shelf;
-            shelf = 0;
+        let (mut best_x, mut best_y) = (0usize, u32::MAX);
+        for x in 0..=(width - w) as usize {
+            let y = skyline[x..x + w as usize]
+                .iter()
+                .copied()
+                .max()
+                .unwrap_or(0);
+            if y < best_y {
+                best_y = y;
+                best_x = x;
+            }
         }
-        placements[i] = [x, y];
-        x += w;
-        shelf = shelf.max(h);
+        placements[i] = [best_x as u32, best_y];
+        for column in &mut skyline[best_x..best_x + w as usize] {
+            *column = best_y + h;
+        }
     }
-    let height = (y + shelf).max(1);
+    let height = skyline.iter().copied().max().unwrap_or(1).max(1);
     let width = width.max(1);
     let mut texels: Vec<Option<TexelSource>> = vec![None; (width * height) as usize];
     let mut blocks = Vec::new();
