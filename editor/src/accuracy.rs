@@ -273,7 +273,121 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let csv_path = out.join("accuracy.csv");
     std::fs::write(&csv_path, csv).with_context(|| format!("writing {}", csv_path.display()))?;
-    println!("wrote {}", csv_path.display());
+    let chart_path = out.join("accuracy.png");
+    chart(&rows, bundle_width, &chart_path)
+        .with_context(|| format!("drawing {}", chart_path.display()))?;
+    println!("wrote {} and {}", csv_path.display(), chart_path.display());
+    Ok(())
+}
+
+/// Two bar panels sharing one row per switch: max error (log) on the left, CPU time on the
+/// right — what each accuracy option costs, side by side.
+fn chart(rows: &[Row], bundle_width: f64, path: &Path) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    let fail = |e: &dyn std::fmt::Debug| anyhow::anyhow!("{e:?}");
+    // Registering again in the same process fails harmlessly.
+    let _ = plotters::style::register_font(
+        "sans-serif",
+        FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    );
+    let plotted: Vec<&Row> = rows.iter().filter(|r| r.max_error > 0.0).collect();
+    let n = plotted.len() as i32;
+    let names: Vec<String> = plotted.iter().map(|r| r.switch.clone()).collect();
+    let e_min = plotted
+        .iter()
+        .map(|r| r.max_error)
+        .fold(f64::INFINITY, f64::min)
+        / 10.0;
+    let e_max = plotted.iter().map(|r| r.max_error).fold(0.0, f64::max) * 5.0;
+    let t_max = rows.iter().map(|r| r.ms_per_million).fold(0.0, f64::max) * 1.25;
+    let root = BitMapBackend::new(path, (1400, 620)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let root = root
+        .titled(
+            &format!("Hairloom accuracy switches: max error vs the f64 reference, and CPU time (bundle width {:.1} mm)", bundle_width * 1e3),
+            ("sans-serif", 20),
+        )
+        .map_err(|e| fail(&e))?;
+    let (left, right) = root.split_horizontally(900);
+    let mut errors = ChartBuilder::on(&left)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(330)
+        .build_cartesian_2d((e_min..e_max).log_scale(), (0..n).into_segmented())
+        .map_err(|e| fail(&e))?;
+    errors
+        .configure_mesh()
+        .disable_y_mesh()
+        .y_labels(n as usize)
+        .y_label_formatter(&|v| match v {
+            SegmentValue::CenterOf(i) => names.get(*i as usize).cloned().unwrap_or_default(),
+            _ => String::new(),
+        })
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .x_desc("max position error, model units (log)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    let mut times = ChartBuilder::on(&right)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(10)
+        .build_cartesian_2d(0.0..t_max, (0..n).into_segmented())
+        .map_err(|e| fail(&e))?;
+    times
+        .configure_mesh()
+        .disable_y_mesh()
+        .y_labels(0)
+        .x_desc("CPU ms per million vertices (one thread)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    for (i, row) in plotted.iter().enumerate() {
+        let i = i as i32;
+        let color = if row.switch.starts_with("styled") {
+            RGBColor(200, 120, 40)
+        } else {
+            RGBColor(60, 110, 180)
+        };
+        errors
+            .draw_series(std::iter::once(Rectangle::new(
+                [
+                    (e_min, SegmentValue::Exact(i)),
+                    (row.max_error, SegmentValue::Exact(i + 1)),
+                ],
+                color.filled(),
+            )))
+            .map_err(|e| fail(&e))?;
+        errors
+            .draw_series(std::iter::once(Text::new(
+                format!(
+                    " {:.2e} ({:.1}% bw)",
+                    row.max_error,
+                    100.0 * row.max_error / bundle_width
+                ),
+                (row.max_error, SegmentValue::CenterOf(i)),
+                ("sans-serif", 13),
+            )))
+            .map_err(|e| fail(&e))?;
+        times
+            .draw_series(std::iter::once(Rectangle::new(
+                [
+                    (0.0, SegmentValue::Exact(i)),
+                    (row.ms_per_million, SegmentValue::Exact(i + 1)),
+                ],
+                color.mix(0.7).filled(),
+            )))
+            .map_err(|e| fail(&e))?;
+        times
+            .draw_series(std::iter::once(Text::new(
+                format!(" {:.0}", row.ms_per_million),
+                (row.ms_per_million, SegmentValue::CenterOf(i)),
+                ("sans-serif", 13),
+            )))
+            .map_err(|e| fail(&e))?;
+    }
+    root.present().map_err(|e| fail(&e))?;
     Ok(())
 }
 
