@@ -57,6 +57,19 @@ impl Atlas {
         self.blocks.iter().find(|b| b.bundle == bundle)
     }
 
+    /// Block coordinates of the point at bundle-corner coordinates `(s, t)` (the coordinates
+    /// root samples are given in): the block's rotation `r = corner_of_block[0]` applied as
+    /// `r` quarter turns `(s, t) ↦ (t, 1 − s)`. Triangles are never rotated.
+    pub fn block_coords(block: &BundleBlock, s: f64, t: f64) -> (f64, f64) {
+        let (mut s, mut t) = (s, t);
+        if block.corner_of_block[3] != block.corner_of_block[2] {
+            for _ in 0..block.corner_of_block[0] {
+                (s, t) = (t, 1.0 - s);
+            }
+        }
+        (s, t)
+    }
+
     /// Bundle-corner weights for block coordinates `(s, t)`: the contract between the
     /// texture path and the reference evaluator.
     pub fn corner_weights(block: &BundleBlock, s: f64, t: f64) -> [f64; 4] {
@@ -299,5 +312,28 @@ mod tests {
         assert_eq!(atlas.blocks[0].corner_of_block, [0, 1, 2, 2]);
         let w = Atlas::corner_weights(&atlas.blocks[0], 0.5, 0.5);
         assert_eq!(w, [0.25, 0.25, 0.5, 0.0]);
+    }
+
+    #[test]
+    fn block_coords_put_the_weight_on_the_same_bundle_corners() {
+        for r in 0..4u8 {
+            let block = BundleBlock {
+                bundle: 0,
+                origin: [0, 0],
+                corner_of_block: [0, 1, 2, 3].map(|b| (b + r) % 4),
+                layers: 1,
+            };
+            for (s, t) in [(0.2, 0.7), (0.0, 1.0), (0.9, 0.1)] {
+                let (bs, bt) = Atlas::block_coords(&block, s, t);
+                let weights = Atlas::corner_weights(&block, bs, bt);
+                let expected = crate::curve::FaceCoord { s, t }.weights(4);
+                for k in 0..4 {
+                    assert!(
+                        (weights[k] - expected[k]).abs() < 1e-15,
+                        "r {r}: {weights:?} vs {expected:?}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -320,6 +320,92 @@ impl TexturePath<'_> {
         let b = fetch(first_slice as f32 + 1.0 + q);
         a + (b - a) * q + self.textures.position_offset
     }
+
+    /// The styled strand rooted at `sample` (bundle-corner coordinates for quads, barycentric
+    /// for triangles — the manifest's sample sets), computed from the five textures as the
+    /// generation shader does: positions from the hair-mesh texture, root uv from the
+    /// uv-texture, w and û, v̂ from linear fetches between layer slices, then twist, length
+    /// variation and the styling offset of `crate::styling`.
+    pub fn styled_strand(
+        &self,
+        block_index: usize,
+        sample: glam::DVec2,
+        vertex_count: usize,
+        params: &crate::styling::StylingParams,
+    ) -> Vec<Vec3> {
+        use crate::styling::{StylingInput, apply_twist, strand_length_fraction, styling_offset};
+        let block = &self.textures.atlas.blocks[block_index];
+        let triangle = block.corner_of_block[2] == block.corner_of_block[3];
+        let (s, t) = if triangle {
+            let q = crate::roots::triangle_to_block(sample);
+            (q.x, q.y)
+        } else {
+            Atlas::block_coords(block, sample.x, sample.y)
+        };
+        let (s, t) = (s as f32, t as f32);
+        let texel = Vec2::new(
+            block.origin[0] as f32 + 0.5 + s,
+            block.origin[1] as f32 + 0.5 + t,
+        );
+        let layer_fetch = |texture: &Texture3d, tau: f32| {
+            sample_trilinear(texture, texel.extend(tau + 0.5), self.filtering)
+        };
+        // The root uv seeds every per-strand random value, and it is fetched once per strand:
+        // always filter it exactly (manual bilinear in the shader), even in hardware mode,
+        // so 8-bit weights cannot shift a strand's curl phase or clump.
+        let root_uv = sample_trilinear(&self.textures.uv, texel.extend(0.5), Filtering::Exact)
+            .truncate()
+            .truncate()
+            .as_dvec2();
+        let tau_max = block.layers as f64 * strand_length_fraction(params, root_uv);
+        let (centre_s, centre_t) = if triangle {
+            (0.5, 1.0 / 3.0)
+        } else {
+            (0.5, 0.5)
+        };
+        let vertex_count = vertex_count.max(2);
+        (0..vertex_count)
+            .map(|k| {
+                let along = k as f64 / (vertex_count - 1) as f64;
+                let tau = (tau_max * along) as f32;
+                let p = self.position(block_index, s, t, tau);
+                if k == 0 {
+                    return p;
+                }
+                let u = layer_fetch(&self.textures.u, tau)
+                    .truncate()
+                    .as_dvec3()
+                    .try_normalize()
+                    .unwrap_or(DVec3::X);
+                let v = layer_fetch(&self.textures.v, tau)
+                    .truncate()
+                    .as_dvec3()
+                    .try_normalize()
+                    .unwrap_or(DVec3::Y);
+                let w_axis = u
+                    .cross(v)
+                    .try_normalize()
+                    .unwrap_or_else(|| crate::frames::fallback_frame(u).v);
+                let w = layer_fetch(&self.textures.w, tau).x as f64;
+                let mut p = p.as_dvec3();
+                if params.twist.turns_per_m != 0.0 {
+                    let centre = self
+                        .position(block_index, centre_s, centre_t, tau)
+                        .as_dvec3();
+                    p = apply_twist(params, p, centre, w_axis, w);
+                }
+                let input = StylingInput {
+                    u,
+                    v,
+                    w_axis,
+                    root_uv,
+                    w,
+                    along,
+                };
+                (p + styling_offset(params, &input)).as_vec3()
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,89 @@
+//! The texture-path mirror (what the GPU shader computes, from the five runtime textures
+//! alone, in f32) against the f64 reference generator, strand for strand, on the bundled
+//! samples with every styling op switched on.
+
+use hairloom_core::curve::{FaceCoord, SegmentForm};
+use hairloom_core::roots::{SampleDomain, progressive_samples};
+use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures, TexturePath};
+use hairloom_core::strands::{StrandContext, StrandOptions};
+use hairloom_core::styling::Twist;
+use hairloom_tests::sample_paths;
+
+#[test]
+fn styled_texture_path_matches_the_reference_generator() {
+    for path in sample_paths() {
+        let mut document = hairloom_core::project::load(&path)
+            .expect("sample")
+            .document;
+        // Every op the sample has, plus twist (the one that needs the centre strand).
+        document.styling.global.twist = Twist { turns_per_m: 4.0 };
+        let textures = RuntimeTextures::build(&document.hair_mesh, Precision::F32);
+        let context = StrandContext::new(&document);
+        let options = StrandOptions {
+            form: SegmentForm::TwoQuadratics,
+            ..StrandOptions::default()
+        };
+        let quad = progressive_samples(8, SampleDomain::Square, 3);
+        let triangle = progressive_samples(8, SampleDomain::Triangle, 3);
+        let size = {
+            let (lo, hi) = document
+                .hair_mesh
+                .columns
+                .iter()
+                .flat_map(|c| c.positions.iter())
+                .fold(
+                    (
+                        glam::DVec3::splat(f64::INFINITY),
+                        glam::DVec3::splat(f64::NEG_INFINITY),
+                    ),
+                    |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+                );
+            (hi - lo).length()
+        };
+        for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
+            let mirror = TexturePath {
+                textures: &textures,
+                filtering,
+            };
+            let mut worst: f64 = 0.0;
+            for (index, block) in textures.atlas.blocks.iter().enumerate().step_by(7) {
+                let bundle = &document.hair_mesh.bundles[block.bundle as usize];
+                let params = document.styling.params_for(block.bundle);
+                let samples = if bundle.vertices.len() == 3 {
+                    &triangle
+                } else {
+                    &quad
+                };
+                for sample in samples {
+                    let gpu_like = mirror.styled_strand(index, *sample, 17, params);
+                    let coord = FaceCoord {
+                        s: sample.x,
+                        t: sample.y,
+                    };
+                    let reference = context
+                        .strand(block.bundle as usize, coord, 17, &options)
+                        .expect("strand");
+                    for (a, b) in gpu_like.iter().zip(&reference.points) {
+                        worst = worst.max(a.as_dvec3().distance(*b));
+                    }
+                }
+            }
+            let bound = match filtering {
+                // f32 storage and arithmetic only.
+                Filtering::Exact => 1e-5 * size,
+                // 8-bit weights move positions by up to ~1/512 of a texel step and the frame
+                // and w likewise; styling amplifies the w error through its frequencies.
+                Filtering::Hardware8Bit => 2e-3 * size,
+            };
+            eprintln!(
+                "{}: {filtering:?}: max {worst:.3e} m (bound {bound:.3e})",
+                path.display()
+            );
+            assert!(
+                worst < bound,
+                "{}: {filtering:?}: {worst} ≥ {bound}",
+                path.display()
+            );
+        }
+    }
+}
