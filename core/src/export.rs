@@ -546,7 +546,13 @@ pub fn glb_lines(strands: &[Strand]) -> Vec<u8> {
         ],
         "buffers": [{"byteLength": bin.len()}]
     });
-    let mut json_bytes = serde_json::to_vec(&json).unwrap_or_default();
+    glb_container(&json, bin)
+}
+
+/// A GLB file: 12-byte header, the JSON chunk (space-padded) and the BIN chunk
+/// (zero-padded), both 4-byte aligned as the glTF 2.0 binary format requires.
+pub fn glb_container(json: &serde_json::Value, mut bin: Vec<u8>) -> Vec<u8> {
+    let mut json_bytes = serde_json::to_vec(json).unwrap_or_default();
     while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }

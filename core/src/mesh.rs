@@ -213,6 +213,23 @@ impl HairMesh {
             .copied()
     }
 
+    /// Axis-aligned bounds `(min, max)` of every vertex; `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
+        let mut points = self
+            .columns
+            .iter()
+            .flat_map(|c| c.positions.iter().copied());
+        let first = points.next()?;
+        Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+
+    /// Length of the bounds' diagonal (0 for an empty mesh).
+    pub fn size(&self) -> f64 {
+        self.bounds()
+            .map(|(lo, hi)| (hi - lo).length())
+            .unwrap_or(0.0)
+    }
+
     /// Number of vertices over all columns and layers.
     pub fn vertex_count(&self) -> usize {
         self.columns.iter().map(|c| c.positions.len()).sum()

@@ -139,10 +139,7 @@ impl RuntimeTextures {
         let atlas = build_atlas(mesh, MAX_REGION_SIDE);
         let max_layers = atlas.blocks.iter().map(|b| b.layers).max().unwrap_or(0);
         let (width, height) = (atlas.width, atlas.height);
-        let (lo, hi) = mesh.columns.iter().flat_map(|c| c.positions.iter()).fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
+        let (lo, hi) = mesh.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
         let offset = match precision {
             Precision::F32 => DVec3::ZERO,
             Precision::F16 if lo.is_finite() && hi.is_finite() => (lo + hi) * 0.5,

@@ -84,37 +84,28 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
     let bundle_width = mean_root_edge(mesh);
     let layers_of = |block: usize| f32_textures.atlas.blocks[block].layers;
 
-    // The reference, once.
-    let reference_start = Instant::now();
-    let mut reference: Vec<Vec<DVec3>> = Vec::with_capacity(strands.len());
-    for (block, _, weights) in &strands {
-        let bundle = f32_textures.atlas.blocks[*block].bundle as usize;
-        let Some(strand) = ReferenceStrand::with_weights(mesh, bundle, *weights) else {
-            continue;
-        };
-        reference.push(
-            taus(layers_of(*block))
-                .map(|t| strand.point(t, CurveDefinition::ColumnBlend, SegmentForm::ExactCubic))
-                .collect(),
-        );
-    }
+    // Every measured strand by the f64 evaluator, with the time it took.
+    let evaluate = |definition: CurveDefinition, form: SegmentForm| -> (Vec<Vec<DVec3>>, f64) {
+        let start = Instant::now();
+        let points: Vec<Vec<DVec3>> = strands
+            .iter()
+            .filter_map(|(block, _, weights)| {
+                let bundle = f32_textures.atlas.blocks[*block].bundle as usize;
+                let strand = ReferenceStrand::with_weights(mesh, bundle, *weights)?;
+                Some(
+                    taus(layers_of(*block))
+                        .map(|t| strand.point(t, definition, form))
+                        .collect(),
+                )
+            })
+            .collect();
+        let vertices = (points.len() * CURVE_VERTICES).max(1) as f64;
+        (points, start.elapsed().as_secs_f64() * 1e3 * 1e6 / vertices)
+    };
+    let (reference, reference_ms) = evaluate(CurveDefinition::ColumnBlend, SegmentForm::ExactCubic);
     let vertex_total = (reference.len() * CURVE_VERTICES) as f64;
-    let reference_ms = reference_start.elapsed().as_secs_f64() * 1e3 * 1e6 / vertex_total;
 
-    let quadratic_model: Vec<Vec<DVec3>> = strands
-        .iter()
-        .filter_map(|(block, _, weights)| {
-            let bundle = f32_textures.atlas.blocks[*block].bundle as usize;
-            let strand = ReferenceStrand::with_weights(mesh, bundle, *weights)?;
-            Some(
-                taus(layers_of(*block))
-                    .map(|t| {
-                        strand.point(t, CurveDefinition::ColumnBlend, SegmentForm::TwoQuadratics)
-                    })
-                    .collect(),
-            )
-        })
-        .collect();
+    let (quadratic_model, _) = evaluate(CurveDefinition::ColumnBlend, SegmentForm::TwoQuadratics);
     let compare_with = |points: &[Vec<DVec3>], against: &[Vec<DVec3>]| -> (f64, f64) {
         let mut max: f64 = 0.0;
         let mut sum = 0.0;
@@ -149,20 +140,7 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
             SegmentForm::TwoQuadratics,
         ),
     ] {
-        let start = Instant::now();
-        let points: Vec<Vec<DVec3>> = strands
-            .iter()
-            .filter_map(|(block, _, weights)| {
-                let bundle = f32_textures.atlas.blocks[*block].bundle as usize;
-                let strand = ReferenceStrand::with_weights(mesh, bundle, *weights)?;
-                Some(
-                    taus(layers_of(*block))
-                        .map(|t| strand.point(t, definition, form))
-                        .collect(),
-                )
-            })
-            .collect();
-        let ms = start.elapsed().as_secs_f64() * 1e3 * 1e6 / vertex_total;
+        let (points, ms) = evaluate(definition, form);
         let (max, mean) = compare(&points);
         rows.push(Row {
             switch: name.into(),

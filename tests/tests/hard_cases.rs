@@ -65,15 +65,7 @@ fn run_pipeline(mesh: HairMesh, styling: StylingParams) -> f64 {
             );
         }
     }
-    let (lo, hi) = document
-        .hair_mesh
-        .columns
-        .iter()
-        .flat_map(|c| c.positions.iter())
-        .fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
+    let (lo, hi) = document.hair_mesh.bounds().expect("non-empty mesh");
     let mut worst: f64 = 0.0;
     for definition in [
         CurveDefinition::ColumnBlend,
@@ -155,11 +147,7 @@ fn hair_grid() -> HairMesh {
 }
 
 fn size(mesh: &HairMesh) -> f64 {
-    let (lo, hi) = mesh.columns.iter().flat_map(|c| c.positions.iter()).fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    );
-    (hi - lo).length()
+    mesh.size()
 }
 
 fn check(mesh: HairMesh, styling: StylingParams) {

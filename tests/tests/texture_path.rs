@@ -25,21 +25,7 @@ fn styled_texture_path_matches_the_reference_generator() {
         };
         let quad = progressive_samples(8, SampleDomain::Square, 3);
         let triangle = progressive_samples(8, SampleDomain::Triangle, 3);
-        let size = {
-            let (lo, hi) = document
-                .hair_mesh
-                .columns
-                .iter()
-                .flat_map(|c| c.positions.iter())
-                .fold(
-                    (
-                        glam::DVec3::splat(f64::INFINITY),
-                        glam::DVec3::splat(f64::NEG_INFINITY),
-                    ),
-                    |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-                );
-            (hi - lo).length()
-        };
+        let size = document.hair_mesh.size();
         for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
             let mirror = TexturePath {
                 textures: &textures,
