@@ -172,32 +172,53 @@ pub fn sample_set_size(strands_per_bundle: u32) -> usize {
 /// Smallest root sample set.
 pub const MIN_SAMPLE_SET: usize = 256;
 
-/// Every strand of the document: `strands_per_bundle` per bundle that grows hair.
-pub fn generate(document: &Document, options: &StrandOptions) -> Vec<Strand> {
-    let context = StrandContext::new(document);
-    let count = options.strands_per_bundle as usize;
-    let set = sample_set_size(options.strands_per_bundle);
-    let quad_samples = progressive_samples(set, SampleDomain::Square, options.sample_seed);
-    let triangle_samples = progressive_samples(set, SampleDomain::Triangle, options.sample_seed);
-    let vertex_count = (1usize << options.vertices_log2.min(16)) + 1;
-    let mut strands = Vec::new();
-    for (index, bundle) in document.hair_mesh.bundles.iter().enumerate() {
-        let samples = if bundle.vertices.len() == 3 {
-            &triangle_samples
-        } else {
-            &quad_samples
-        };
-        for sample in &samples[..count.min(set)] {
-            let coord = FaceCoord {
-                s: sample.x,
-                t: sample.y,
-            };
-            if let Some(strand) = context.strand(index, coord, vertex_count, options) {
-                strands.push(strand);
-            }
+/// What every bundle's strands are generated from: the root sample sets and counts.
+pub struct StrandPlan {
+    pub options: StrandOptions,
+    quad_samples: Vec<glam::DVec2>,
+    triangle_samples: Vec<glam::DVec2>,
+    count: usize,
+    vertex_count: usize,
+}
+
+impl StrandPlan {
+    pub fn new(options: &StrandOptions) -> Self {
+        let set = sample_set_size(options.strands_per_bundle);
+        Self {
+            options: *options,
+            quad_samples: progressive_samples(set, SampleDomain::Square, options.sample_seed),
+            triangle_samples: progressive_samples(set, SampleDomain::Triangle, options.sample_seed),
+            count: (options.strands_per_bundle as usize).min(set),
+            vertex_count: (1usize << options.vertices_log2.min(16)) + 1,
         }
     }
-    strands
+
+    /// The strands of bundle `index` (none for a bundle that grows no hair).
+    pub fn bundle_strands(&self, context: &StrandContext, index: usize) -> Vec<Strand> {
+        let Some(bundle) = context.document.hair_mesh.bundles.get(index) else {
+            return Vec::new();
+        };
+        let samples = if bundle.vertices.len() == 3 {
+            &self.triangle_samples
+        } else {
+            &self.quad_samples
+        };
+        samples[..self.count]
+            .iter()
+            .filter_map(|sample| {
+                let coord = FaceCoord {
+                    s: sample.x,
+                    t: sample.y,
+                };
+                context.strand(index, coord, self.vertex_count, &self.options)
+            })
+            .collect()
+    }
+}
+
+/// Every strand of the document: `strands_per_bundle` per bundle that grows hair.
+pub fn generate(document: &Document, options: &StrandOptions) -> Vec<Strand> {
+    generate_parallel(document, options, 1)
 }
 
 /// [`generate`] on `threads` threads (bundles split into contiguous chunks); the result is
@@ -207,46 +228,25 @@ pub fn generate_parallel(
     options: &StrandOptions,
     threads: usize,
 ) -> Vec<Strand> {
-    let threads = threads.max(1);
-    let bundle_count = document.hair_mesh.bundles.len();
-    if threads == 1 || bundle_count < 2 {
-        return generate(document, options);
-    }
     let context = StrandContext::new(document);
-    let count = options.strands_per_bundle as usize;
-    let set = sample_set_size(options.strands_per_bundle);
-    let quad_samples = progressive_samples(set, SampleDomain::Square, options.sample_seed);
-    let triangle_samples = progressive_samples(set, SampleDomain::Triangle, options.sample_seed);
-    let vertex_count = (1usize << options.vertices_log2.min(16)) + 1;
+    let plan = StrandPlan::new(options);
+    let bundle_count = document.hair_mesh.bundles.len();
+    let threads = threads.clamp(1, bundle_count.max(1));
+    if threads == 1 {
+        return (0..bundle_count)
+            .flat_map(|i| plan.bundle_strands(&context, i))
+            .collect();
+    }
     let chunk = bundle_count.div_ceil(threads);
-    let context = &context;
-    let (quad_samples, triangle_samples) = (&quad_samples, &triangle_samples);
+    let (context, plan) = (&context, &plan);
     std::thread::scope(|scope| {
         let handles: Vec<_> = (0..bundle_count)
             .step_by(chunk)
             .map(|start| {
                 scope.spawn(move || {
-                    let mut strands = Vec::new();
-                    for index in start..(start + chunk).min(bundle_count) {
-                        let bundle = &context.document.hair_mesh.bundles[index];
-                        let samples = if bundle.vertices.len() == 3 {
-                            triangle_samples
-                        } else {
-                            quad_samples
-                        };
-                        for sample in &samples[..count.min(set)] {
-                            let coord = FaceCoord {
-                                s: sample.x,
-                                t: sample.y,
-                            };
-                            if let Some(strand) =
-                                context.strand(index, coord, vertex_count, options)
-                            {
-                                strands.push(strand);
-                            }
-                        }
-                    }
-                    strands
+                    (start..(start + chunk).min(bundle_count))
+                        .flat_map(|i| plan.bundle_strands(context, i))
+                        .collect::<Vec<_>>()
                 })
             })
             .collect();

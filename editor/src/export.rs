@@ -10,7 +10,7 @@ use hairloom_core::export::{
 };
 use hairloom_core::project::write_atomic;
 use hairloom_core::runtime::Precision;
-use hairloom_core::strands::{StrandContext, StrandOptions, sample_set_size};
+use hairloom_core::strands::{StrandContext, StrandOptions, StrandPlan};
 
 /// Strand width written to the strand files (80 µm, a typical human hair).
 const STRAND_WIDTH_M: f32 = 8e-5;
@@ -96,40 +96,22 @@ fn generate_with_progress(
     strands_per_bundle: u32,
     vertices_log2: u32,
 ) -> Vec<hairloom_core::strands::Strand> {
-    use hairloom_core::curve::FaceCoord;
-    use hairloom_core::roots::{SampleDomain, progressive_samples};
     let options = StrandOptions {
         strands_per_bundle,
         vertices_log2,
         ..StrandOptions::default()
     };
     let context = StrandContext::new(document);
-    let set = sample_set_size(strands_per_bundle);
-    let quad = progressive_samples(set, SampleDomain::Square, options.sample_seed);
-    let triangle = progressive_samples(set, SampleDomain::Triangle, options.sample_seed);
-    let count = (strands_per_bundle as usize).min(set);
-    let bundles = &document.hair_mesh.bundles;
+    let plan = StrandPlan::new(&options);
+    let bundle_count = document.hair_mesh.bundles.len();
     let mut strands = Vec::new();
     let mut last_percent = usize::MAX;
     let mut stderr = std::io::stderr();
     // Redrawn in place on a terminal; logs and pipes get nothing.
     let show_progress = stderr.is_terminal();
-    for (index, bundle) in bundles.iter().enumerate() {
-        let samples = if bundle.vertices.len() == 3 {
-            &triangle
-        } else {
-            &quad
-        };
-        for sample in &samples[..count] {
-            let coord = FaceCoord {
-                s: sample.x,
-                t: sample.y,
-            };
-            if let Some(strand) = context.strand(index, coord, (1 << vertices_log2) + 1, &options) {
-                strands.push(strand);
-            }
-        }
-        let percent = (index + 1) * 100 / bundles.len().max(1);
+    for index in 0..bundle_count {
+        strands.extend(plan.bundle_strands(&context, index));
+        let percent = (index + 1) * 100 / bundle_count.max(1);
         if show_progress && percent != last_percent {
             let filled = percent / 5;
             let _ = write!(
