@@ -11,6 +11,7 @@ pub mod document;
 pub mod edit;
 pub mod export;
 pub mod frames;
+pub mod gpu_types;
 pub mod history;
 pub mod import;
 pub mod interior;

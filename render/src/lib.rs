@@ -2,3 +2,4 @@
 //! it. Every GPU stage here has a CPU mirror in `hairloom-core` that tests compare against.
 
 pub mod device;
+pub mod strand_gen;

@@ -1,0 +1,306 @@
+//! GPU strand generation (`shaders/strand_gen.wgsl`): strand vertex positions computed from
+//! the hair-mesh texture, never stored between frames. This first stage writes positions to
+//! a storage buffer for read-back (tests, benchmarks); the preview renderer consumes the same
+//! shader's output.
+//!
+//! CPU mirror: `hairloom_core::runtime::TexturePath::position`.
+
+use hairloom_core::gpu_types::{FILTERING_EXACT, FILTERING_HARDWARE, StrandGenParams, StrandRoot};
+use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures};
+use wgpu::util::DeviceExt;
+
+use crate::device::GpuContext;
+
+/// The WGSL source, validated by naga in `cargo test`.
+pub const SHADER_SOURCE: &str = include_str!("../../shaders/strand_gen.wgsl");
+
+/// Why generation failed.
+#[derive(Debug, thiserror::Error)]
+pub enum StrandGenError {
+    #[error(
+        "{adapter} cannot filter 32-bit float textures in hardware; use exact filtering or f16 textures"
+    )]
+    NoFloat32Filtering { adapter: String },
+    #[error("reading generated positions back failed: {0}")]
+    Readback(String),
+}
+
+/// Pipeline and bind-group layout of `strand_gen` (one per device).
+pub struct StrandGenRenderer {
+    pipeline: wgpu::ComputePipeline,
+    bind_group_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    float32_filterable: bool,
+}
+
+/// Workgroup size of `main` in `strand_gen.wgsl`.
+const WORKGROUP_SIZE: u32 = 64;
+
+impl StrandGenRenderer {
+    pub fn new(context: &GpuContext) -> Self {
+        let device = &context.device;
+        let float32_filterable = device
+            .features()
+            .contains(wgpu::Features::FLOAT32_FILTERABLE);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("strand_gen"),
+            source: wgpu::ShaderSource::Wgsl(SHADER_SOURCE.into()),
+        });
+        let storage = |read_only: bool, size: u64| wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: wgpu::BufferSize::new(size),
+        };
+        // In @binding order, as the shader declares them.
+        let bind_group_layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("strand_gen"),
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: false,
+                            min_binding_size: wgpu::BufferSize::new(
+                                size_of::<StrandGenParams>() as u64
+                            ),
+                        },
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 1,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: storage(true, size_of::<StrandRoot>() as u64),
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 2,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Texture {
+                            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                            view_dimension: wgpu::TextureViewDimension::D3,
+                            multisampled: false,
+                        },
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 3,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                        count: None,
+                    },
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 4,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: storage(false, 16),
+                        count: None,
+                    },
+                ],
+            });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("strand_gen"),
+            bind_group_layouts: &[Some(&bind_group_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("strand_gen"),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("strand_gen_linear_clamp"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            address_mode_w: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Self {
+            pipeline,
+            bind_group_layout,
+            sampler,
+            float32_filterable,
+        }
+    }
+
+    /// Uploads the hair-mesh texture of `textures` (f32 or f16 as built).
+    pub fn upload_hair_mesh(
+        &self,
+        context: &GpuContext,
+        textures: &RuntimeTextures,
+    ) -> wgpu::Texture {
+        let texture = &textures.hair_mesh;
+        let (format, export_format) = match textures.precision {
+            Precision::F32 => (
+                wgpu::TextureFormat::Rgba32Float,
+                hairloom_core::export::TexelFormat::Rgba32Float,
+            ),
+            Precision::F16 => (
+                wgpu::TextureFormat::Rgba16Float,
+                hairloom_core::export::TexelFormat::Rgba16Float,
+            ),
+        };
+        let bytes = hairloom_core::export::texel_bytes(&texture.texels, export_format);
+        let size = wgpu::Extent3d {
+            width: texture.width,
+            height: texture.height,
+            depth_or_array_layers: texture.depth,
+        };
+        let gpu_texture = context.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("hair_mesh"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let texel_size = 4 * export_format.bytes_per_channel() as u32;
+        context.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &gpu_texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            &bytes,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(texture.width * texel_size),
+                rows_per_image: Some(texture.height),
+            },
+            size,
+        );
+        gpu_texture
+    }
+
+    /// Generates `roots.len() × vertex_count` positions and reads them back (strand-major).
+    pub fn generate_positions(
+        &self,
+        context: &GpuContext,
+        textures: &RuntimeTextures,
+        hair_mesh: &wgpu::Texture,
+        roots: &[StrandRoot],
+        vertex_count: u32,
+        filtering: Filtering,
+    ) -> Result<Vec<[f32; 4]>, StrandGenError> {
+        let hardware = filtering == Filtering::Hardware8Bit;
+        if hardware && textures.precision == Precision::F32 && !self.float32_filterable {
+            return Err(StrandGenError::NoFloat32Filtering {
+                adapter: context.adapter_info.name.clone(),
+            });
+        }
+        let device = &context.device;
+        let params = StrandGenParams {
+            position_offset: textures.position_offset.extend(0.0).to_array(),
+            texture_size: [
+                textures.hair_mesh.width,
+                textures.hair_mesh.height,
+                textures.hair_mesh.depth,
+                0,
+            ],
+            strand_count: roots.len() as u32,
+            vertex_count,
+            filtering: if hardware {
+                FILTERING_HARDWARE
+            } else {
+                FILTERING_EXACT
+            },
+            _padding: 0,
+        };
+        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("strand_gen_params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let placeholder = [StrandRoot::default()];
+        let roots_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("strand_gen_roots"),
+            contents: bytemuck::cast_slice(if roots.is_empty() {
+                &placeholder
+            } else {
+                roots
+            }),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let vertices = (roots.len() as u64 * vertex_count as u64).max(1);
+        let output_size = vertices * 16;
+        let output = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("strand_gen_positions"),
+            size: output_size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("strand_gen_readback"),
+            size: output_size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let view = hair_mesh.create_view(&wgpu::TextureViewDescriptor::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("strand_gen"),
+            layout: &self.bind_group_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: roots_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: output.as_entire_binding(),
+                },
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("strand_gen"),
+        });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("strand_gen"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups((vertices as u32).div_ceil(WORKGROUP_SIZE), 1, 1);
+        }
+        encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, output_size);
+        context.queue.submit([encoder.finish()]);
+        let slice = readback.slice(..);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |result| {
+            let _ = sender.send(result);
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| StrandGenError::Readback(e.to_string()))?;
+        receiver
+            .recv()
+            .map_err(|e| StrandGenError::Readback(e.to_string()))?
+            .map_err(|e| StrandGenError::Readback(e.to_string()))?;
+        let mapped = slice
+            .get_mapped_range()
+            .map_err(|e| StrandGenError::Readback(format!("{e:?}")))?;
+        let mut positions: Vec<[f32; 4]> = bytemuck::cast_slice(&mapped).to_vec();
+        positions.truncate(roots.len() * vertex_count as usize);
+        Ok(positions)
+    }
+}
