@@ -18,7 +18,7 @@ APT_PACKAGES := mesa-vulkan-drivers libvulkan1
 VALIDATE_VENV := target/validate-venv
 USD_CORE := usd-core==26.11
 
-.PHONY: run test deps toolchain lint samples bench
+.PHONY: run test deps gpu-deps toolchain lint samples bench
 
 toolchain:
 	@command -v $(CARGO) >/dev/null || { \
@@ -28,7 +28,7 @@ toolchain:
 	  echo "Rust installed: open a new shell or run 'source ~/.cargo/env', then run make again"; exit 1; }
 
 # Installs Mesa's software Vulkan (lavapipe) so wgpu finds an adapter without a GPU.
-deps:
+gpu-deps:
 	@mkdir -p "$(XDG_RUNTIME_DIR)" && chmod 700 "$(XDG_RUNTIME_DIR)"
 	@missing=""; for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
 	if [ -n "$$missing" ]; then \
@@ -39,6 +39,9 @@ deps:
 	    echo "warning: missing$$missing (install them as root for the software GPU adapter)"; \
 	  fi; \
 	fi
+
+# gpu-deps plus the export validators.
+deps: gpu-deps
 	@tools=""; command -v npm >/dev/null || tools="$$tools nodejs npm"; \
 	python3 -c 'import venv, ensurepip' 2>/dev/null || tools="$$tools python3-venv"; \
 	if [ -n "$$tools" ] && command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
@@ -48,10 +51,16 @@ deps:
 	@$(VALIDATE_VENV)/bin/python -c 'import pxr' 2>/dev/null || \
 	  { python3 -m venv $(VALIDATE_VENV) && $(VALIDATE_VENV)/bin/pip install -q --disable-pip-version-check $(USD_CORE); }
 
-run: toolchain
+RENDER_OUT ?= out/$(notdir $(SAMPLE:.hairloom=.png))
+
+# The interactive editor is not built yet: render the sample headless (software Vulkan when
+# there is no GPU) and say where the picture is.
+run: toolchain gpu-deps
 	$(CARGO) build --release -p hairloom-editor
 	./target/release/hairloom check $(SAMPLE)
 	./target/release/hairloom info $(SAMPLE)
+	./target/release/hairloom render $(SAMPLE) --out $(RENDER_OUT)
+	@echo "Rendered $(SAMPLE) to $(RENDER_OUT)"
 
 test: toolchain deps
 	$(CARGO) test --workspace --all-targets

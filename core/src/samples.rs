@@ -157,7 +157,7 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
             let outward = DVec3::new(n.x, 0.0, n.z).normalize_or_zero() * 0.3;
             // Hair from the front of the scalp sweeps back instead of falling over the face.
             let front = (root.z / radii_m.z).max(0.0);
-            let sweep_back = DVec3::new(0.0, 0.0, -1.2 * front);
+            let sweep_back = DVec3::new(0.0, 0.0, -3.0 * front);
             let down = (-DVec3::Y + outward + sweep_back).normalize();
             let direction = n.lerp(down, bend).normalize_or(n);
             let mut p = previous + direction * growth.step_m;

@@ -14,6 +14,7 @@ use hairloom_core::project;
 mod accuracy;
 mod bench;
 mod export;
+mod render;
 
 #[derive(Parser)]
 #[command(
@@ -72,6 +73,21 @@ enum Command {
         #[arg(long, default_value = "f32")]
         precision: String,
     },
+    /// Render a project headless to a PNG (body + shaded strands, MSAA).
+    Render {
+        project: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// Image size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "960x960")]
+        size: String,
+        /// Strands per bundle.
+        #[arg(long, default_value_t = 48)]
+        strands_per_bundle: u32,
+        /// Camera direction from the model: front, side, back, three-quarter, or x,y,z.
+        #[arg(long, default_value = "three-quarter")]
+        view: String,
+    },
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
     Adapters,
     /// Measure performance; prints a table (see BENCHMARKS.md).
@@ -114,6 +130,13 @@ fn main() -> ExitCode {
             vertices_log2,
             &precision,
         ),
+        Some(Command::Render {
+            project,
+            out,
+            size,
+            strands_per_bundle,
+            view,
+        }) => render::run(&project, &out, &size, strands_per_bundle, &view),
         Some(Command::Adapters) => adapters(),
         Some(Command::Bench { which }) => bench::run(which),
     };

@@ -259,3 +259,56 @@ fn exports_of_every_sample_pass_third_party_validators() {
         }
     }
 }
+
+#[test]
+fn render_draws_shaded_hair_over_the_body() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("teapot.png");
+    let sample = samples()
+        .into_iter()
+        .find(|p| p.to_string_lossy().contains("teapot"))
+        .expect("teapot sample");
+    let (code, stdout, stderr) = run(hairloom()
+        .arg("render")
+        .arg(&sample)
+        .arg("--out")
+        .arg(&out)
+        .args(["--size", "200x160", "--strands-per-bundle", "6"]));
+    if code != 0
+        && stderr.contains("no GPU adapter")
+        && std::env::var("HAIRLOOM_REQUIRE_GPU").as_deref() != Ok("1")
+    {
+        eprintln!("skipped: {stderr}");
+        return;
+    }
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("200x160"), "{stdout}");
+    let image = image::open(&out).expect("a PNG").to_rgba8();
+    assert_eq!(image.dimensions(), (200, 160));
+    // Background is near-black grey; the body is light and warm; the hair is brown.
+    let pixels: Vec<[u8; 4]> = image.pixels().map(|p| p.0).collect();
+    let background = pixels[0];
+    let differing = pixels
+        .iter()
+        .filter(|p| p.iter().zip(&background).any(|(a, b)| a.abs_diff(*b) > 12))
+        .count();
+    assert!(
+        differing > pixels.len() / 20,
+        "only {differing} of {} pixels drawn",
+        pixels.len()
+    );
+    let hair_like = pixels
+        .iter()
+        .filter(|p| p[0] > p[2] + 8 && p[0] < 200)
+        .count();
+    assert!(hair_like > 100, "no brown strand pixels ({hair_like})");
+    // Bad input is an error, not a panic.
+    let (code, _, stderr) = run(hairloom()
+        .arg("render")
+        .arg(&sample)
+        .arg("--out")
+        .arg(&out)
+        .args(["--size", "0x10"]));
+    assert_eq!(code, 2);
+    assert!(stderr.contains("--size"), "{stderr}");
+}

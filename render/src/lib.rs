@@ -2,4 +2,5 @@
 //! it. Every GPU stage here has a CPU mirror in `hairloom-core` that tests compare against.
 
 pub mod device;
+pub mod preview;
 pub mod strand_gen;

@@ -61,11 +61,19 @@ fn wgsl_struct_size(module: &naga::Module, name: &str) -> Option<u32> {
 #[test]
 fn gpu_structs_match_their_wgsl() {
     use hairloom_core::gpu_types::{StrandGenParams, StrandRoot};
-    let module = parse("strand_gen", hairloom_render::strand_gen::SHADER_SOURCE);
-    for (name, rust_size) in [
-        ("StrandGenParams", size_of::<StrandGenParams>()),
-        ("StrandRoot", size_of::<StrandRoot>()),
+    use hairloom_render::preview::{BODY_SHADER, BodyUniforms, HAIR_SHADER, HairUniforms};
+    use hairloom_render::strand_gen::SHADER_SOURCE;
+    for (source, name, rust_size) in [
+        (
+            SHADER_SOURCE,
+            "StrandGenParams",
+            size_of::<StrandGenParams>(),
+        ),
+        (SHADER_SOURCE, "StrandRoot", size_of::<StrandRoot>()),
+        (HAIR_SHADER, "HairUniforms", size_of::<HairUniforms>()),
+        (BODY_SHADER, "BodyUniforms", size_of::<BodyUniforms>()),
     ] {
+        let module = parse(name, source);
         let wgsl_size = wgsl_struct_size(&module, name)
             .unwrap_or_else(|| panic!("{name} missing from strand_gen.wgsl"));
         assert_eq!(

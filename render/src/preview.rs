@@ -1,0 +1,452 @@
+//! Offscreen preview: the opaque body and the hair as camera-facing ribbons with Kajiya-Kay
+//! shading (`shaders/preview_body.wgsl`, `shaders/preview_hair.wgsl`), depth-tested, 4× MSAA
+//! where the adapter supports it, read back as RGBA8 pixels.
+//!
+//! Strand vertices arrive in a storage buffer, strand-major; they may come from the GPU
+//! generation stage or from the CPU reference generator (the explicit-storage path).
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+use crate::device::GpuContext;
+
+pub const HAIR_SHADER: &str = include_str!("../../shaders/preview_hair.wgsl");
+pub const BODY_SHADER: &str = include_str!("../../shaders/preview_body.wgsl");
+
+const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Keep in sync with `shaders/preview_hair.wgsl` (`HairUniforms`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct HairUniforms {
+    pub view_projection: [[f32; 4]; 4],
+    pub camera_position: [f32; 4],
+    pub root_color: [f32; 4],
+    pub tip_color: [f32; 4],
+    /// Ribbon width (x), strand count (y), vertices per strand (z), unused (w).
+    pub width_counts: [f32; 4],
+}
+
+/// Keep in sync with `shaders/preview_body.wgsl` (`BodyUniforms`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct BodyUniforms {
+    pub view_projection: [[f32; 4]; 4],
+    pub camera_position: [f32; 4],
+    pub color: [f32; 4],
+}
+
+/// A perspective camera looking at `target`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub fov_y_rad: f32,
+}
+
+impl Camera {
+    /// Frames the box `(min, max)` seen from `direction` (toward the camera), so that its
+    /// bounding sphere fills the view.
+    pub fn framing(min: Vec3, max: Vec3, direction: Vec3) -> Self {
+        let center = (min + max) * 0.5;
+        let radius = ((max - min).length() * 0.5).max(1e-6);
+        let fov_y_rad = 30f32.to_radians();
+        let distance = radius / (fov_y_rad * 0.5).sin() * 0.8;
+        Self {
+            eye: center + direction.normalize_or(Vec3::Z) * distance,
+            target: center,
+            up: Vec3::Y,
+            fov_y_rad,
+        }
+    }
+
+    pub fn view_projection(&self, aspect: f32) -> Mat4 {
+        let distance = self.eye.distance(self.target).max(1e-6);
+        let projection = Mat4::perspective_rh(
+            self.fov_y_rad,
+            aspect.max(1e-6),
+            distance * 0.01,
+            distance * 10.0,
+        );
+        projection * Mat4::look_at_rh(self.eye, self.target, self.up)
+    }
+}
+
+/// What to draw.
+pub struct PreviewScene<'a> {
+    pub body_positions: &'a [[f32; 3]],
+    pub body_triangles: &'a [[u32; 3]],
+    /// Strand-major vertices, `vertex_count` per strand (w unused).
+    pub strand_positions: &'a [[f32; 4]],
+    pub vertex_count: u32,
+    pub strand_width_m: f32,
+    pub root_color: [f32; 3],
+    pub tip_color: [f32; 3],
+    pub body_color: [f32; 3],
+    pub camera: Camera,
+}
+
+/// Pipelines of the preview (one per device and sample count).
+pub struct PreviewRenderer {
+    hair_pipeline: wgpu::RenderPipeline,
+    hair_layout: wgpu::BindGroupLayout,
+    body_pipeline: wgpu::RenderPipeline,
+    body_layout: wgpu::BindGroupLayout,
+    pub sample_count: u32,
+}
+
+impl PreviewRenderer {
+    pub fn new(context: &GpuContext) -> Self {
+        let device = &context.device;
+        let flags = context
+            .adapter
+            .get_texture_format_features(COLOR_FORMAT)
+            .flags;
+        let sample_count = if flags.sample_count_supported(4) {
+            4
+        } else {
+            1
+        };
+        let uniform_entry = |size: usize| wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(size as u64),
+            },
+            count: None,
+        };
+        let hair_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("preview_hair"),
+            entries: &[
+                uniform_entry(size_of::<HairUniforms>()),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::VERTEX,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(16),
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let body_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("preview_body"),
+            entries: &[uniform_entry(size_of::<BodyUniforms>())],
+        });
+        let pipeline = |label: &str,
+                        source: &str,
+                        layout: &wgpu::BindGroupLayout,
+                        buffers: &[Option<wgpu::VertexBufferLayout>]| {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: &[Some(layout)],
+                immediate_size: 0,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: wgpu::MultisampleState {
+                    count: sample_count,
+                    ..Default::default()
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(COLOR_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let body_buffers = [Some(wgpu::VertexBufferLayout {
+            array_stride: 12,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+        })];
+        let hair_pipeline = pipeline("preview_hair", HAIR_SHADER, &hair_layout, &[]);
+        let body_pipeline = pipeline("preview_body", BODY_SHADER, &body_layout, &body_buffers);
+        Self {
+            hair_pipeline,
+            hair_layout,
+            body_pipeline,
+            body_layout,
+            sample_count,
+        }
+    }
+
+    /// Renders `scene` into a `width × height` image; returns RGBA8 (sRGB) rows, top first.
+    pub fn render(
+        &self,
+        context: &GpuContext,
+        scene: &PreviewScene,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, String> {
+        let device = &context.device;
+        let (width, height) = (width.max(1), height.max(1));
+        let view_projection = scene
+            .camera
+            .view_projection(width as f32 / height as f32)
+            .to_cols_array_2d();
+        let camera_position = scene.camera.eye.extend(1.0).to_array();
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let target =
+            |label: &str, format: wgpu::TextureFormat, samples: u32, usage: wgpu::TextureUsages| {
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size,
+                    mip_level_count: 1,
+                    sample_count: samples,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+            };
+        let resolved = target(
+            "preview_color",
+            COLOR_FORMAT,
+            1,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let msaa = (self.sample_count > 1).then(|| {
+            target(
+                "preview_msaa",
+                COLOR_FORMAT,
+                self.sample_count,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            )
+        });
+        let depth = target(
+            "preview_depth",
+            DEPTH_FORMAT,
+            self.sample_count,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let resolved_view = resolved.create_view(&Default::default());
+        let msaa_view = msaa.as_ref().map(|t| t.create_view(&Default::default()));
+        let depth_view = depth.create_view(&Default::default());
+
+        let body_uniforms = BodyUniforms {
+            view_projection,
+            camera_position,
+            color: [
+                scene.body_color[0],
+                scene.body_color[1],
+                scene.body_color[2],
+                1.0,
+            ],
+        };
+        let strand_count = scene.strand_positions.len() as u32 / scene.vertex_count.max(1);
+        let hair_uniforms = HairUniforms {
+            view_projection,
+            camera_position,
+            root_color: [
+                scene.root_color[0],
+                scene.root_color[1],
+                scene.root_color[2],
+                1.0,
+            ],
+            tip_color: [
+                scene.tip_color[0],
+                scene.tip_color[1],
+                scene.tip_color[2],
+                1.0,
+            ],
+            width_counts: [
+                scene.strand_width_m,
+                strand_count as f32,
+                scene.vertex_count as f32,
+                0.0,
+            ],
+        };
+        let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let body_uniform_buffer = buffer(
+            "preview_body_uniforms",
+            bytemuck::bytes_of(&body_uniforms),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let hair_uniform_buffer = buffer(
+            "preview_hair_uniforms",
+            bytemuck::bytes_of(&hair_uniforms),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let placeholder = [[0.0f32; 4]];
+        let strands = if scene.strand_positions.is_empty() {
+            &placeholder[..]
+        } else {
+            scene.strand_positions
+        };
+        let strand_buffer = buffer(
+            "preview_strands",
+            bytemuck::cast_slice(strands),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let body_vertices = buffer(
+            "preview_body_vertices",
+            bytemuck::cast_slice(scene.body_positions),
+            wgpu::BufferUsages::VERTEX,
+        );
+        let body_indices = buffer(
+            "preview_body_indices",
+            bytemuck::cast_slice(scene.body_triangles),
+            wgpu::BufferUsages::INDEX,
+        );
+        let body_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("preview_body"),
+            layout: &self.body_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: body_uniform_buffer.as_entire_binding(),
+            }],
+        });
+        let hair_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("preview_hair"),
+            layout: &self.hair_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: hair_uniform_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: strand_buffer.as_entire_binding(),
+                },
+            ],
+        });
+        // Rows of a texture-to-buffer copy are padded to 256 bytes.
+        let padded_row = (width * 4).div_ceil(256) * 256;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("preview_readback"),
+            size: (padded_row * height) as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("preview"),
+        });
+        {
+            let (view, resolve_target) = match &msaa_view {
+                Some(msaa_view) => (msaa_view, Some(&resolved_view)),
+                None => (&resolved_view, None),
+            };
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("preview"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: 0.02,
+                            g: 0.022,
+                            b: 0.026,
+                            a: 1.0,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            if !scene.body_triangles.is_empty() {
+                pass.set_pipeline(&self.body_pipeline);
+                pass.set_bind_group(0, &body_group, &[]);
+                pass.set_vertex_buffer(0, body_vertices.slice(..));
+                pass.set_index_buffer(body_indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..scene.body_triangles.len() as u32 * 3, 0, 0..1);
+            }
+            if strand_count > 0 && scene.vertex_count >= 2 {
+                pass.set_pipeline(&self.hair_pipeline);
+                pass.set_bind_group(0, &hair_group, &[]);
+                pass.draw(0..strand_count * (scene.vertex_count - 1) * 6, 0..1);
+            }
+        }
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &resolved,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(height),
+                },
+            },
+            size,
+        );
+        context.queue.submit([encoder.finish()]);
+        let slice = readback.slice(..);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |result| {
+            let _ = sender.send(result);
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| e.to_string())?;
+        receiver
+            .recv()
+            .map_err(|e| e.to_string())?
+            .map_err(|e| e.to_string())?;
+        let mapped = slice.get_mapped_range().map_err(|e| format!("{e:?}"))?;
+        let mut pixels = Vec::with_capacity((width * height * 4) as usize);
+        for row in 0..height {
+            let start = (row * padded_row) as usize;
+            pixels.extend_from_slice(&mapped[start..start + (width * 4) as usize]);
+        }
+        Ok(pixels)
+    }
+}
