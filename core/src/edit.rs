@@ -12,7 +12,7 @@
 
 use std::collections::{BTreeSet, HashMap};
 
-use glam::{DMat3, DQuat, DVec2, DVec3};
+use glam::{DQuat, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 use crate::curve::{cubic_point, curve_segments};
@@ -562,12 +562,11 @@ pub fn transform_vertices(
     // A moved root vertex changes the affine reference of every layer.
     let all_layers = layers.contains(&0);
     let layers: Vec<usize> = layers.into_iter().collect();
-    let affected = affected_bundles_of_columns(mesh, &topology, &selected);
+    let affected = affected_bundles_of_columns(&topology, &selected);
     finish(out, affected, if all_layers { None } else { Some(&layers) })
 }
 
 fn affected_bundles_of_columns(
-    _mesh: &HairMesh,
     topology: &Topology,
     vertices: &BTreeSet<VertexRef>,
 ) -> BTreeSet<u32> {
@@ -651,11 +650,6 @@ pub fn set_corner_uvs(
         mesh: out,
         affected_bundles: affected.into_iter().collect(),
     })
-}
-
-/// The rotation matrix helper used by tests and tools: rotation about `axis` by `angle_rad`.
-pub fn rotation(axis: DVec3, angle_rad: f64) -> DMat3 {
-    DMat3::from_axis_angle(axis.normalize(), angle_rad)
 }
 
 #[cfg(test)]

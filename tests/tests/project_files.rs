@@ -213,3 +213,28 @@ fn a_writer_killed_mid_save_leaves_the_previous_file_intact() {
     // A later save still succeeds next to the leftover temporary file.
     project::save(&path, &original).expect("save again");
 }
+
+#[test]
+fn head_samples_keep_hair_outside_the_cranium() {
+    use hairloom_core::samples::{HEAD_CRANIUM_RADII, HEAD_SCALE, tips_inside_ellipsoid};
+    for path in sample_paths()
+        .iter()
+        .filter(|p| p.to_string_lossy().contains("head_"))
+    {
+        let project = project::load(path).expect("sample");
+        let mesh = &project.document.hair_mesh;
+        let inside = tips_inside_ellipsoid(mesh, HEAD_CRANIUM_RADII * HEAD_SCALE);
+        assert_eq!(
+            inside,
+            0,
+            "{}: {inside} tips inside the head",
+            path.display()
+        );
+        // And the growth is real: every tip is off the scalp.
+        assert!(
+            mesh.columns
+                .iter()
+                .all(|c| c.positions.len() < 2 || c.w.last().is_some_and(|w| *w > 0.005))
+        );
+    }
+}
