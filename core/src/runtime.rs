@@ -227,6 +227,35 @@ impl RuntimeTextures {
         }
     }
 
+    /// Roots of `per_bundle` strands in every bundle (the first samples of the progressive
+    /// sets, mapped onto each bundle's block): the bundle-level work of generation.
+    pub fn strand_roots(&self, per_bundle: usize, seed: u64) -> Vec<crate::gpu_types::StrandRoot> {
+        use crate::roots::{SampleDomain, progressive_samples, triangle_to_block};
+        let quad = progressive_samples(per_bundle, SampleDomain::Square, seed);
+        let triangle = progressive_samples(per_bundle, SampleDomain::Triangle, seed);
+        let mut roots = Vec::with_capacity(self.atlas.blocks.len() * per_bundle);
+        for block in &self.atlas.blocks {
+            let is_triangle = block.corner_of_block[2] == block.corner_of_block[3];
+            for sample in if is_triangle { &triangle } else { &quad } {
+                let (s, t) = if is_triangle {
+                    let q = triangle_to_block(*sample);
+                    (q.x, q.y)
+                } else {
+                    Atlas::block_coords(block, sample.x, sample.y)
+                };
+                roots.push(crate::gpu_types::StrandRoot {
+                    texel: [
+                        block.origin[0] as f32 + 0.5 + s as f32,
+                        block.origin[1] as f32 + 0.5 + t as f32,
+                    ],
+                    layers: block.layers,
+                    _padding: 0,
+                });
+            }
+        }
+        roots
+    }
+
     /// Bytes the five textures take on the GPU: RGBA hair mesh, u and v (4 channels), RG uv,
     /// R w, at 4 bytes (f32) or 2 bytes (f16) per channel.
     pub fn gpu_bytes(&self) -> usize {

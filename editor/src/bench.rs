@@ -29,6 +29,15 @@ pub enum Which {
         #[arg(long, default_value_t = 8)]
         strands: u32,
     },
+    /// GPU strand generation (timestamp queries) at 10K / 100K / 300K strands, exact vs
+    /// hardware filtering, f32 vs f16 textures, with memory against explicit storage.
+    Gpu {
+        #[arg(long)]
+        project: Option<std::path::PathBuf>,
+        /// Vertices per strand: 2^N + 1.
+        #[arg(long, default_value_t = 5)]
+        vertices_log2: u32,
+    },
     /// Styled strand vertices per second on all cores at 10K and 100K strands.
     Cpu {
         #[arg(long)]
@@ -45,6 +54,10 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             strands,
         } => crate::accuracy::run(project, &out, strands.max(1)),
         Which::Cpu { project } => crate::accuracy::cpu(project),
+        Which::Gpu {
+            project,
+            vertices_log2,
+        } => gpu(project, vertices_log2.min(8)),
     }
 }
 
@@ -139,4 +152,112 @@ pub fn machine() -> String {
         .map(|n| n.get())
         .unwrap_or(1);
     format!("{model}, {cores} cores")
+}
+
+fn gpu(project: Option<std::path::PathBuf>, vertices_log2: u32) -> anyhow::Result<()> {
+    use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures};
+    use hairloom_render::device::{GpuContext, describe};
+    use hairloom_render::strand_gen::StrandGenRenderer;
+    let path = project.unwrap_or_else(|| {
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../assets/samples/head_long_wavy.hairloom")
+    });
+    let project = hairloom_core::project::load(&path)?;
+    let mesh = &project.document.hair_mesh;
+    let context = GpuContext::new_headless()?;
+    let renderer = StrandGenRenderer::new(&context);
+    let vertex_count = (1u32 << vertices_log2) + 1;
+    println!(
+        "GPU strand generation (positions from the hair-mesh texture; no styling yet): {}",
+        path.display()
+    );
+    println!("adapter: {}", describe(&context.adapter_info));
+    println!("machine: {}", machine());
+    println!(
+        "{:>8} {:>8} {:>9} {:>10} {:>9} {:>11} {:>10} {:>12} {:>12} {:>8}",
+        "strands",
+        "textures",
+        "filtering",
+        "GPU ms",
+        "wall ms",
+        "M verts/s",
+        "scratch MB",
+        "textures MB",
+        "explicit MB",
+        "ratio"
+    );
+    for precision in [Precision::F32, Precision::F16] {
+        let textures = RuntimeTextures::build(mesh, precision);
+        let texture = renderer.upload_hair_mesh(&context, &textures);
+        let bundles = textures.atlas.blocks.len().max(1);
+        for target in [10_000usize, 100_000, 300_000] {
+            let roots = textures.strand_roots(target.div_ceil(bundles), 1);
+            let vertices = roots.len() as f64 * vertex_count as f64;
+            // Explicit storage: every strand vertex as three f32.
+            let explicit_mb = vertices * 12.0 / 1e6;
+            let textures_mb = textures.gpu_bytes() as f64 / 1e6;
+            for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
+                // One warm-up run (pipeline compilation, first-touch allocations), then the median of 3.
+                let _ = renderer.time_generation(
+                    &context,
+                    &textures,
+                    &texture,
+                    &roots,
+                    vertex_count,
+                    filtering,
+                );
+                let mut runs = Vec::new();
+                for _ in 0..3 {
+                    match renderer.time_generation(
+                        &context,
+                        &textures,
+                        &texture,
+                        &roots,
+                        vertex_count,
+                        filtering,
+                    ) {
+                        Ok(timing) => runs.push(timing),
+                        Err(error) => {
+                            println!(
+                                "{:>8} {:>8?} {:>9?}   skipped: {error}",
+                                roots.len(),
+                                precision,
+                                filtering
+                            );
+                            break;
+                        }
+                    }
+                }
+                if runs.is_empty() {
+                    continue;
+                }
+                runs.sort_by(|a, b| a.wall_ms.total_cmp(&b.wall_ms));
+                let timing = runs[runs.len() / 2];
+                let gpu_ms = timing.gpu_ms.unwrap_or(f64::NAN);
+                let rate_ms = if gpu_ms.is_finite() && gpu_ms > 0.0 {
+                    gpu_ms
+                } else {
+                    timing.wall_ms
+                };
+                println!(
+                    "{:>8} {:>8} {:>9} {:>10.2} {:>9.2} {:>11.1} {:>10.1} {:>12.3} {:>12.1} {:>7.0}×",
+                    roots.len(),
+                    format!("{precision:?}"),
+                    if filtering == Filtering::Exact {
+                        "exact"
+                    } else {
+                        "hardware"
+                    },
+                    gpu_ms,
+                    timing.wall_ms,
+                    vertices / rate_ms / 1e3,
+                    timing.scratch_bytes as f64 / 1e6,
+                    textures_mb,
+                    explicit_mb,
+                    explicit_mb / textures_mb
+                );
+            }
+        }
+    }
+    Ok(())
 }

@@ -36,6 +36,24 @@ pub struct StrandGenRenderer {
 /// Workgroup size of `main` in `strand_gen.wgsl`.
 const WORKGROUP_SIZE: u32 = 64;
 
+/// Strands generated per dispatch. The transient output buffer holds one batch, so scratch
+/// memory is `BATCH_STRANDS × vertices × 16` bytes whatever the strand count (34 MB at 65
+/// vertices, under the 64 MB bound). A multiple of 16 keeps root-buffer offsets 256-aligned.
+pub const BATCH_STRANDS: usize = 32_768;
+
+/// Measured cost of generating a set of strands.
+#[derive(Clone, Copy, Debug)]
+pub struct GenerationTiming {
+    /// Sum of the compute passes' GPU time (timestamp queries); `None` without
+    /// `TIMESTAMP_QUERY`.
+    pub gpu_ms: Option<f64>,
+    /// Wall time from the first submit to the GPU going idle.
+    pub wall_ms: f64,
+    /// Bytes of the transient output buffer.
+    pub scratch_bytes: u64,
+    pub batches: usize,
+}
+
 impl StrandGenRenderer {
     pub fn new(context: &GpuContext) -> Self {
         let device = &context.device;
@@ -178,6 +196,193 @@ impl StrandGenRenderer {
             size,
         );
         gpu_texture
+    }
+
+    /// Generates every strand in batches of [`BATCH_STRANDS`] into one reused output buffer
+    /// and measures the GPU time (nothing is read back: this is the cost of generation).
+    pub fn time_generation(
+        &self,
+        context: &GpuContext,
+        textures: &RuntimeTextures,
+        hair_mesh: &wgpu::Texture,
+        roots: &[StrandRoot],
+        vertex_count: u32,
+        filtering: Filtering,
+    ) -> Result<GenerationTiming, StrandGenError> {
+        let hardware = filtering == Filtering::Hardware8Bit;
+        if hardware && textures.precision == Precision::F32 && !self.float32_filterable {
+            return Err(StrandGenError::NoFloat32Filtering {
+                adapter: context.adapter_info.name.clone(),
+            });
+        }
+        let device = &context.device;
+        let batches: Vec<&[StrandRoot]> = roots.chunks(BATCH_STRANDS).collect();
+        let placeholder = [StrandRoot::default()];
+        let all_roots = if roots.is_empty() {
+            &placeholder[..]
+        } else {
+            roots
+        };
+        let roots_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("strand_gen_roots"),
+            contents: bytemuck::cast_slice(all_roots),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let batch_vertices = (BATCH_STRANDS.min(roots.len().max(1)) as u64) * vertex_count as u64;
+        let scratch_bytes = batch_vertices * 16;
+        let output = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("strand_gen_positions"),
+            size: scratch_bytes.max(16),
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let query_count = (2 * batches.len()).max(2) as u32;
+        let query_set = timestamps.then(|| {
+            device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("strand_gen_timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: query_count,
+            })
+        });
+        let view = hair_mesh.create_view(&wgpu::TextureViewDescriptor::default());
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("strand_gen_timing"),
+        });
+        let mut keep_alive = Vec::new();
+        for (index, batch) in batches.iter().enumerate() {
+            let params = StrandGenParams {
+                position_offset: textures.position_offset.extend(0.0).to_array(),
+                texture_size: [
+                    textures.hair_mesh.width,
+                    textures.hair_mesh.height,
+                    textures.hair_mesh.depth,
+                    0,
+                ],
+                strand_count: batch.len() as u32,
+                vertex_count,
+                filtering: if hardware {
+                    FILTERING_HARDWARE
+                } else {
+                    FILTERING_EXACT
+                },
+                _padding: 0,
+            };
+            let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("strand_gen_params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let offset = (index * BATCH_STRANDS * size_of::<StrandRoot>()) as u64;
+            let size = wgpu::BufferSize::new((batch.len() * size_of::<StrandRoot>()) as u64);
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("strand_gen"),
+                layout: &self.bind_group_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &roots_buffer,
+                            offset,
+                            size,
+                        }),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::Sampler(&self.sampler),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: output.as_entire_binding(),
+                    },
+                ],
+            });
+            {
+                let timestamp_writes =
+                    query_set
+                        .as_ref()
+                        .map(|query_set| wgpu::ComputePassTimestampWrites {
+                            query_set,
+                            beginning_of_pass_write_index: Some(2 * index as u32),
+                            end_of_pass_write_index: Some(2 * index as u32 + 1),
+                        });
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("strand_gen"),
+                    timestamp_writes,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind_group, &[]);
+                pass.dispatch_workgroups(
+                    ((batch.len() as u64 * vertex_count as u64) as u32).div_ceil(WORKGROUP_SIZE),
+                    1,
+                    1,
+                );
+            }
+            keep_alive.push(params_buffer);
+        }
+        let resolve = query_set.as_ref().map(|query_set| {
+            let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("strand_gen_timestamps_resolve"),
+                size: query_count as u64 * 8,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let readback = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("strand_gen_timestamps_readback"),
+                size: query_count as u64 * 8,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            encoder.resolve_query_set(query_set, 0..query_count, &resolve, 0);
+            encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, query_count as u64 * 8);
+            readback
+        });
+        let start = std::time::Instant::now();
+        context.queue.submit([encoder.finish()]);
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| StrandGenError::Readback(e.to_string()))?;
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = match resolve {
+            Some(readback) => {
+                let slice = readback.slice(..);
+                let (sender, receiver) = std::sync::mpsc::channel();
+                slice.map_async(wgpu::MapMode::Read, move |result| {
+                    let _ = sender.send(result);
+                });
+                device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|e| StrandGenError::Readback(e.to_string()))?;
+                receiver
+                    .recv()
+                    .map_err(|e| StrandGenError::Readback(e.to_string()))?
+                    .map_err(|e| StrandGenError::Readback(e.to_string()))?;
+                let mapped = slice
+                    .get_mapped_range()
+                    .map_err(|e| StrandGenError::Readback(format!("{e:?}")))?;
+                let ticks: &[u64] = bytemuck::cast_slice(&mapped);
+                let period_ns = context.queue.get_timestamp_period() as f64;
+                let total: u64 = (0..batches.len())
+                    .map(|i| ticks[2 * i + 1].saturating_sub(ticks[2 * i]))
+                    .sum();
+                Some(total as f64 * period_ns * 1e-6)
+            }
+            None => None,
+        };
+        Ok(GenerationTiming {
+            gpu_ms,
+            wall_ms,
+            scratch_bytes,
+            batches: batches.len(),
+        })
     }
 
     /// Generates `roots.len() × vertex_count` positions and reads them back (strand-major).

@@ -107,3 +107,57 @@ fn gpu_positions_match_the_cpu_mirror() {
         }
     }
 }
+
+#[test]
+fn generation_runs_in_batches_with_bounded_scratch() {
+    use hairloom_render::strand_gen::BATCH_STRANDS;
+    let Some(context) = context() else { return };
+    let renderer = StrandGenRenderer::new(&context);
+    let samples_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/samples");
+    let project =
+        hairloom_core::project::load(&samples_dir.join("teapot_fur.hairloom")).expect("sample");
+    let textures = RuntimeTextures::build(&project.document.hair_mesh, Precision::F16);
+    let texture = renderer.upload_hair_mesh(&context, &textures);
+    let small = textures.strand_roots(4, 1);
+    let large = textures.strand_roots(160, 1); // 288 bundles × 160 = 46,080 strands: 2 batches
+    assert!(large.len() > BATCH_STRANDS);
+    let vertex_count = 5;
+    let a = renderer
+        .time_generation(
+            &context,
+            &textures,
+            &texture,
+            &small,
+            vertex_count,
+            Filtering::Exact,
+        )
+        .expect("timing");
+    let b = renderer
+        .time_generation(
+            &context,
+            &textures,
+            &texture,
+            &large,
+            vertex_count,
+            Filtering::Exact,
+        )
+        .expect("timing");
+    assert_eq!((a.batches, b.batches), (1, 2));
+    // Scratch is one batch, whatever the strand count.
+    assert_eq!(
+        b.scratch_bytes,
+        (BATCH_STRANDS as u64) * vertex_count as u64 * 16
+    );
+    assert!(b.scratch_bytes <= 64 << 20);
+    if context
+        .device
+        .features()
+        .contains(wgpu::Features::TIMESTAMP_QUERY)
+    {
+        let (ta, tb) = (a.gpu_ms.expect("timestamps"), b.gpu_ms.expect("timestamps"));
+        assert!(
+            ta.is_finite() && tb.is_finite() && ta >= 0.0 && tb > 0.0,
+            "{ta} {tb}"
+        );
+    }
+}
