@@ -274,7 +274,7 @@ impl StrandGenRenderer {
                 usage: wgpu::BufferUsages::UNIFORM,
             });
             let offset = (index * BATCH_STRANDS * size_of::<StrandRoot>()) as u64;
-            let size = wgpu::BufferSize::new((batch.len() * size_of::<StrandRoot>()) as u64);
+            let size = wgpu::BufferSize::new(size_of_val(*batch) as u64);
             let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("strand_gen"),
                 layout: &self.bind_group_layout,
