@@ -573,6 +573,227 @@ pub fn glb_container(json: &serde_json::Value, mut bin: Vec<u8>) -> Vec<u8> {
     out
 }
 
+/// Why a runtime bundle could not be loaded; names the file and what is wrong.
+#[derive(Debug, thiserror::Error)]
+#[error("{file}: {message}")]
+pub struct BundleError {
+    pub file: String,
+    pub message: String,
+}
+
+/// A runtime bundle read back from disk: the manifest and the textures, ready for the
+/// texture-path mirror or a GPU upload.
+pub struct LoadedBundle {
+    pub manifest: Manifest,
+    pub textures: RuntimeTextures,
+}
+
+/// Half-precision bits to f32.
+pub fn f16_to_f32(bits: u16) -> f32 {
+    let sign = if bits & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exponent = ((bits >> 10) & 0x1F) as i32;
+    let mantissa = (bits & 0x3FF) as f32;
+    match exponent {
+        0 => sign * mantissa * 2f32.powi(-24),
+        31 if mantissa == 0.0 => sign * f32::INFINITY,
+        31 => f32::NAN,
+        e => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
+/// Loads and checks a runtime bundle folder written by [`runtime_bundle`]: the manifest's
+/// version and formats, every KTX2 header against the manifest, sizes, block placements and
+/// layer counts, and finite texel values.
+pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<LoadedBundle, BundleError> {
+    let error = |file: &str, message: String| BundleError {
+        file: dir.join(file).display().to_string(),
+        message,
+    };
+    let manifest_bytes = std::fs::read(dir.join("manifest.json"))
+        .map_err(|e| error("manifest.json", format!("cannot read: {e}")))?;
+    let version: serde_json::Value = serde_json::from_slice(&manifest_bytes)
+        .map_err(|e| error("manifest.json", format!("not JSON: {e}")))?;
+    let found = version
+        .get("format_version")
+        .and_then(|v| v.as_u64())
+        .unwrap_or(0);
+    if version.get("format").and_then(|v| v.as_str()) != Some("hairloom-runtime") {
+        return Err(error(
+            "manifest.json",
+            "not a Hairloom runtime manifest (\"format\" is not \"hairloom-runtime\")".into(),
+        ));
+    }
+    if found != RUNTIME_FORMAT_VERSION as u64 {
+        return Err(error(
+            "manifest.json",
+            format!(
+                "format_version {found} is not supported (this build reads {RUNTIME_FORMAT_VERSION})"
+            ),
+        ));
+    }
+    let manifest: Manifest = serde_json::from_slice(&manifest_bytes)
+        .map_err(|e| error("manifest.json", e.to_string()))?;
+    let load = |entry: &TextureEntry, channels: usize| -> Result<Texture3d, BundleError> {
+        let format = TexelFormat::for_precision(manifest.precision, channels);
+        if entry.vk_format != format.vk_name() {
+            return Err(error(
+                &entry.file,
+                format!(
+                    "manifest says {}, expected {} for {:?}",
+                    entry.vk_format,
+                    format.vk_name(),
+                    manifest.precision
+                ),
+            ));
+        }
+        let bytes = std::fs::read(dir.join(&entry.file))
+            .map_err(|e| error(&entry.file, format!("cannot read: {e}")))?;
+        let reader = ktx2::Reader::new(&bytes[..])
+            .map_err(|e| error(&entry.file, format!("not a valid KTX2 file: {e:?}")))?;
+        let header = reader.header();
+        if header.format != Some(format.ktx2()) {
+            return Err(error(
+                &entry.file,
+                format!(
+                    "KTX2 format {:?} does not match the manifest ({})",
+                    header.format, entry.vk_format
+                ),
+            ));
+        }
+        let size = [header.pixel_width, header.pixel_height, header.pixel_depth];
+        if size != entry.size {
+            return Err(error(
+                &entry.file,
+                format!(
+                    "KTX2 size {size:?} does not match the manifest {:?}",
+                    entry.size
+                ),
+            ));
+        }
+        let Some(level) = reader.levels().next() else {
+            return Err(error(&entry.file, "no mip level".into()));
+        };
+        let depth = size[2].max(1);
+        let texel_count = (size[0] as usize) * (size[1] as usize) * depth as usize;
+        let texel_bytes = channels * format.bytes_per_channel();
+        if level.data.len() != texel_count * texel_bytes {
+            return Err(error(
+                &entry.file,
+                format!(
+                    "{} bytes of texels, expected {}",
+                    level.data.len(),
+                    texel_count * texel_bytes
+                ),
+            ));
+        }
+        let mut texels = Vec::with_capacity(texel_count);
+        for chunk in level.data.chunks_exact(texel_bytes) {
+            let mut texel = Vec4::ZERO;
+            for c in 0..channels {
+                let value = if format.bytes_per_channel() == 4 {
+                    f32::from_le_bytes([
+                        chunk[4 * c],
+                        chunk[4 * c + 1],
+                        chunk[4 * c + 2],
+                        chunk[4 * c + 3],
+                    ])
+                } else {
+                    f16_to_f32(u16::from_le_bytes([chunk[2 * c], chunk[2 * c + 1]]))
+                };
+                if !value.is_finite() {
+                    return Err(error(
+                        &entry.file,
+                        format!("texel {} channel {c} is not finite", texels.len()),
+                    ));
+                }
+                texel[c] = value;
+            }
+            texels.push(texel);
+        }
+        Ok(Texture3d {
+            width: size[0],
+            height: size[1],
+            depth,
+            texels,
+        })
+    };
+    let hair_mesh = load(&manifest.hair_mesh, 4)?;
+    let uv = load(&manifest.uv, 2)?;
+    let w = load(&manifest.w, 1)?;
+    let u = load(&manifest.u, 4)?;
+    let v = load(&manifest.v, 4)?;
+    let (width, height) = (uv.width, uv.height);
+    for texture in [&hair_mesh, &w, &u, &v] {
+        if (texture.width, texture.height) != (width, height) {
+            return Err(error(
+                "manifest.json",
+                format!("3D textures must be {width}x{height} like the uv-texture"),
+            ));
+        }
+    }
+    if hair_mesh.depth != 1 + SLICES_PER_SEGMENT * manifest.max_layers
+        || w.depth != 1 + manifest.max_layers
+    {
+        return Err(error(
+            "manifest.json",
+            format!(
+                "texture depths do not match max_layers {}",
+                manifest.max_layers
+            ),
+        ));
+    }
+    let mut blocks = Vec::with_capacity(manifest.bundles.len());
+    for (i, entry) in manifest.bundles.iter().enumerate() {
+        if entry.origin[0] + 1 >= width || entry.origin[1] + 1 >= height {
+            return Err(error(
+                "manifest.json",
+                format!(
+                    "bundles[{i}].origin {:?} does not fit a 2x2 block in {width}x{height}",
+                    entry.origin
+                ),
+            ));
+        }
+        if entry.layers == 0 || entry.layers > manifest.max_layers {
+            return Err(error(
+                "manifest.json",
+                format!(
+                    "bundles[{i}].layers {} is outside 1..={}",
+                    entry.layers, manifest.max_layers
+                ),
+            ));
+        }
+        if entry.corner_of_block.iter().any(|&c| c > 3) {
+            return Err(error(
+                "manifest.json",
+                format!("bundles[{i}].corner_of_block has a corner above 3"),
+            ));
+        }
+        blocks.push(crate::atlas::BundleBlock {
+            bundle: entry.bundle,
+            origin: entry.origin,
+            corner_of_block: entry.corner_of_block,
+            layers: entry.layers,
+        });
+    }
+    let atlas = crate::atlas::Atlas {
+        width,
+        height,
+        blocks,
+        texels: vec![None; (width * height) as usize],
+    };
+    let textures = RuntimeTextures {
+        atlas,
+        precision: manifest.precision,
+        position_offset: glam::Vec3::from_array(manifest.position_offset),
+        hair_mesh,
+        uv,
+        w,
+        u,
+        v,
+    };
+    Ok(LoadedBundle { manifest, textures })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -643,6 +864,74 @@ mod tests {
             runtime_bundle(&empty, &RuntimeExportOptions::default()),
             Err(ExportError::NothingToExport)
         ));
+    }
+
+    #[test]
+    fn runtime_bundles_load_back_and_corruption_is_named() {
+        use crate::runtime::{Filtering, TexturePath};
+        let mut mesh = grid(3, 2, 2, 0.5);
+        crate::interior::place_interior(&mut mesh, None);
+        let document = Document::new("grid", mesh);
+        let dir = std::env::temp_dir().join(format!("hairloom-bundle-test-{}", std::process::id()));
+        for precision in [Precision::F32, Precision::F16] {
+            let options = RuntimeExportOptions {
+                precision,
+                ..RuntimeExportOptions::default()
+            };
+            std::fs::create_dir_all(&dir).expect("dir");
+            for (name, bytes) in runtime_bundle(&document, &options).expect("export") {
+                std::fs::write(dir.join(name), bytes).expect("write");
+            }
+            let loaded = load_runtime_bundle(&dir).expect("loads");
+            let built = RuntimeTextures::build(&document.hair_mesh, precision);
+            assert_eq!(loaded.textures.hair_mesh, built.hair_mesh);
+            assert_eq!(
+                (loaded.textures.u.clone(), loaded.textures.w.clone()),
+                (built.u.clone(), built.w.clone())
+            );
+            // The texture path gives the same strands from the loaded bundle.
+            let (a, b) = (
+                TexturePath {
+                    textures: &loaded.textures,
+                    filtering: Filtering::Exact,
+                },
+                TexturePath {
+                    textures: &built,
+                    filtering: Filtering::Exact,
+                },
+            );
+            for block in 0..built.atlas.blocks.len() {
+                assert_eq!(
+                    a.position(block, 0.3, 0.6, 1.4),
+                    b.position(block, 0.3, 0.6, 1.4)
+                );
+            }
+        }
+        // Corruptions, each named.
+        let manifest_path = dir.join("manifest.json");
+        let original = std::fs::read(&manifest_path).expect("manifest");
+        let mut value: serde_json::Value = serde_json::from_slice(&original).expect("json");
+        value["format_version"] = 99.into();
+        std::fs::write(&manifest_path, serde_json::to_vec(&value).expect("json")).expect("write");
+        let error = load_runtime_bundle(&dir).err().expect("newer version");
+        assert!(error.to_string().contains("format_version 99"), "{error}");
+        std::fs::write(&manifest_path, &original).expect("restore");
+        let texture = std::fs::read(dir.join("w.ktx2")).expect("w");
+        std::fs::write(dir.join("w.ktx2"), &texture[..texture.len() / 2]).expect("truncate");
+        let error = load_runtime_bundle(&dir).err().expect("truncated");
+        assert!(error.to_string().contains("w.ktx2"), "{error}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn half_to_float_inverts_rounding() {
+        for value in [0.0f32, 1.0, -2.5, 0.1, 65504.0, 2f32.powi(-24), -3.0e-5] {
+            assert_eq!(
+                f16_to_f32(f16_bits(value)),
+                crate::runtime::round_to_f16(value),
+                "{value}"
+            );
+        }
     }
 
     #[test]
