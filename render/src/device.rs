@@ -143,6 +143,29 @@ impl GpuContext {
     }
 }
 
+/// Maps a `MAP_READ` buffer after the queue's work, and returns its bytes.
+pub fn read_buffer(context: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, String> {
+    let slice = buffer.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    context
+        .device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| e.to_string())?;
+    receiver
+        .recv()
+        .map_err(|e| e.to_string())?
+        .map_err(|e| e.to_string())?;
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| format!("{e:?}"))?
+        .to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

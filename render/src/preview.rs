@@ -9,7 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
-use crate::device::GpuContext;
+use crate::device::{GpuContext, read_buffer};
 
 pub const HAIR_SHADER: &str = include_str!("../../shaders/preview_hair.wgsl");
 pub const BODY_SHADER: &str = include_str!("../../shaders/preview_body.wgsl");
@@ -429,19 +429,7 @@ impl PreviewRenderer {
             size,
         );
         context.queue.submit([encoder.finish()]);
-        let slice = readback.slice(..);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |result| {
-            let _ = sender.send(result);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| e.to_string())?;
-        receiver
-            .recv()
-            .map_err(|e| e.to_string())?
-            .map_err(|e| e.to_string())?;
-        let mapped = slice.get_mapped_range().map_err(|e| format!("{e:?}"))?;
+        let mapped = read_buffer(context, &readback)?;
         let mut pixels = Vec::with_capacity((width * height * 4) as usize);
         for row in 0..height {
             let start = (row * padded_row) as usize;

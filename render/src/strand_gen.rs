@@ -9,7 +9,7 @@ use hairloom_core::gpu_types::{FILTERING_EXACT, FILTERING_HARDWARE, StrandGenPar
 use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures};
 use wgpu::util::DeviceExt;
 
-use crate::device::GpuContext;
+use crate::device::{GpuContext, read_buffer};
 
 /// The WGSL source, validated by naga in `cargo test`.
 pub const SHADER_SOURCE: &str = include_str!("../../shaders/strand_gen.wgsl");
@@ -198,6 +198,119 @@ impl StrandGenRenderer {
         gpu_texture
     }
 
+    /// Uniform parameters for `strand_count` strands.
+    fn params(
+        textures: &RuntimeTextures,
+        strand_count: usize,
+        vertex_count: u32,
+        hardware: bool,
+    ) -> StrandGenParams {
+        StrandGenParams {
+            position_offset: textures.position_offset.extend(0.0).to_array(),
+            texture_size: [
+                textures.hair_mesh.width,
+                textures.hair_mesh.height,
+                textures.hair_mesh.depth,
+                0,
+            ],
+            strand_count: strand_count as u32,
+            vertex_count,
+            filtering: if hardware {
+                FILTERING_HARDWARE
+            } else {
+                FILTERING_EXACT
+            },
+            _padding: 0,
+        }
+    }
+
+    fn check_filtering(
+        &self,
+        context: &GpuContext,
+        textures: &RuntimeTextures,
+        filtering: Filtering,
+    ) -> Result<bool, StrandGenError> {
+        let hardware = filtering == Filtering::Hardware8Bit;
+        if hardware && textures.precision == Precision::F32 && !self.float32_filterable {
+            return Err(StrandGenError::NoFloat32Filtering {
+                adapter: context.adapter_info.name.clone(),
+            });
+        }
+        Ok(hardware)
+    }
+
+    /// Records one dispatch over `batch` (a range of the roots buffer) into `encoder`.
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "one dispatch's resources, passed through unchanged"
+    )]
+    fn dispatch(
+        &self,
+        context: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        params: &StrandGenParams,
+        roots: wgpu::BufferBinding,
+        hair_mesh: &wgpu::TextureView,
+        output: &wgpu::Buffer,
+        timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
+    ) {
+        let device = &context.device;
+        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("strand_gen_params"),
+            contents: bytemuck::bytes_of(params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("strand_gen"),
+            layout: &self.bind_group_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Buffer(roots),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(hair_mesh),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: output.as_entire_binding(),
+                },
+            ],
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("strand_gen"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        let vertices = params.strand_count as u64 * params.vertex_count as u64;
+        pass.dispatch_workgroups((vertices as u32).div_ceil(WORKGROUP_SIZE), 1, 1);
+    }
+
+    fn roots_buffer(context: &GpuContext, roots: &[StrandRoot]) -> wgpu::Buffer {
+        let placeholder = [StrandRoot::default()];
+        context
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("strand_gen_roots"),
+                contents: bytemuck::cast_slice(if roots.is_empty() {
+                    &placeholder
+                } else {
+                    roots
+                }),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+    }
+
     /// Generates every strand in batches of [`BATCH_STRANDS`] into one reused output buffer
     /// and measures the GPU time (nothing is read back: this is the cost of generation).
     pub fn time_generation(
@@ -209,27 +322,12 @@ impl StrandGenRenderer {
         vertex_count: u32,
         filtering: Filtering,
     ) -> Result<GenerationTiming, StrandGenError> {
-        let hardware = filtering == Filtering::Hardware8Bit;
-        if hardware && textures.precision == Precision::F32 && !self.float32_filterable {
-            return Err(StrandGenError::NoFloat32Filtering {
-                adapter: context.adapter_info.name.clone(),
-            });
-        }
+        let hardware = self.check_filtering(context, textures, filtering)?;
         let device = &context.device;
         let batches: Vec<&[StrandRoot]> = roots.chunks(BATCH_STRANDS).collect();
-        let placeholder = [StrandRoot::default()];
-        let all_roots = if roots.is_empty() {
-            &placeholder[..]
-        } else {
-            roots
-        };
-        let roots_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("strand_gen_roots"),
-            contents: bytemuck::cast_slice(all_roots),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let batch_vertices = (BATCH_STRANDS.min(roots.len().max(1)) as u64) * vertex_count as u64;
-        let scratch_bytes = batch_vertices * 16;
+        let roots_buffer = Self::roots_buffer(context, roots);
+        let scratch_bytes =
+            (BATCH_STRANDS.min(roots.len().max(1)) as u64) * vertex_count as u64 * 16;
         let output = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("strand_gen_positions"),
             size: scratch_bytes.max(16),
@@ -249,100 +347,47 @@ impl StrandGenRenderer {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("strand_gen_timing"),
         });
-        let mut keep_alive = Vec::new();
         for (index, batch) in batches.iter().enumerate() {
-            let params = StrandGenParams {
-                position_offset: textures.position_offset.extend(0.0).to_array(),
-                texture_size: [
-                    textures.hair_mesh.width,
-                    textures.hair_mesh.height,
-                    textures.hair_mesh.depth,
-                    0,
-                ],
-                strand_count: batch.len() as u32,
-                vertex_count,
-                filtering: if hardware {
-                    FILTERING_HARDWARE
-                } else {
-                    FILTERING_EXACT
-                },
-                _padding: 0,
+            let params = Self::params(textures, batch.len(), vertex_count, hardware);
+            let roots = wgpu::BufferBinding {
+                buffer: &roots_buffer,
+                offset: (index * BATCH_STRANDS * size_of::<StrandRoot>()) as u64,
+                size: wgpu::BufferSize::new(size_of_val(*batch) as u64),
             };
-            let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("strand_gen_params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let offset = (index * BATCH_STRANDS * size_of::<StrandRoot>()) as u64;
-            let size = wgpu::BufferSize::new(size_of_val(*batch) as u64);
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("strand_gen"),
-                layout: &self.bind_group_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &roots_buffer,
-                            offset,
-                            size,
-                        }),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::TextureView(&view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::Sampler(&self.sampler),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: output.as_entire_binding(),
-                    },
-                ],
-            });
-            {
-                let timestamp_writes =
-                    query_set
-                        .as_ref()
-                        .map(|query_set| wgpu::ComputePassTimestampWrites {
-                            query_set,
-                            beginning_of_pass_write_index: Some(2 * index as u32),
-                            end_of_pass_write_index: Some(2 * index as u32 + 1),
-                        });
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("strand_gen"),
-                    timestamp_writes,
-                });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &bind_group, &[]);
-                pass.dispatch_workgroups(
-                    ((batch.len() as u64 * vertex_count as u64) as u32).div_ceil(WORKGROUP_SIZE),
-                    1,
-                    1,
-                );
-            }
-            keep_alive.push(params_buffer);
+            let timestamp_writes =
+                query_set
+                    .as_ref()
+                    .map(|query_set| wgpu::ComputePassTimestampWrites {
+                        query_set,
+                        beginning_of_pass_write_index: Some(2 * index as u32),
+                        end_of_pass_write_index: Some(2 * index as u32 + 1),
+                    });
+            self.dispatch(
+                context,
+                &mut encoder,
+                &params,
+                roots,
+                &view,
+                &output,
+                timestamp_writes,
+            );
         }
-        let resolve = query_set.as_ref().map(|query_set| {
+        let readback = query_set.as_ref().map(|query_set| {
+            let size = query_count as u64 * 8;
             let resolve = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("strand_gen_timestamps_resolve"),
-                size: query_count as u64 * 8,
+                size,
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
             let readback = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("strand_gen_timestamps_readback"),
-                size: query_count as u64 * 8,
+                size,
                 usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
                 mapped_at_creation: false,
             });
             encoder.resolve_query_set(query_set, 0..query_count, &resolve, 0);
-            encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, query_count as u64 * 8);
+            encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, size);
             readback
         });
         let start = std::time::Instant::now();
@@ -351,24 +396,10 @@ impl StrandGenRenderer {
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| StrandGenError::Readback(e.to_string()))?;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        let gpu_ms = match resolve {
+        let gpu_ms = match readback {
             Some(readback) => {
-                let slice = readback.slice(..);
-                let (sender, receiver) = std::sync::mpsc::channel();
-                slice.map_async(wgpu::MapMode::Read, move |result| {
-                    let _ = sender.send(result);
-                });
-                device
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|e| StrandGenError::Readback(e.to_string()))?;
-                receiver
-                    .recv()
-                    .map_err(|e| StrandGenError::Readback(e.to_string()))?
-                    .map_err(|e| StrandGenError::Readback(e.to_string()))?;
-                let mapped = slice
-                    .get_mapped_range()
-                    .map_err(|e| StrandGenError::Readback(format!("{e:?}")))?;
-                let ticks: &[u64] = bytemuck::cast_slice(&mapped);
+                let bytes = read_buffer(context, &readback).map_err(StrandGenError::Readback)?;
+                let ticks: &[u64] = bytemuck::cast_slice(&bytes);
                 let period_ns = context.queue.get_timestamp_period() as f64;
                 let total: u64 = (0..batches.len())
                     .map(|i| ticks[2 * i + 1].saturating_sub(ticks[2 * i]))
@@ -395,47 +426,11 @@ impl StrandGenRenderer {
         vertex_count: u32,
         filtering: Filtering,
     ) -> Result<Vec<[f32; 4]>, StrandGenError> {
-        let hardware = filtering == Filtering::Hardware8Bit;
-        if hardware && textures.precision == Precision::F32 && !self.float32_filterable {
-            return Err(StrandGenError::NoFloat32Filtering {
-                adapter: context.adapter_info.name.clone(),
-            });
-        }
+        let hardware = self.check_filtering(context, textures, filtering)?;
         let device = &context.device;
-        let params = StrandGenParams {
-            position_offset: textures.position_offset.extend(0.0).to_array(),
-            texture_size: [
-                textures.hair_mesh.width,
-                textures.hair_mesh.height,
-                textures.hair_mesh.depth,
-                0,
-            ],
-            strand_count: roots.len() as u32,
-            vertex_count,
-            filtering: if hardware {
-                FILTERING_HARDWARE
-            } else {
-                FILTERING_EXACT
-            },
-            _padding: 0,
-        };
-        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("strand_gen_params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let placeholder = [StrandRoot::default()];
-        let roots_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("strand_gen_roots"),
-            contents: bytemuck::cast_slice(if roots.is_empty() {
-                &placeholder
-            } else {
-                roots
-            }),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let vertices = (roots.len() as u64 * vertex_count as u64).max(1);
-        let output_size = vertices * 16;
+        let params = Self::params(textures, roots.len(), vertex_count, hardware);
+        let roots_buffer = Self::roots_buffer(context, roots);
+        let output_size = (roots.len() as u64 * vertex_count as u64).max(1) * 16;
         let output = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("strand_gen_positions"),
             size: output_size,
@@ -449,62 +444,22 @@ impl StrandGenRenderer {
             mapped_at_creation: false,
         });
         let view = hair_mesh.create_view(&wgpu::TextureViewDescriptor::default());
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("strand_gen"),
-            layout: &self.bind_group_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: roots_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: output.as_entire_binding(),
-                },
-            ],
-        });
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("strand_gen"),
         });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("strand_gen"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups((vertices as u32).div_ceil(WORKGROUP_SIZE), 1, 1);
-        }
+        self.dispatch(
+            context,
+            &mut encoder,
+            &params,
+            roots_buffer.as_entire_buffer_binding(),
+            &view,
+            &output,
+            None,
+        );
         encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, output_size);
         context.queue.submit([encoder.finish()]);
-        let slice = readback.slice(..);
-        let (sender, receiver) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |result| {
-            let _ = sender.send(result);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| StrandGenError::Readback(e.to_string()))?;
-        receiver
-            .recv()
-            .map_err(|e| StrandGenError::Readback(e.to_string()))?
-            .map_err(|e| StrandGenError::Readback(e.to_string()))?;
-        let mapped = slice
-            .get_mapped_range()
-            .map_err(|e| StrandGenError::Readback(format!("{e:?}")))?;
-        let mut positions: Vec<[f32; 4]> = bytemuck::cast_slice(&mapped).to_vec();
+        let bytes = read_buffer(context, &readback).map_err(StrandGenError::Readback)?;
+        let mut positions: Vec<[f32; 4]> = bytemuck::cast_slice(&bytes).to_vec();
         positions.truncate(roots.len() * vertex_count as usize);
         Ok(positions)
     }

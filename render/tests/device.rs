@@ -36,16 +36,6 @@ fn headless_device_is_created_and_runs_a_copy() {
         .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
     encoder.copy_buffer_to_buffer(&source, 0, &readback, 0, 256);
     context.queue.submit([encoder.finish()]);
-    let slice = readback.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |result| {
-        let _ = sender.send(result);
-    });
-    context
-        .device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .expect("poll");
-    receiver.recv().expect("map callback").expect("map");
-    let mapped = slice.get_mapped_range().expect("mapped range");
-    assert_eq!(&mapped[..], &data[..]);
+    let bytes = hairloom_render::device::read_buffer(&context, &readback).expect("read back");
+    assert_eq!(bytes, data);
 }
