@@ -70,6 +70,23 @@ impl Atlas {
         (s, t)
     }
 
+    /// Whether the block holds a triangle (its corners 2 and 3 are the same face corner).
+    pub fn is_triangle(block: &BundleBlock) -> bool {
+        block.corner_of_block[2] == block.corner_of_block[3]
+    }
+
+    /// Block coordinates of a root sample as the manifest's sample sets give it: bundle-corner
+    /// coordinates for quads ([`Atlas::block_coords`]), barycentric for triangles
+    /// ([`crate::roots::triangle_to_block`]).
+    pub fn sample_block_coords(block: &BundleBlock, sample: DVec2) -> (f64, f64) {
+        if Self::is_triangle(block) {
+            let q = crate::roots::triangle_to_block(sample);
+            (q.x, q.y)
+        } else {
+            Self::block_coords(block, sample.x, sample.y)
+        }
+    }
+
     /// Bundle-corner weights for block coordinates `(s, t)`: the contract between the
     /// texture path and the reference evaluator.
     pub fn corner_weights(block: &BundleBlock, s: f64, t: f64) -> [f64; 4] {

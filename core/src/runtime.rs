@@ -230,19 +230,17 @@ impl RuntimeTextures {
     /// Roots of `per_bundle` strands in every bundle (the first samples of the progressive
     /// sets, mapped onto each bundle's block): the bundle-level work of generation.
     pub fn strand_roots(&self, per_bundle: usize, seed: u64) -> Vec<crate::gpu_types::StrandRoot> {
-        use crate::roots::{SampleDomain, progressive_samples, triangle_to_block};
+        use crate::roots::{SampleDomain, progressive_samples};
         let quad = progressive_samples(per_bundle, SampleDomain::Square, seed);
         let triangle = progressive_samples(per_bundle, SampleDomain::Triangle, seed);
         let mut roots = Vec::with_capacity(self.atlas.blocks.len() * per_bundle);
         for block in &self.atlas.blocks {
-            let is_triangle = block.corner_of_block[2] == block.corner_of_block[3];
-            for sample in if is_triangle { &triangle } else { &quad } {
-                let (s, t) = if is_triangle {
-                    let q = triangle_to_block(*sample);
-                    (q.x, q.y)
-                } else {
-                    Atlas::block_coords(block, sample.x, sample.y)
-                };
+            for sample in if Atlas::is_triangle(block) {
+                &triangle
+            } else {
+                &quad
+            } {
+                let (s, t) = Atlas::sample_block_coords(block, *sample);
                 roots.push(crate::gpu_types::StrandRoot {
                     texel: [
                         block.origin[0] as f32 + 0.5 + s as f32,
@@ -361,13 +359,8 @@ impl TexturePath<'_> {
     ) -> Vec<Vec3> {
         use crate::styling::{StylingInput, apply_twist, strand_length_fraction, styling_offset};
         let block = &self.textures.atlas.blocks[block_index];
-        let triangle = block.corner_of_block[2] == block.corner_of_block[3];
-        let (s, t) = if triangle {
-            let q = crate::roots::triangle_to_block(sample);
-            (q.x, q.y)
-        } else {
-            Atlas::block_coords(block, sample.x, sample.y)
-        };
+        let triangle = Atlas::is_triangle(block);
+        let (s, t) = Atlas::sample_block_coords(block, sample);
         let (s, t) = (s as f32, t as f32);
         let texel = Vec2::new(
             block.origin[0] as f32 + 0.5 + s,

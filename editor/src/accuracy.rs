@@ -13,7 +13,7 @@ use anyhow::Context;
 use glam::{DVec2, DVec3};
 use hairloom_core::atlas::Atlas;
 use hairloom_core::curve::{CurveDefinition, ReferenceStrand, SegmentForm};
-use hairloom_core::roots::{SampleDomain, progressive_samples, triangle_to_block};
+use hairloom_core::roots::{SampleDomain, progressive_samples};
 use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures, TexturePath};
 use hairloom_core::strands::{StrandOptions, generate, generate_parallel};
 
@@ -43,23 +43,19 @@ struct Row {
 }
 
 /// Strands to measure: (atlas block index, block coords, bundle-corner weights).
-fn strand_set(
-    textures: &RuntimeTextures,
-    mesh: &hairloom_core::HairMesh,
-    per_bundle: u32,
-) -> Vec<(usize, DVec2, [f64; 4])> {
+fn strand_set(textures: &RuntimeTextures, per_bundle: u32) -> Vec<(usize, DVec2, [f64; 4])> {
     let quad = progressive_samples(per_bundle as usize, SampleDomain::Square, 7);
     let triangle = progressive_samples(per_bundle as usize, SampleDomain::Triangle, 7);
     let mut out = Vec::new();
     for (index, block) in textures.atlas.blocks.iter().enumerate() {
-        let is_triangle = mesh.bundles[block.bundle as usize].vertices.len() == 3;
-        let samples = if is_triangle { &triangle } else { &quad };
+        let samples = if Atlas::is_triangle(block) {
+            &triangle
+        } else {
+            &quad
+        };
         for sample in samples {
-            let coords = if is_triangle {
-                triangle_to_block(*sample)
-            } else {
-                *sample
-            };
+            let (s, t) = Atlas::sample_block_coords(block, *sample);
+            let coords = DVec2::new(s, t);
             out.push((
                 index,
                 coords,
@@ -80,7 +76,7 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
     let mesh = &document.hair_mesh;
     let f32_textures = RuntimeTextures::build(mesh, Precision::F32);
     let f16_textures = RuntimeTextures::build(mesh, Precision::F16);
-    let strands = strand_set(&f32_textures, mesh, per_bundle);
+    let strands = strand_set(&f32_textures, per_bundle);
     let bundle_width = mean_root_edge(mesh);
     let layers_of = |block: usize| f32_textures.atlas.blocks[block].layers;
 

@@ -197,25 +197,21 @@ fn gpu(project: Option<std::path::PathBuf>, vertices_log2: u32) -> anyhow::Resul
             let explicit_mb = vertices * 12.0 / 1e6;
             let textures_mb = textures.gpu_bytes() as f64 / 1e6;
             for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
-                // One warm-up run (pipeline compilation, first-touch allocations), then the median of 3.
-                let _ = renderer.time_generation(
-                    &context,
-                    &textures,
-                    &texture,
-                    &roots,
-                    vertex_count,
-                    filtering,
-                );
-                let mut runs = Vec::new();
-                for _ in 0..3 {
-                    match renderer.time_generation(
+                let time = || {
+                    renderer.time_generation(
                         &context,
                         &textures,
                         &texture,
                         &roots,
                         vertex_count,
                         filtering,
-                    ) {
+                    )
+                };
+                // One warm-up run (pipeline compilation, first-touch allocations), then the median of 3.
+                let _ = time();
+                let mut runs = Vec::new();
+                for _ in 0..3 {
+                    match time() {
                         Ok(timing) => runs.push(timing),
                         Err(error) => {
                             println!(

@@ -4,7 +4,7 @@
 
 use hairloom_core::atlas::Atlas;
 use hairloom_core::gpu_types::StrandRoot;
-use hairloom_core::roots::{SampleDomain, progressive_samples, triangle_to_block};
+use hairloom_core::roots::{SampleDomain, progressive_samples};
 use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures, TexturePath};
 use hairloom_render::device::GpuContext;
 use hairloom_render::strand_gen::StrandGenRenderer;
@@ -42,14 +42,12 @@ fn gpu_positions_match_the_cpu_mirror() {
             let mut roots = Vec::new();
             let mut expected_coords = Vec::new();
             for (index, block) in textures.atlas.blocks.iter().enumerate() {
-                let is_triangle = block.corner_of_block[2] == block.corner_of_block[3];
-                for sample in if is_triangle { &triangle } else { &quad } {
-                    let (s, t) = if is_triangle {
-                        let q = triangle_to_block(*sample);
-                        (q.x, q.y)
-                    } else {
-                        Atlas::block_coords(block, sample.x, sample.y)
-                    };
+                for sample in if Atlas::is_triangle(block) {
+                    &triangle
+                } else {
+                    &quad
+                } {
+                    let (s, t) = Atlas::sample_block_coords(block, *sample);
                     roots.push(StrandRoot {
                         texel: [
                             block.origin[0] as f32 + 0.5 + s as f32,
