@@ -5,12 +5,11 @@
 //! Every function here builds bytes in memory; writing them to disk is the caller's job
 //! (the CLI writes each file atomically).
 
-use glam::{DVec3, Vec4};
+use glam::Vec4;
 use serde::{Deserialize, Serialize};
 
 use crate::document::Document;
-use crate::roots::{SampleDomain, progressive_samples};
-use crate::runtime::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
+use crate::runtime::{Precision, RootSamples, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 use crate::strands::{Strand, sample_set_size};
 use crate::styling::StylingSet;
 
@@ -80,13 +79,17 @@ impl TexelFormat {
         }
     }
 
-    fn for_precision(precision: Precision, channels: usize) -> Self {
+    /// Format of a runtime texture with `channels` channels at `precision`. The uv-texture
+    /// (the only two-channel one) stays f32 at every precision: the root uv seeds every
+    /// per-strand random value, and f16 would quantise it to 1/2048 — whole rows of
+    /// neighbouring strands would share their curl phase and clump. It is one 2D slice, so
+    /// this costs 4 bytes per atlas texel.
+    pub fn for_precision(precision: Precision, channels: usize) -> Self {
         match (precision, channels) {
+            (_, 2) => Self::Rg32Float,
             (Precision::F32, 4) => Self::Rgba32Float,
-            (Precision::F32, 2) => Self::Rg32Float,
             (Precision::F32, _) => Self::R32Float,
             (Precision::F16, 4) => Self::Rgba16Float,
-            (Precision::F16, 2) => Self::Rg16Float,
             (Precision::F16, _) => Self::R16Float,
         }
     }
@@ -267,12 +270,18 @@ pub struct Manifest {
     pub strands_per_bundle: u32,
     pub lod: LodEntry,
     pub styling: StylingSet,
+    /// The opaque body mesh (GLB, triangles) hair is depth-tested against, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<String>,
     /// Progressive root samples in `[0,1)²` for quads (block coordinates).
     pub quad_samples: Vec<[f32; 2]>,
     /// Progressive root samples, barycentric `(s, t)` with `s + t < 1`, for triangles;
     /// block coordinates are `(s / (1 − t), t)`.
     pub triangle_samples: Vec<[f32; 2]>,
 }
+
+/// File name of the body mesh in a runtime bundle.
+pub const BODY_FILE: &str = "body.glb";
 
 /// Settings of a runtime export.
 #[derive(Clone, Debug)]
@@ -363,21 +372,9 @@ pub fn runtime_bundle(
         "unit styling direction v per layer slice (xyz)",
     )?;
     let set = sample_set_size(options.strands_per_bundle);
-    let samples = |domain| -> Vec<[f32; 2]> {
-        progressive_samples(set, domain, options.sample_seed)
-            .iter()
-            .map(|p| [p.x as f32, p.y as f32])
-            .collect()
-    };
-    let group_of = |bundle: u32| -> i32 {
-        document
-            .styling
-            .groups
-            .iter()
-            .rposition(|g| g.bundles.contains(&bundle))
-            .map(|i| i as i32)
-            .unwrap_or(-1)
-    };
+    let samples = RootSamples::progressive(set, options.sample_seed);
+    let group_of =
+        |bundle: u32| -> i32 { document.styling.group_of(bundle).map_or(-1, |i| i as i32) };
     let manifest = Manifest {
         format: "hairloom-runtime".into(),
         format_version: RUNTIME_FORMAT_VERSION,
@@ -408,9 +405,13 @@ pub fn runtime_bundle(
         strands_per_bundle: options.strands_per_bundle,
         lod: options.lod.clone(),
         styling: document.styling.clone(),
-        quad_samples: samples(SampleDomain::Square),
-        triangle_samples: samples(SampleDomain::Triangle),
+        body: (!document.body.triangles.is_empty()).then(|| BODY_FILE.to_string()),
+        quad_samples: samples.quad,
+        triangle_samples: samples.triangle,
     };
+    if manifest.body.is_some() {
+        files.push((BODY_FILE.into(), glb_body(&document.body)));
+    }
     let json = serde_json::to_vec_pretty(&manifest).unwrap_or_default();
     files.push(("manifest.json".into(), json));
     Ok(files)
@@ -503,41 +504,56 @@ pub fn usda_file(strands: &[Strand], width_m: f32) -> String {
 pub fn glb_lines(strands: &[Strand]) -> Vec<u8> {
     let mut positions = Vec::new();
     let mut indices: Vec<u32> = Vec::new();
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for strand in strands {
-        let base = (positions.len() / 12) as u32;
+        let base = positions.len() as u32;
         for (k, p) in strand.points.iter().enumerate() {
-            let p32 = p.as_vec3();
-            lo = lo.min(p32.as_dvec3());
-            hi = hi.max(p32.as_dvec3());
-            for c in p32.to_array() {
-                positions.extend_from_slice(&c.to_le_bytes());
-            }
+            positions.push(p.as_vec3().to_array());
             if k > 0 {
                 indices.push(base + k as u32 - 1);
                 indices.push(base + k as u32);
             }
         }
     }
-    let vertex_count = positions.len() / 12;
-    let mut bin = positions;
-    let index_offset = bin.len();
-    for i in &indices {
-        bin.extend_from_slice(&i.to_le_bytes());
+    glb_mesh("Hair", &positions, &indices, GLTF_MODE_LINES)
+}
+
+const GLTF_MODE_LINES: u32 = 1;
+const GLTF_MODE_TRIANGLES: u32 = 4;
+
+/// The opaque body (scalp/head) as a triangle GLB: what the runtime bundle carries so a
+/// preview of the bundle alone can depth-test hair against the same mesh.
+pub fn glb_body(body: &crate::document::BodyMesh) -> Vec<u8> {
+    let indices: Vec<u32> = body.triangles.iter().flatten().copied().collect();
+    glb_mesh("Body", &body.positions, &indices, GLTF_MODE_TRIANGLES)
+}
+
+/// One indexed mesh of `mode` (glTF primitive mode) in a GLB.
+fn glb_mesh(name: &str, positions: &[[f32; 3]], indices: &[u32], mode: u32) -> Vec<u8> {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let mut bin = Vec::with_capacity(positions.len() * 12 + indices.len() * 4);
+    for p in positions {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+            bin.extend_from_slice(&p[c].to_le_bytes());
+        }
     }
-    if lo.x > hi.x {
-        lo = DVec3::ZERO;
-        hi = DVec3::ZERO;
+    if positions.is_empty() {
+        (lo, hi) = ([0.0; 3], [0.0; 3]);
+    }
+    let index_offset = bin.len();
+    for i in indices {
+        bin.extend_from_slice(&i.to_le_bytes());
     }
     let json = serde_json::json!({
         "asset": {"version": "2.0", "generator": format!("hairloom {}", env!("CARGO_PKG_VERSION"))},
         "scene": 0,
         "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "name": "Hair"}],
-        "meshes": [{"name": "Hair", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": 1}]}],
+        "nodes": [{"mesh": 0, "name": name}],
+        "meshes": [{"name": name, "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": mode}]}],
         "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": vertex_count, "type": "VEC3",
-             "min": lo.as_vec3().to_array(), "max": hi.as_vec3().to_array()},
+            {"bufferView": 0, "componentType": 5126, "count": positions.len(), "type": "VEC3",
+             "min": lo, "max": hi},
             {"bufferView": 1, "componentType": 5125, "count": indices.len(), "type": "SCALAR"}
         ],
         "bufferViews": [
@@ -586,6 +602,27 @@ pub struct BundleError {
 pub struct LoadedBundle {
     pub manifest: Manifest,
     pub textures: RuntimeTextures,
+    /// The body mesh the manifest names (empty when it names none).
+    pub body: crate::document::BodyMesh,
+}
+
+impl LoadedBundle {
+    /// The manifest's root samples.
+    pub fn root_samples(&self) -> RootSamples {
+        RootSamples {
+            quad: self.manifest.quad_samples.clone(),
+            triangle: self.manifest.triangle_samples.clone(),
+        }
+    }
+
+    /// Roots of `per_bundle` strands per bundle with each bundle's styling group: what a game
+    /// uploads from the bundle alone.
+    pub fn strand_roots(&self, per_bundle: usize) -> Vec<crate::gpu_types::StrandRoot> {
+        self.textures
+            .strand_roots(&self.root_samples(), per_bundle, |index, _| {
+                (self.manifest.bundles[index].styling_group + 1) as u32
+            })
+    }
 }
 
 /// Half-precision bits to f32.
@@ -768,12 +805,50 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<LoadedBundle, Bundle
                 format!("bundles[{i}].corner_of_block has a corner above 3"),
             ));
         }
+        let groups = manifest.styling.groups.len() as i32;
+        if !(-1..groups).contains(&entry.styling_group) {
+            return Err(error(
+                "manifest.json",
+                format!(
+                    "bundles[{i}].styling_group {} is outside -1..{groups}",
+                    entry.styling_group
+                ),
+            ));
+        }
         blocks.push(crate::atlas::BundleBlock {
             bundle: entry.bundle,
             origin: entry.origin,
             corner_of_block: entry.corner_of_block,
             layers: entry.layers,
         });
+    }
+    manifest
+        .styling
+        .validate()
+        .map_err(|e| error("manifest.json", format!("styling.{e}")))?;
+    for (name, samples) in [
+        ("quad_samples", &manifest.quad_samples),
+        ("triangle_samples", &manifest.triangle_samples),
+    ] {
+        if samples.len() < manifest.strands_per_bundle as usize {
+            return Err(error(
+                "manifest.json",
+                format!(
+                    "{name} has {} samples, fewer than strands_per_bundle {}",
+                    samples.len(),
+                    manifest.strands_per_bundle
+                ),
+            ));
+        }
+        if let Some(i) = samples
+            .iter()
+            .position(|p| !p.iter().all(|c| (0.0..=1.0).contains(c)))
+        {
+            return Err(error(
+                "manifest.json",
+                format!("{name}[{i}] {:?} is outside [0, 1]²", samples[i]),
+            ));
+        }
     }
     let atlas = crate::atlas::Atlas {
         width,
@@ -791,7 +866,24 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<LoadedBundle, Bundle
         u,
         v,
     };
-    Ok(LoadedBundle { manifest, textures })
+    let body = match &manifest.body {
+        None => crate::document::BodyMesh::default(),
+        Some(file) => {
+            let options = crate::import::ImportOptions {
+                weld_tolerance_relative: 0.0,
+                pair_quads: false,
+                ..Default::default()
+            };
+            crate::import::import_file(&dir.join(file), &options)
+                .map_err(|e| error(file, e.to_string()))?
+                .to_body()
+        }
+    };
+    Ok(LoadedBundle {
+        manifest,
+        textures,
+        body,
+    })
 }
 
 #[cfg(test)]

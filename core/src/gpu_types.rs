@@ -18,7 +18,8 @@ pub struct StrandGenParams {
     pub vertex_count: u32,
     /// 0: exact (manual) filtering, 1: hardware filtering.
     pub filtering: u32,
-    pub _padding: u32,
+    /// Index of this dispatch's first strand in the roots buffer (batches share one buffer).
+    pub first_strand: u32,
 }
 
 /// One strand's root on the root slice.
@@ -28,9 +29,84 @@ pub struct StrandGenParams {
 pub struct StrandRoot {
     /// Texel coordinates of the root: block origin + 0.5 + block coordinates.
     pub texel: [f32; 2],
+    /// Texel coordinates of the bundle's centre strand (the axis twist turns about).
+    pub centre_texel: [f32; 2],
     /// Layers of the strand's bundle.
     pub layers: u32,
+    /// Index into the styling-parameter array: 0 = global, `g + 1` = styling group `g`.
+    pub styling: u32,
+    pub _padding: [u32; 2],
+}
+
+/// One set of styling parameters in f32 (`crate::styling::StylingParams`), flattened.
+/// Keep in sync with `shaders/strand_gen.wgsl` (`Styling`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StylingGpu {
+    pub curl_radius_m: f32,
+    pub curl_turns_per_m: f32,
+    pub curl_ramp_in_m: f32,
+    pub curl_radius_jitter: f32,
+    pub twist_turns_per_m: f32,
+    pub noise_amplitude_m: f32,
+    pub noise_frequency_per_m: f32,
+    pub noise_octaves: u32,
+    pub clump_strength: f32,
+    pub clump_clumps_per_uv: f32,
+    pub clump_radius_m: f32,
+    pub clump_tightening: f32,
+    pub frizz_amplitude_m: f32,
+    pub frizz_frequency_per_m: f32,
+    pub frizz_fraction: f32,
+    pub length_fraction: f32,
+    pub wave_amplitude_m: f32,
+    pub wave_frequency_per_m: f32,
+    pub wave_direction_rad: f32,
+    pub wave_phase_spread: f32,
+    pub wave_ramp_in_m: f32,
+    pub variation_per_uv: f32,
+    pub seed: u32,
     pub _padding: u32,
+}
+
+impl From<&crate::styling::StylingParams> for StylingGpu {
+    fn from(p: &crate::styling::StylingParams) -> Self {
+        Self {
+            curl_radius_m: p.curl.radius_m as f32,
+            curl_turns_per_m: p.curl.turns_per_m as f32,
+            curl_ramp_in_m: p.curl.ramp_in_m as f32,
+            curl_radius_jitter: p.curl.radius_jitter as f32,
+            twist_turns_per_m: p.twist.turns_per_m as f32,
+            noise_amplitude_m: p.noise.amplitude_m as f32,
+            noise_frequency_per_m: p.noise.frequency_per_m as f32,
+            noise_octaves: p.noise.octaves.clamp(1, 8),
+            clump_strength: p.clump.strength as f32,
+            clump_clumps_per_uv: p.clump.clumps_per_uv as f32,
+            clump_radius_m: p.clump.radius_m as f32,
+            clump_tightening: p.clump.tightening.max(0.0) as f32,
+            frizz_amplitude_m: p.frizz.amplitude_m as f32,
+            frizz_frequency_per_m: p.frizz.frequency_per_m as f32,
+            frizz_fraction: p.frizz.fraction as f32,
+            length_fraction: p.length.fraction.clamp(0.0, 1.0) as f32,
+            wave_amplitude_m: p.wave.amplitude_m as f32,
+            wave_frequency_per_m: p.wave.frequency_per_m as f32,
+            wave_direction_rad: p.wave.direction_rad as f32,
+            wave_phase_spread: p.wave.phase_spread as f32,
+            wave_ramp_in_m: p.wave.ramp_in_m as f32,
+            variation_per_uv: p.variation_per_uv as f32,
+            seed: p.seed,
+            _padding: 0,
+        }
+    }
+}
+
+/// The styling array the shader indexes with [`StrandRoot::styling`]: the global
+/// parameters, then every group in order.
+pub fn styling_array(set: &crate::styling::StylingSet) -> Vec<StylingGpu> {
+    std::iter::once(&set.global)
+        .chain(set.groups.iter().map(|g| &g.params))
+        .map(StylingGpu::from)
+        .collect()
 }
 
 /// Filtering mode values of [`StrandGenParams::filtering`].

@@ -19,7 +19,7 @@
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
 
-use crate::atlas::{Atlas, build_atlas};
+use crate::atlas::{Atlas, BundleBlock, build_atlas};
 use crate::curve::{cubic_to_quadratics, curve_segments};
 use crate::frames::layer_frames;
 use crate::mesh::HairMesh;
@@ -227,35 +227,72 @@ impl RuntimeTextures {
         }
     }
 
-    /// Roots of `per_bundle` strands in every bundle (the first samples of the progressive
-    /// sets, mapped onto each bundle's block): the bundle-level work of generation.
-    pub fn strand_roots(&self, per_bundle: usize, seed: u64) -> Vec<crate::gpu_types::StrandRoot> {
-        use crate::roots::{SampleDomain, progressive_samples};
-        let quad = progressive_samples(per_bundle, SampleDomain::Square, seed);
-        let triangle = progressive_samples(per_bundle, SampleDomain::Triangle, seed);
+    /// Roots of the first `per_bundle` samples of `samples` in every bundle, mapped onto
+    /// each bundle's block: the bundle-level work of generation. `styling_of_block` gives a
+    /// block's index into the styling array (0 = global, `g + 1` = group `g`).
+    pub fn strand_roots(
+        &self,
+        samples: &RootSamples,
+        per_bundle: usize,
+        styling_of_block: impl Fn(usize, &BundleBlock) -> u32,
+    ) -> Vec<crate::gpu_types::StrandRoot> {
+        let per_bundle = per_bundle
+            .min(samples.quad.len())
+            .min(samples.triangle.len());
         let mut roots = Vec::with_capacity(self.atlas.blocks.len() * per_bundle);
-        for block in &self.atlas.blocks {
-            for sample in if Atlas::is_triangle(block) {
-                &triangle
+        for (index, block) in self.atlas.blocks.iter().enumerate() {
+            let set = if Atlas::is_triangle(block) {
+                &samples.triangle
             } else {
-                &quad
-            } {
-                let (s, t) = Atlas::sample_block_coords(block, *sample);
-                roots.push(crate::gpu_types::StrandRoot {
-                    texel: [
-                        block.origin[0] as f32 + 0.5 + s as f32,
-                        block.origin[1] as f32 + 0.5 + t as f32,
-                    ],
-                    layers: block.layers,
-                    _padding: 0,
-                });
-            }
+                &samples.quad
+            };
+            let styling = styling_of_block(index, block);
+            roots.extend(
+                set[..per_bundle]
+                    .iter()
+                    .map(|sample| strand_root(block, *sample, styling)),
+            );
         }
         roots
     }
 
-    /// Bytes the five textures take on the GPU: RGBA hair mesh, u and v (4 channels), RG uv,
-    /// R w, at 4 bytes (f32) or 2 bytes (f16) per channel.
+    /// Roots of a document's bundles, each with its styling group (see
+    /// [`crate::styling::StylingSet::group_of`]).
+    pub fn document_roots(
+        &self,
+        styling: &crate::styling::StylingSet,
+        samples: &RootSamples,
+        per_bundle: usize,
+    ) -> Vec<crate::gpu_types::StrandRoot> {
+        self.strand_roots(samples, per_bundle, |_, block| {
+            styling.group_of(block.bundle).map_or(0, |g| g as u32 + 1)
+        })
+    }
+
+    /// Bounding box of every control point the bundles' blocks sample (positions plus the
+    /// offset), from the hair-mesh texture alone: the same box for a project and for its
+    /// exported runtime bundle. `None` without bundles.
+    pub fn hair_bounds(&self) -> Option<(Vec3, Vec3)> {
+        let texture = &self.hair_mesh;
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for block in &self.atlas.blocks {
+            let slices = (SLICES_PER_SEGMENT * block.layers + 1).min(texture.depth);
+            for z in 0..slices {
+                for y in block.origin[1]..(block.origin[1] + 2).min(texture.height) {
+                    for x in block.origin[0]..(block.origin[0] + 2).min(texture.width) {
+                        let p = texture.get(x, y, z).truncate() + self.position_offset;
+                        lo = lo.min(p);
+                        hi = hi.max(p);
+                    }
+                }
+            }
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// Bytes the five textures take on the GPU: RGBA hair mesh, u and v (4 channels), R w,
+    /// at 4 bytes (f32) or 2 bytes (f16) per channel, and the RG uv-texture, always f32
+    /// (see `export::TexelFormat::for_precision`).
     pub fn gpu_bytes(&self) -> usize {
         let channel = match self.precision {
             Precision::F32 => 4,
@@ -266,8 +303,57 @@ impl RuntimeTextures {
             * (4 * texels(&self.hair_mesh)
                 + 4 * texels(&self.u)
                 + 4 * texels(&self.v)
-                + 2 * texels(&self.uv)
                 + texels(&self.w))
+            + 8 * texels(&self.uv)
+    }
+}
+
+/// The root of the strand at `sample` (a manifest sample) of `block`, with the texel of the
+/// bundle's centre strand (block centre, or the triangle's centroid) for twist.
+pub fn strand_root(
+    block: &BundleBlock,
+    sample: [f32; 2],
+    styling: u32,
+) -> crate::gpu_types::StrandRoot {
+    let origin = Vec2::new(block.origin[0] as f32, block.origin[1] as f32) + 0.5;
+    let centre = if Atlas::is_triangle(block) {
+        Vec2::new(0.5, 1.0 / 3.0)
+    } else {
+        Vec2::splat(0.5)
+    };
+    let (s, t) =
+        Atlas::sample_block_coords(block, glam::DVec2::new(sample[0] as f64, sample[1] as f64));
+    crate::gpu_types::StrandRoot {
+        texel: (origin + Vec2::new(s as f32, t as f32)).to_array(),
+        centre_texel: (origin + centre).to_array(),
+        layers: block.layers,
+        styling,
+        _padding: [0; 2],
+    }
+}
+
+/// Progressive root samples as a runtime bundle stores them (f32, seed 000 §3.3): quads in
+/// block coordinates `[0,1)²`, triangles barycentric `(s, t)`, `s + t < 1`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RootSamples {
+    pub quad: Vec<[f32; 2]>,
+    pub triangle: Vec<[f32; 2]>,
+}
+
+impl RootSamples {
+    /// `set` samples per domain from `seed` (what an export writes to its manifest).
+    pub fn progressive(set: usize, seed: u64) -> Self {
+        use crate::roots::{SampleDomain, progressive_samples};
+        let samples = |domain| {
+            progressive_samples(set, domain, seed)
+                .iter()
+                .map(|p| [p.x as f32, p.y as f32])
+                .collect()
+        };
+        Self {
+            quad: samples(SampleDomain::Square),
+            triangle: samples(SampleDomain::Triangle),
+        }
     }
 }
 
@@ -322,9 +408,14 @@ impl TexturePath<'_> {
             block.origin[0] as f32 + 0.5 + s,
             block.origin[1] as f32 + 0.5 + t,
         );
-        let layers = block.layers.max(1) as f32;
-        let tau = tau.clamp(0.0, layers);
-        let segment = (tau.floor() as u32).min(block.layers.saturating_sub(1));
+        self.position_at(texel, block.layers, tau)
+    }
+
+    /// Position at root texel coordinates `texel` of a bundle with `layers` layers and curve
+    /// parameter `tau` (mirror: `strand_position` in `strand_gen.wgsl`).
+    pub fn position_at(&self, texel: Vec2, layers: u32, tau: f32) -> Vec3 {
+        let tau = tau.clamp(0.0, layers.max(1) as f32);
+        let segment = (tau.floor() as u32).min(layers.max(1) - 1);
         let local = tau - segment as f32;
         // Which quadratic, and its parameter.
         let (first_slice, q) = if local < 0.5 {
@@ -346,10 +437,7 @@ impl TexturePath<'_> {
     }
 
     /// The styled strand rooted at `sample` (bundle-corner coordinates for quads, barycentric
-    /// for triangles — the manifest's sample sets), computed from the five textures as the
-    /// generation shader does: positions from the hair-mesh texture, root uv from the
-    /// uv-texture, w and û, v̂ from linear fetches between layer slices, then twist, length
-    /// variation and the styling offset of `crate::styling`.
+    /// for triangles — the manifest's sample sets) of atlas block `block_index`.
     pub fn styled_strand(
         &self,
         block_index: usize,
@@ -357,15 +445,25 @@ impl TexturePath<'_> {
         vertex_count: usize,
         params: &crate::styling::StylingParams,
     ) -> Vec<Vec3> {
-        use crate::styling::{StylingInput, apply_twist, strand_length_fraction, styling_offset};
         let block = &self.textures.atlas.blocks[block_index];
-        let triangle = Atlas::is_triangle(block);
-        let (s, t) = Atlas::sample_block_coords(block, sample);
-        let (s, t) = (s as f32, t as f32);
-        let texel = Vec2::new(
-            block.origin[0] as f32 + 0.5 + s,
-            block.origin[1] as f32 + 0.5 + t,
-        );
+        let root = strand_root(block, [sample.x as f32, sample.y as f32], 0);
+        self.styled_strand_at(&root, vertex_count, params)
+    }
+
+    /// The styled strand of `root`, computed from the five textures as `strand_gen.wgsl`
+    /// does: positions from the hair-mesh texture, root uv from the uv-texture, w and û, v̂
+    /// from linear fetches between layer slices, then twist, length variation and the
+    /// styling offset of `crate::styling` (in f64: the GPU's f32 stays within the parity
+    /// bound of `render/tests/strand_gen.rs`).
+    pub fn styled_strand_at(
+        &self,
+        root: &crate::gpu_types::StrandRoot,
+        vertex_count: usize,
+        params: &crate::styling::StylingParams,
+    ) -> Vec<Vec3> {
+        use crate::styling::{StylingInput, apply_twist, strand_length_fraction, styling_offset};
+        let texel = Vec2::from_array(root.texel);
+        let centre = Vec2::from_array(root.centre_texel);
         let layer_fetch = |texture: &Texture3d, tau: f32| {
             sample_trilinear(texture, texel.extend(tau + 0.5), self.filtering)
         };
@@ -376,18 +474,13 @@ impl TexturePath<'_> {
             .truncate()
             .truncate()
             .as_dvec2();
-        let tau_max = block.layers as f64 * strand_length_fraction(params, root_uv);
-        let (centre_s, centre_t) = if triangle {
-            (0.5, 1.0 / 3.0)
-        } else {
-            (0.5, 0.5)
-        };
+        let tau_max = root.layers as f64 * strand_length_fraction(params, root_uv);
         let vertex_count = vertex_count.max(2);
         (0..vertex_count)
             .map(|k| {
                 let along = k as f64 / (vertex_count - 1) as f64;
                 let tau = (tau_max * along) as f32;
-                let p = self.position(block_index, s, t, tau);
+                let p = self.position_at(texel, root.layers, tau);
                 if k == 0 {
                     return p;
                 }
@@ -408,9 +501,7 @@ impl TexturePath<'_> {
                 let w = layer_fetch(&self.textures.w, tau).x as f64;
                 let mut p = p.as_dvec3();
                 if params.twist.turns_per_m != 0.0 {
-                    let centre = self
-                        .position(block_index, centre_s, centre_t, tau)
-                        .as_dvec3();
+                    let centre = self.position_at(centre, root.layers, tau).as_dvec3();
                     p = apply_twist(params, p, centre, w_axis, w);
                 }
                 let input = StylingInput {
@@ -422,6 +513,29 @@ impl TexturePath<'_> {
                     along,
                 };
                 (p + styling_offset(params, &input)).as_vec3()
+            })
+            .collect()
+    }
+
+    /// CPU mirror of the `strand_gen` compute stage: `vertex_count` vertices of every root,
+    /// strand-major, with `styling[root.styling]` (an out-of-range index uses the global
+    /// parameters, `styling[0]`, as the shader does).
+    pub fn strand_gen(
+        &self,
+        roots: &[crate::gpu_types::StrandRoot],
+        styling: &[&crate::styling::StylingParams],
+        vertex_count: usize,
+    ) -> Vec<Vec3> {
+        let default = crate::styling::StylingParams::default();
+        roots
+            .iter()
+            .flat_map(|root| {
+                let params = styling
+                    .get(root.styling as usize)
+                    .or(styling.first())
+                    .copied()
+                    .unwrap_or(&default);
+                self.styled_strand_at(root, vertex_count, params)
             })
             .collect()
     }
@@ -510,7 +624,12 @@ mod tests {
         let mesh = curved_mesh();
         let full = RuntimeTextures::build(&mesh, Precision::F32);
         let half = RuntimeTextures::build(&mesh, Precision::F16);
-        assert!(half.gpu_bytes() * 2 == full.gpu_bytes());
+        // Everything halves except the uv-texture, which stays f32.
+        let uv_bytes = 8 * (full.uv.width * full.uv.height) as usize;
+        assert_eq!(
+            (half.gpu_bytes() - uv_bytes) * 2,
+            full.gpu_bytes() - uv_bytes
+        );
         let exact = TexturePath {
             textures: &full,
             filtering: Filtering::Exact,

@@ -212,12 +212,17 @@ pub struct StylingGroup {
 
 impl StylingSet {
     pub fn params_for(&self, bundle: u32) -> &StylingParams {
+        self.group_of(bundle)
+            .map(|g| &self.groups[g].params)
+            .unwrap_or(&self.global)
+    }
+
+    /// Index of the group whose parameters `bundle` uses (the last that lists it), `None`
+    /// for the global parameters.
+    pub fn group_of(&self, bundle: u32) -> Option<usize> {
         self.groups
             .iter()
-            .rev()
-            .find(|g| g.bundles.contains(&bundle))
-            .map(|g| &g.params)
-            .unwrap_or(&self.global)
+            .rposition(|g| g.bundles.contains(&bundle))
     }
 
     /// Every number must be finite and every range respected; names the offending field.

@@ -188,25 +188,26 @@ fn gpu(project: Option<std::path::PathBuf>, vertices_log2: u32) -> anyhow::Resul
     );
     for precision in [Precision::F32, Precision::F16] {
         let textures = RuntimeTextures::build(mesh, precision);
-        let texture = renderer.upload_hair_mesh(&context, &textures);
         let bundles = textures.atlas.blocks.len().max(1);
         for target in [10_000usize, 100_000, 300_000] {
-            let roots = textures.strand_roots(target.div_ceil(bundles), 1);
+            let per_bundle = target.div_ceil(bundles);
+            let samples = hairloom_core::runtime::RootSamples::progressive(
+                hairloom_core::strands::sample_set_size(per_bundle as u32),
+                1,
+            );
+            let roots = textures.document_roots(&project.document.styling, &samples, per_bundle);
+            let hair = renderer.upload(
+                &context,
+                &textures,
+                &roots,
+                &hairloom_core::gpu_types::styling_array(&project.document.styling),
+            );
             let vertices = roots.len() as f64 * vertex_count as f64;
             // Explicit storage: every strand vertex as three f32.
             let explicit_mb = vertices * 12.0 / 1e6;
             let textures_mb = textures.gpu_bytes() as f64 / 1e6;
             for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
-                let time = || {
-                    renderer.time_generation(
-                        &context,
-                        &textures,
-                        &texture,
-                        &roots,
-                        vertex_count,
-                        filtering,
-                    )
-                };
+                let time = || renderer.time_generation(&context, &hair, vertex_count, filtering);
                 // One warm-up run (pipeline compilation, first-touch allocations), then the median of 3.
                 let _ = time();
                 let mut runs = Vec::new();

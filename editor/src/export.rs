@@ -21,16 +21,11 @@ pub fn run(
     strand_files: &[std::path::PathBuf],
     strands_per_bundle: u32,
     vertices_log2: u32,
-    precision: &str,
+    precision: Precision,
 ) -> anyhow::Result<()> {
     if runtime.is_none() && strand_files.is_empty() {
         bail!("nothing to export: give --runtime DIR and/or --strands FILE.{{hair,usda,glb}}");
     }
-    let precision = match precision {
-        "f32" => Precision::F32,
-        "f16" => Precision::F16,
-        other => bail!("--precision must be f32 or f16, got {other:?}"),
-    };
     if vertices_log2 > 10 {
         bail!("--vertices-log2 {vertices_log2} is more than 10 (1025 vertices per strand)");
     }

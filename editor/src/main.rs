@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
 use hairloom_core::project;
+use hairloom_core::runtime::{Filtering, Precision};
 
 mod accuracy;
 mod bench;
@@ -69,24 +70,35 @@ enum Command {
         /// Strands have 2^N + 1 vertices.
         #[arg(long, default_value_t = 5)]
         vertices_log2: u32,
-        /// Runtime texture precision: f32 or f16.
-        #[arg(long, default_value = "f32")]
-        precision: String,
+        /// Runtime texture precision.
+        #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
+        precision: PrecisionArg,
     },
-    /// Render a project headless to a PNG (body + shaded strands, MSAA).
+    /// Render a project, or an exported runtime bundle folder, headless to a PNG: strands
+    /// generated on the GPU from the runtime textures, body, Kajiya-Kay shading, MSAA.
     Render {
-        project: PathBuf,
+        /// A .hairloom project or a runtime bundle folder.
+        input: PathBuf,
         #[arg(long)]
         out: PathBuf,
         /// Image size, WIDTHxHEIGHT.
         #[arg(long, default_value = "960x960")]
         size: String,
-        /// Strands per bundle.
-        #[arg(long, default_value_t = 48)]
-        strands_per_bundle: u32,
+        /// Strands per bundle (default: the bundle's own count, or 64 for a project).
+        #[arg(long)]
+        strands_per_bundle: Option<u32>,
         /// Camera direction from the model: front, side, back, three-quarter, or x,y,z.
         #[arg(long, default_value = "three-quarter")]
         view: String,
+        /// Strands have 2^N + 1 vertices.
+        #[arg(long, default_value_t = render::PREVIEW_VERTICES_LOG2)]
+        vertices_log2: u32,
+        /// Texture precision of a project render (a runtime bundle has its own).
+        #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
+        precision: PrecisionArg,
+        /// Texture filtering in the generation shader.
+        #[arg(long, value_enum, default_value_t = FilteringArg::Exact)]
+        filtering: FilteringArg,
     },
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
     Adapters,
@@ -95,6 +107,38 @@ enum Command {
         #[command(subcommand)]
         which: bench::Which,
     },
+}
+
+/// Texture precision on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum PrecisionArg {
+    F32,
+    F16,
+}
+
+impl From<PrecisionArg> for Precision {
+    fn from(value: PrecisionArg) -> Self {
+        match value {
+            PrecisionArg::F32 => Precision::F32,
+            PrecisionArg::F16 => Precision::F16,
+        }
+    }
+}
+
+/// Texture filtering on the command line: exact (manual, f32 weights) or hardware.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum FilteringArg {
+    Exact,
+    Hardware,
+}
+
+impl From<FilteringArg> for Filtering {
+    fn from(value: FilteringArg) -> Self {
+        match value {
+            FilteringArg::Exact => Filtering::Exact,
+            FilteringArg::Hardware => Filtering::Hardware8Bit,
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -128,15 +172,32 @@ fn main() -> ExitCode {
             &strands,
             strands_per_bundle,
             vertices_log2,
-            &precision,
+            precision.into(),
         ),
         Some(Command::Render {
-            project,
+            input,
             out,
             size,
             strands_per_bundle,
             view,
-        }) => render::run(&project, &out, &size, strands_per_bundle, &view),
+            vertices_log2,
+            precision,
+            filtering,
+        }) => {
+            if vertices_log2 > 8 {
+                eprintln!("error: --vertices-log2 {vertices_log2} is more than 8");
+                return ExitCode::from(2);
+            }
+            let settings = render::RenderSettings {
+                size,
+                strands_per_bundle,
+                view,
+                vertices_log2,
+                precision: precision.into(),
+                filtering: filtering.into(),
+            };
+            render::run(&input, &out, &settings)
+        }
         Some(Command::Adapters) => adapters(),
         Some(Command::Bench { which }) => bench::run(which),
     };

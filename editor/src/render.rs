@@ -1,19 +1,53 @@
-//! `hairloom render`: a headless picture of a project through the preview renderer.
-//!
-//! Strands come from the styled CPU reference generator for now (uploaded as vertices); the
-//! GPU generation stage renders unstyled strands bit-identically (see render/tests) and will
-//! take over once styling runs in WGSL.
+//! `hairloom render`: a headless picture through the game's path. Strands are generated on
+//! the GPU from the runtime textures (`strand_gen.wgsl`) every frame and drawn by the preview
+//! renderer; a project is turned into the same textures, roots and styling an export would
+//! write, so rendering a project and rendering its exported runtime bundle give the same
+//! image (tested in `editor/tests/cli.rs`).
 
 use std::path::Path;
 
 use anyhow::{Context, bail};
 use glam::Vec3;
-use hairloom_core::strands::{StrandOptions, generate_parallel};
+use hairloom_core::document::BodyMesh;
+use hairloom_core::gpu_types::{StrandRoot, StylingGpu, styling_array};
+use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures};
+use hairloom_core::strands::sample_set_size;
 use hairloom_render::device::{GpuContext, describe};
-use hairloom_render::preview::{Camera, PreviewRenderer, PreviewScene};
+use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, PreviewScene};
+use hairloom_render::strand_gen::StrandGenRenderer;
 
-/// Vertices per strand in previews: 2^4 + 1.
-const PREVIEW_VERTICES_LOG2: u32 = 4;
+/// Vertices per strand in previews by default: 2^4 + 1.
+pub const PREVIEW_VERTICES_LOG2: u32 = 4;
+/// Strands per bundle of a project render when none is given (an export's default).
+pub const DEFAULT_STRANDS_PER_BUNDLE: u32 = 64;
+/// Root-sample seed of project renders: the one runtime exports use by default.
+const SAMPLE_SEED: u64 = 1;
+
+/// Settings of a headless render.
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    pub size: String,
+    /// `None`: the runtime bundle's own count, or [`DEFAULT_STRANDS_PER_BUNDLE`].
+    pub strands_per_bundle: Option<u32>,
+    pub view: String,
+    pub vertices_log2: u32,
+    /// Texture precision of a project render (a runtime bundle has its own).
+    pub precision: Precision,
+    pub filtering: Filtering,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            size: "960x960".into(),
+            strands_per_bundle: None,
+            view: "three-quarter".into(),
+            vertices_log2: PREVIEW_VERTICES_LOG2,
+            precision: Precision::F32,
+            filtering: Filtering::Exact,
+        }
+    }
+}
 
 fn parse_size(size: &str) -> anyhow::Result<(u32, u32)> {
     let (w, h) = size
@@ -26,7 +60,7 @@ fn parse_size(size: &str) -> anyhow::Result<(u32, u32)> {
     Ok((w, h))
 }
 
-fn parse_view(view: &str) -> anyhow::Result<Vec3> {
+pub fn parse_view(view: &str) -> anyhow::Result<Vec3> {
     Ok(match view {
         "front" => Vec3::new(0.0, 0.1, 1.0),
         "side" => Vec3::new(1.0, 0.1, 0.0),
@@ -50,45 +84,96 @@ fn parse_view(view: &str) -> anyhow::Result<Vec3> {
     })
 }
 
-pub fn run(
-    project_path: &Path,
-    out: &Path,
-    size: &str,
-    strands_per_bundle: u32,
-    view: &str,
-) -> anyhow::Result<()> {
-    let (width, height) = parse_size(size)?;
-    let direction = parse_view(view)?;
-    let project = hairloom_core::project::load(project_path)?;
-    let document = &project.document;
-    let context = GpuContext::new_headless()?;
-    let options = StrandOptions {
-        strands_per_bundle,
-        vertices_log2: PREVIEW_VERTICES_LOG2,
-        ..StrandOptions::default()
-    };
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    let strands = generate_parallel(document, &options, threads);
-    let vertex_count = (1u32 << PREVIEW_VERTICES_LOG2) + 1;
-    let positions: Vec<[f32; 4]> = strands
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.as_vec3().extend(1.0).to_array()))
-        .collect();
+/// What the GPU needs to draw a head of hair: the runtime textures, roots, styling and the
+/// opaque body. Built from a project or read from a runtime bundle.
+pub struct RenderableHair {
+    pub textures: RuntimeTextures,
+    pub roots: Vec<StrandRoot>,
+    pub styling: Vec<StylingGpu>,
+    pub body: BodyMesh,
+}
+
+impl RenderableHair {
+    /// What exporting `document` with these settings would produce.
+    pub fn from_document(
+        document: &hairloom_core::document::Document,
+        precision: Precision,
+        strands_per_bundle: u32,
+    ) -> Self {
+        let textures = RuntimeTextures::build(&document.hair_mesh, precision);
+        let samples = RootSamples::progressive(sample_set_size(strands_per_bundle), SAMPLE_SEED);
+        let roots =
+            textures.document_roots(&document.styling, &samples, strands_per_bundle as usize);
+        Self {
+            textures,
+            roots,
+            styling: styling_array(&document.styling),
+            body: document.body.clone(),
+        }
+    }
+
+    /// A project file, or a runtime bundle folder (the game's input).
+    pub fn load(path: &Path, settings: &RenderSettings) -> anyhow::Result<Self> {
+        if path.is_dir() {
+            let bundle = hairloom_core::export::load_runtime_bundle(path)?;
+            let per_bundle = settings
+                .strands_per_bundle
+                .unwrap_or(bundle.manifest.strands_per_bundle);
+            if per_bundle as usize > bundle.manifest.quad_samples.len() {
+                bail!(
+                    "{}: --strands-per-bundle {per_bundle} is more than the bundle's {} samples",
+                    path.display(),
+                    bundle.manifest.quad_samples.len()
+                );
+            }
+            Ok(Self {
+                roots: bundle.strand_roots(per_bundle as usize),
+                styling: styling_array(&bundle.manifest.styling),
+                textures: bundle.textures,
+                body: bundle.body,
+            })
+        } else {
+            let project = hairloom_core::project::load(path)?;
+            Ok(Self::from_document(
+                &project.document,
+                settings.precision,
+                settings
+                    .strands_per_bundle
+                    .unwrap_or(DEFAULT_STRANDS_PER_BUNDLE),
+            ))
+        }
+    }
+}
+
+/// Draws `hair` seen from `direction`; returns RGBA8 pixels and a one-line description.
+pub fn render_pixels(
+    context: &GpuContext,
+    hair: &RenderableHair,
+    width: u32,
+    height: u32,
+    direction: Vec3,
+    vertices_log2: u32,
+    filtering: Filtering,
+) -> anyhow::Result<(Vec<u8>, String)> {
+    let generator = StrandGenRenderer::new(context);
+    let gpu_hair = generator.upload(context, &hair.textures, &hair.roots, &hair.styling);
+    let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
     // Frame the hair (the head scan's shoulders would make it tiny), padded by a margin.
-    let (lo, hi) = document
-        .hair_mesh
-        .bounds()
-        .context("the project has no hair mesh")?;
-    let (lo, hi) = (lo.as_vec3(), hi.as_vec3());
+    let (lo, hi) = hair
+        .textures
+        .hair_bounds()
+        .context("nothing to render: no bundle grows hair")?;
     let pad = (hi - lo) * 0.05;
     let camera = Camera::framing(lo - pad, hi + pad, direction);
-    let renderer = PreviewRenderer::new(&context);
+    let renderer = PreviewRenderer::new(context);
     let scene = PreviewScene {
-        body_positions: &document.body.positions,
-        body_triangles: &document.body.triangles,
-        strand_positions: &positions,
+        body_positions: &hair.body.positions,
+        body_triangles: &hair.body.triangles,
+        hair: HairSource::Generated {
+            generator: &generator,
+            hair: &gpu_hair,
+            filtering,
+        },
         vertex_count,
         strand_width_m: (hi - lo).length() * 0.0012,
         // Linear colours (the target is sRGB): dark brown roots, lighter tips.
@@ -97,13 +182,24 @@ pub fn run(
         body_color: [0.55, 0.38, 0.30],
         camera,
     };
-    let pixels = renderer
-        .render(&context, &scene, width, height)
-        .map_err(|e| anyhow::anyhow!("rendering: {e}"))?;
+    let pixels = renderer.render(context, &scene, width, height)?;
+    let summary = format!(
+        "{width}x{height}, {} strands × {vertex_count} vertices generated on the GPU ({:?} filtering, {:?} textures), {}× MSAA, on {}",
+        hair.roots.len(),
+        filtering,
+        hair.textures.precision,
+        renderer.sample_count,
+        describe(&context.adapter_info)
+    );
+    Ok((pixels, summary))
+}
+
+/// RGBA8 pixels as a PNG file, written atomically.
+pub fn write_png(out: &Path, pixels: &[u8], width: u32, height: u32) -> anyhow::Result<()> {
     let mut png = Vec::new();
     image::ImageEncoder::write_image(
         image::codecs::png::PngEncoder::new(&mut png),
-        &pixels,
+        pixels,
         width,
         height,
         image::ExtendedColorType::Rgba8,
@@ -114,16 +210,24 @@ pub fn run(
             .with_context(|| format!("creating {}", parent.display()))?;
     }
     hairloom_core::project::write_atomic(out, &png, |_| {})
-        .with_context(|| format!("writing {}", out.display()))?;
-    println!(
-        "{}: {}x{}, {} strands × {} vertices, {}× MSAA, on {}",
-        out.display(),
+        .with_context(|| format!("writing {}", out.display()))
+}
+
+pub fn run(input: &Path, out: &Path, settings: &RenderSettings) -> anyhow::Result<()> {
+    let (width, height) = parse_size(&settings.size)?;
+    let direction = parse_view(&settings.view)?;
+    let hair = RenderableHair::load(input, settings)?;
+    let context = GpuContext::new_headless()?;
+    let (pixels, summary) = render_pixels(
+        &context,
+        &hair,
         width,
         height,
-        strands.len(),
-        vertex_count,
-        renderer.sample_count,
-        describe(&context.adapter_info)
-    );
+        direction,
+        settings.vertices_log2,
+        settings.filtering,
+    )?;
+    write_png(out, &pixels, width, height)?;
+    println!("{}: {summary}", out.display());
     Ok(())
 }

@@ -211,7 +211,11 @@ fn exports_of_every_sample_pass_third_party_validators() {
         ]);
         let (code, stdout, stderr) = run(&mut command);
         assert_eq!(code, 0, "{name}: {stderr}");
-        assert!(stdout.contains("runtime bundle, 6 files"), "{stdout}");
+        // Five textures and the manifest, plus the body mesh every sample has.
+        let body = runtime.join("body.glb");
+        assert!(body.exists(), "{name}: no body.glb");
+        assert!(stdout.contains("runtime bundle, 7 files"), "{stdout}");
+        glbs.push(body);
         // Our own reading of the .hair header: counts match what was generated.
         let hair = std::fs::read(&files[0]).expect("hair file");
         assert_eq!(&hair[..4], b"HAIR");

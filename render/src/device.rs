@@ -166,6 +166,111 @@ pub fn read_buffer(context: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8
     Ok(bytes)
 }
 
+/// GPU timestamps around a known number of passes (one begin/end pair each), resolved after
+/// submission. `None` from [`PassTimer::new`] when the adapter has no `TIMESTAMP_QUERY`.
+pub struct PassTimer {
+    query_set: wgpu::QuerySet,
+    capacity: u32,
+    next: std::cell::Cell<u32>,
+}
+
+impl PassTimer {
+    pub fn new(context: &GpuContext, passes: usize) -> Option<Self> {
+        if !context
+            .device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+        {
+            return None;
+        }
+        let capacity = (2 * passes).max(2) as u32;
+        Some(Self {
+            query_set: context.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass_timer"),
+                ty: wgpu::QueryType::Timestamp,
+                count: capacity,
+            }),
+            capacity,
+            next: std::cell::Cell::new(0),
+        })
+    }
+
+    /// Begin and end query indices of the next pass (`None` once full).
+    fn claim(&self) -> Option<(u32, u32)> {
+        let first = self.next.get();
+        (first + 2 <= self.capacity).then(|| {
+            self.next.set(first + 2);
+            (first, first + 1)
+        })
+    }
+
+    pub fn compute_pass(&self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.claim()
+            .map(|(begin, end)| wgpu::ComputePassTimestampWrites {
+                query_set: &self.query_set,
+                beginning_of_pass_write_index: Some(begin),
+                end_of_pass_write_index: Some(end),
+            })
+    }
+
+    pub fn render_pass(&self) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.claim()
+            .map(|(begin, end)| wgpu::RenderPassTimestampWrites {
+                query_set: &self.query_set,
+                beginning_of_pass_write_index: Some(begin),
+                end_of_pass_write_index: Some(end),
+            })
+    }
+}
+
+/// Submits `encoder`, waits for the GPU, and returns (wall ms, summed GPU ms of the timed
+/// passes, if timed).
+pub fn submit_timed(
+    context: &GpuContext,
+    mut encoder: wgpu::CommandEncoder,
+    timer: Option<PassTimer>,
+) -> Result<(f64, Option<f64>), String> {
+    let device = &context.device;
+    let readback = timer.as_ref().map(|timer| {
+        let used = timer.next.get().max(2);
+        let size = used as u64 * 8;
+        let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pass_timer_resolve"),
+            size,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pass_timer_readback"),
+            size,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.resolve_query_set(&timer.query_set, 0..used, &resolve, 0);
+        encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, size);
+        (readback, timer.next.get() / 2)
+    });
+    let start = std::time::Instant::now();
+    context.queue.submit([encoder.finish()]);
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| e.to_string())?;
+    let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+    let gpu_ms = match readback {
+        Some((readback, passes)) => {
+            let bytes = read_buffer(context, &readback)?;
+            let ticks: &[u64] = bytemuck::cast_slice(&bytes);
+            let period_ns = context.queue.get_timestamp_period() as f64;
+            let total: u64 = (0..passes as usize)
+                .map(|i| ticks[2 * i + 1].saturating_sub(ticks[2 * i]))
+                .sum();
+            Some(total as f64 * period_ns * 1e-6)
+        }
+        None => None,
+    };
+    Ok((wall_ms, gpu_ms))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,14 +2,18 @@
 //! shading (`shaders/preview_body.wgsl`, `shaders/preview_hair.wgsl`), depth-tested, 4× MSAA
 //! where the adapter supports it, read back as RGBA8 pixels.
 //!
-//! Strand vertices arrive in a storage buffer, strand-major; they may come from the GPU
-//! generation stage or from the CPU reference generator (the explicit-storage path).
+//! Strand vertices arrive in a storage buffer, strand-major ([`HairSource`]): generated on
+//! the GPU from the runtime textures every frame, batch by batch into one bounded scratch
+//! buffer (the paper's path and the game's), or stored (vertices generated beforehand: the
+//! explicit-storage baseline, and the CPU reference).
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
+use hairloom_core::runtime::Filtering;
 use wgpu::util::DeviceExt;
 
-use crate::device::{GpuContext, read_buffer};
+use crate::device::{GpuContext, PassTimer, read_buffer, submit_timed};
+use crate::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batches};
 
 pub const HAIR_SHADER: &str = include_str!("../../shaders/preview_hair.wgsl");
 pub const BODY_SHADER: &str = include_str!("../../shaders/preview_body.wgsl");
@@ -75,12 +79,30 @@ impl Camera {
     }
 }
 
+/// Where the strand vertices of a frame come from.
+pub enum HairSource<'a> {
+    /// Strand-major vertices in memory (xyz, w = fraction along the strand), uploaded for
+    /// the frame: the CPU reference generator's output.
+    Vertices(&'a [[f32; 4]]),
+    /// Strand-major vertices already in a GPU storage buffer: the explicit-storage baseline.
+    Stored {
+        buffer: &'a wgpu::Buffer,
+        strand_count: usize,
+    },
+    /// Generated from the runtime textures in this frame, batch by batch.
+    Generated {
+        generator: &'a StrandGenRenderer,
+        hair: &'a GpuHair,
+        filtering: Filtering,
+    },
+}
+
 /// What to draw.
 pub struct PreviewScene<'a> {
     pub body_positions: &'a [[f32; 3]],
     pub body_triangles: &'a [[u32; 3]],
-    /// Strand-major vertices, `vertex_count` per strand (w unused).
-    pub strand_positions: &'a [[f32; 4]],
+    pub hair: HairSource<'a>,
+    /// Vertices per strand.
     pub vertex_count: u32,
     pub strand_width_m: f32,
     pub root_color: [f32; 3],
@@ -211,7 +233,88 @@ impl PreviewRenderer {
         scene: &PreviewScene,
         width: u32,
         height: u32,
-    ) -> Result<Vec<u8>, String> {
+    ) -> Result<Vec<u8>, PreviewError> {
+        let frame = self.encode_frame(context, scene, width, height, None)?;
+        let (width, height) = (frame.width, frame.height);
+        // Rows of a texture-to-buffer copy are padded to 256 bytes.
+        let padded_row = (width * 4).div_ceil(256) * 256;
+        let readback = context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("preview_readback"),
+            size: (padded_row * height) as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = frame.encoder;
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &frame.resolved,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        context.queue.submit([encoder.finish()]);
+        let mapped = read_buffer(context, &readback).map_err(PreviewError::Readback)?;
+        let mut pixels = Vec::with_capacity((width * height * 4) as usize);
+        for row in 0..height {
+            let start = (row * padded_row) as usize;
+            pixels.extend_from_slice(&mapped[start..start + (width * 4) as usize]);
+        }
+        Ok(pixels)
+    }
+
+    /// Renders one frame of `scene` without reading it back and measures it: GPU time of
+    /// every pass (generation and drawing) by timestamp queries where the adapter has them,
+    /// and wall time from submission to idle.
+    pub fn time_frame(
+        &self,
+        context: &GpuContext,
+        scene: &PreviewScene,
+        width: u32,
+        height: u32,
+    ) -> Result<FrameTiming, PreviewError> {
+        let passes = 1 + 2 * self.batch_count(scene);
+        let timer = PassTimer::new(context, passes);
+        let frame = self.encode_frame(context, scene, width, height, timer.as_ref())?;
+        let (wall_ms, gpu_ms) =
+            submit_timed(context, frame.encoder, timer).map_err(PreviewError::Readback)?;
+        Ok(FrameTiming {
+            gpu_ms,
+            wall_ms,
+            scratch_bytes: frame.scratch_bytes,
+        })
+    }
+
+    fn batch_count(&self, scene: &PreviewScene) -> usize {
+        match &scene.hair {
+            HairSource::Generated { hair, .. } => batches(hair.root_count).count(),
+            _ => 1,
+        }
+    }
+
+    /// Records a frame: the body (clearing), then the hair, one generation + draw pair per
+    /// batch for generated hair.
+    fn encode_frame(
+        &self,
+        context: &GpuContext,
+        scene: &PreviewScene,
+        width: u32,
+        height: u32,
+        timer: Option<&PassTimer>,
+    ) -> Result<EncodedFrame, PreviewError> {
         let device = &context.device;
         let (width, height) = (width.max(1), height.max(1));
         let view_projection = scene
@@ -271,7 +374,6 @@ impl PreviewRenderer {
                 1.0,
             ],
         };
-        let strand_count = scene.strand_positions.len() as u32 / scene.vertex_count.max(1);
         let hair_uniforms = HairUniforms {
             view_projection,
             camera_position,
@@ -287,12 +389,7 @@ impl PreviewRenderer {
                 scene.tip_color[2],
                 1.0,
             ],
-            width_counts: [
-                scene.strand_width_m,
-                strand_count as f32,
-                scene.vertex_count as f32,
-                0.0,
-            ],
+            width_counts: [scene.strand_width_m, 0.0, scene.vertex_count as f32, 0.0],
         };
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -311,27 +408,6 @@ impl PreviewRenderer {
             bytemuck::bytes_of(&hair_uniforms),
             wgpu::BufferUsages::UNIFORM,
         );
-        let placeholder = [[0.0f32; 4]];
-        let strands = if scene.strand_positions.is_empty() {
-            &placeholder[..]
-        } else {
-            scene.strand_positions
-        };
-        let strand_buffer = buffer(
-            "preview_strands",
-            bytemuck::cast_slice(strands),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let body_vertices = buffer(
-            "preview_body_vertices",
-            bytemuck::cast_slice(scene.body_positions),
-            wgpu::BufferUsages::VERTEX,
-        );
-        let body_indices = buffer(
-            "preview_body_indices",
-            bytemuck::cast_slice(scene.body_triangles),
-            wgpu::BufferUsages::INDEX,
-        );
         let body_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("preview_body"),
             layout: &self.body_layout,
@@ -340,101 +416,227 @@ impl PreviewRenderer {
                 resource: body_uniform_buffer.as_entire_binding(),
             }],
         });
-        let hair_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("preview_hair"),
-            layout: &self.hair_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: hair_uniform_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: strand_buffer.as_entire_binding(),
-                },
-            ],
-        });
-        // Rows of a texture-to-buffer copy are padded to 256 bytes.
-        let padded_row = (width * 4).div_ceil(256) * 256;
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("preview_readback"),
-            size: (padded_row * height) as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
+        let hair_group = |strands: &wgpu::Buffer| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview_hair"),
+                layout: &self.hair_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: hair_uniform_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: strands.as_entire_binding(),
+                    },
+                ],
+            })
+        };
+        let vertex_count = scene.vertex_count;
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("preview"),
         });
-        {
-            let (view, resolve_target) = match &msaa_view {
-                Some(msaa_view) => (msaa_view, Some(&resolved_view)),
-                None => (&resolved_view, None),
-            };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("preview"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: 0.02,
-                            g: 0.022,
-                            b: 0.026,
-                            a: 1.0,
+
+        // The hair's draws: (bind group, strands) per batch, generation recorded as it goes.
+        enum Draws {
+            Stored(wgpu::Buffer, usize),
+            Borrowed(usize),
+            Generated(Vec<std::ops::Range<usize>>, wgpu::Buffer),
+        }
+        let draws = match &scene.hair {
+            HairSource::Vertices(vertices) => {
+                let placeholder = [[0.0f32; 4]];
+                let data = if vertices.is_empty() {
+                    &placeholder[..]
+                } else {
+                    vertices
+                };
+                let strands = vertices.len() / vertex_count.max(1) as usize;
+                Draws::Stored(
+                    buffer(
+                        "preview_strands",
+                        bytemuck::cast_slice(data),
+                        wgpu::BufferUsages::STORAGE,
+                    ),
+                    strands,
+                )
+            }
+            HairSource::Stored { strand_count, .. } => Draws::Borrowed(*strand_count),
+            HairSource::Generated {
+                generator,
+                hair,
+                filtering,
+            } => {
+                generator
+                    .check_filtering(context, *filtering)
+                    .map_err(PreviewError::Generation)?;
+                Draws::Generated(
+                    batches(hair.root_count).collect(),
+                    generator.scratch(context, hair.root_count, vertex_count),
+                )
+            }
+        };
+        let scratch_bytes = match &draws {
+            Draws::Generated(_, scratch) => scratch.size(),
+            _ => 0,
+        };
+        let (view, resolve_view) = match &msaa_view {
+            Some(msaa_view) => (msaa_view, Some(&resolved_view)),
+            None => (&resolved_view, None),
+        };
+        // One render pass per hair batch (after its generation pass) plus the body's; the
+        // last pass resolves the multisampled target.
+        let pass_count = 1 + match &draws {
+            Draws::Generated(ranges, _) => ranges.len(),
+            _ => 1,
+        };
+        let mut pass_index = 0;
+        let mut begin_pass = |encoder: &mut wgpu::CommandEncoder| {
+            let first = pass_index == 0;
+            let last = pass_index + 1 == pass_count;
+            pass_index += 1;
+            encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("preview"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view,
+                        depth_slice: None,
+                        resolve_target: if last { resolve_view } else { None },
+                        ops: wgpu::Operations {
+                            load: if first {
+                                wgpu::LoadOp::Clear(wgpu::Color {
+                                    r: 0.02,
+                                    g: 0.022,
+                                    b: 0.026,
+                                    a: 1.0,
+                                })
+                            } else {
+                                wgpu::LoadOp::Load
+                            },
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth_view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: if first {
+                                wgpu::LoadOp::Clear(1.0)
+                            } else {
+                                wgpu::LoadOp::Load
+                            },
+                            store: if last {
+                                wgpu::StoreOp::Discard
+                            } else {
+                                wgpu::StoreOp::Store
+                            },
                         }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
+                        stencil_ops: None,
                     }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+                    timestamp_writes: timer.and_then(|t| t.render_pass()),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                })
+                // Each pass ends (drops) before the next is begun; wgpu checks this at run time.
+                .forget_lifetime()
+        };
+        let body_vertices;
+        let body_indices;
+        {
+            let mut pass = begin_pass(&mut encoder);
             if !scene.body_triangles.is_empty() {
+                body_vertices = buffer(
+                    "preview_body_vertices",
+                    bytemuck::cast_slice(scene.body_positions),
+                    wgpu::BufferUsages::VERTEX,
+                );
+                body_indices = buffer(
+                    "preview_body_indices",
+                    bytemuck::cast_slice(scene.body_triangles),
+                    wgpu::BufferUsages::INDEX,
+                );
                 pass.set_pipeline(&self.body_pipeline);
                 pass.set_bind_group(0, &body_group, &[]);
                 pass.set_vertex_buffer(0, body_vertices.slice(..));
                 pass.set_index_buffer(body_indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..scene.body_triangles.len() as u32 * 3, 0, 0..1);
             }
-            if strand_count > 0 && scene.vertex_count >= 2 {
-                pass.set_pipeline(&self.hair_pipeline);
-                pass.set_bind_group(0, &hair_group, &[]);
-                pass.draw(0..strand_count * (scene.vertex_count - 1) * 6, 0..1);
+        }
+        let segments = vertex_count.saturating_sub(1);
+        let mut draw =
+            |encoder: &mut wgpu::CommandEncoder, strands: &wgpu::Buffer, count: usize| {
+                let group = hair_group(strands);
+                let mut pass = begin_pass(encoder);
+                if count > 0 && segments > 0 {
+                    pass.set_pipeline(&self.hair_pipeline);
+                    pass.set_bind_group(0, &group, &[]);
+                    pass.draw(0..count as u32 * segments * 6, 0..1);
+                }
+            };
+        match (&draws, &scene.hair) {
+            (Draws::Stored(buffer, count), _) => draw(&mut encoder, buffer, *count),
+            (Draws::Borrowed(count), HairSource::Stored { buffer, .. }) => {
+                draw(&mut encoder, buffer, *count)
             }
-        }
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &resolved,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded_row),
-                    rows_per_image: Some(height),
+            (
+                Draws::Generated(ranges, scratch),
+                HairSource::Generated {
+                    generator,
+                    hair,
+                    filtering,
                 },
-            },
-            size,
-        );
-        context.queue.submit([encoder.finish()]);
-        let mapped = read_buffer(context, &readback)?;
-        let mut pixels = Vec::with_capacity((width * height * 4) as usize);
-        for row in 0..height {
-            let start = (row * padded_row) as usize;
-            pixels.extend_from_slice(&mapped[start..start + (width * 4) as usize]);
+            ) => {
+                for range in ranges {
+                    generator.encode(
+                        context,
+                        &mut encoder,
+                        hair,
+                        range.clone(),
+                        vertex_count,
+                        *filtering,
+                        scratch,
+                        timer.and_then(|t| t.compute_pass()),
+                    );
+                    draw(&mut encoder, scratch, range.len());
+                }
+                if ranges.is_empty() {
+                    draw(&mut encoder, scratch, 0);
+                }
+            }
+            _ => unreachable!("draws are built from the scene's source"),
         }
-        Ok(pixels)
+        Ok(EncodedFrame {
+            encoder,
+            resolved,
+            width,
+            height,
+            scratch_bytes,
+        })
     }
+}
+
+struct EncodedFrame {
+    encoder: wgpu::CommandEncoder,
+    resolved: wgpu::Texture,
+    width: u32,
+    height: u32,
+    scratch_bytes: u64,
+}
+
+/// Measured cost of one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameTiming {
+    /// Sum of every pass's GPU time; `None` without `TIMESTAMP_QUERY`.
+    pub gpu_ms: Option<f64>,
+    pub wall_ms: f64,
+    /// Transient scratch of generation (0 for stored vertices).
+    pub scratch_bytes: u64,
+}
+
+/// Why a frame could not be drawn.
+#[derive(Debug, thiserror::Error)]
+pub enum PreviewError {
+    #[error(transparent)]
+    Generation(StrandGenError),
+    #[error("reading the frame back failed: {0}")]
+    Readback(String),
 }

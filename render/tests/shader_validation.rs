@@ -60,7 +60,7 @@ fn wgsl_struct_size(module: &naga::Module, name: &str) -> Option<u32> {
 
 #[test]
 fn gpu_structs_match_their_wgsl() {
-    use hairloom_core::gpu_types::{StrandGenParams, StrandRoot};
+    use hairloom_core::gpu_types::{StrandGenParams, StrandRoot, StylingGpu};
     use hairloom_render::preview::{BODY_SHADER, BodyUniforms, HAIR_SHADER, HairUniforms};
     use hairloom_render::strand_gen::SHADER_SOURCE;
     for (source, name, rust_size) in [
@@ -70,6 +70,7 @@ fn gpu_structs_match_their_wgsl() {
             size_of::<StrandGenParams>(),
         ),
         (SHADER_SOURCE, "StrandRoot", size_of::<StrandRoot>()),
+        (SHADER_SOURCE, "Styling", size_of::<StylingGpu>()),
         (HAIR_SHADER, "HairUniforms", size_of::<HairUniforms>()),
         (BODY_SHADER, "BodyUniforms", size_of::<BodyUniforms>()),
     ] {
