@@ -1,19 +1,37 @@
-// preview_hair: camera-facing ribbons from strand vertex positions, Kajiya-Kay shading with a
-// root-to-tip colour and three lights. Strand vertices are strand-major in `positions`
-// (`vertex_count` per strand); each segment is two triangles (6 vertices).
-// Structs: keep in sync with render/src/preview.rs (`HairUniforms`).
+// preview_hair: camera-facing ribbons from strand vertices, Kajiya-Kay shading with a
+// root-to-tip colour and three lights. Vertices sit in `positions` as the batch's runs lay
+// them out (`run.vertex_offset + strand * run.vertex_count + k`, w = fraction along the
+// strand); each segment is two triangles (6 vertices). Tangents follow eq. 5-6 (ends mirror
+// their neighbour about the end segment), so shading holds when vertex LOD changes counts;
+// ribbon width grows by the run's thickness factor (eq. 8 compensation).
+// Structs: keep in sync with render/src/preview.rs (`HairUniforms`) and
+// core/src/gpu_types.rs (`StrandRun`).
 
 struct HairUniforms {
     view_projection: mat4x4<f32>,
     camera_position: vec4<f32>,
     root_color: vec4<f32>,
     tip_color: vec4<f32>,
-    // Ribbon width in model units (x), strand count (y, as f32), vertex count (z).
-    width_counts: vec4<f32>,
+    // Ribbon width in model units (x); y, z, w unused.
+    width: vec4<f32>,
+    // The batch's runs: runs[first_run .. first_run + run_count] (x, y); z, w unused.
+    batch: vec4<u32>,
+}
+
+struct StrandRun {
+    first_root: u32,
+    strand_count: u32,
+    vertex_count: u32,
+    vertex_offset: u32,
+    segment_offset: u32,
+    gamma: f32,
+    thickness: f32,
+    _padding: u32,
 }
 
 @group(0) @binding(0) var<uniform> hair: HairUniforms;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> runs: array<StrandRun>;
 
 struct VertexOutput {
     @builtin(position) clip: vec4<f32>,
@@ -22,38 +40,83 @@ struct VertexOutput {
     @location(2) along: f32,
 }
 
-fn strand_point(strand: u32, k: u32, vertex_count: u32) -> vec3<f32> {
-    return positions[strand * vertex_count + k].xyz;
+// The run holding batch segment `segment` (binary search).
+fn find_run(segment: u32) -> u32 {
+    var low = hair.batch.x;
+    var high = hair.batch.x + max(hair.batch.y, 1u) - 1u;
+    while low < high {
+        let middle = (low + high + 1u) / 2u;
+        if runs[middle].segment_offset <= segment {
+            low = middle;
+        } else {
+            high = middle - 1u;
+        }
+    }
+    return low;
+}
+
+fn safe_normalize(v: vec3<f32>) -> vec3<f32> {
+    let length_squared = dot(v, v);
+    if !(length_squared > 1e-24) {
+        return vec3<f32>(0.0);
+    }
+    return v * inverseSqrt(length_squared);
+}
+
+// Eq. 5-6 (mirror: hairloom_core::lod::tangents): inner vertices use p[k+1] − p[k−1]; an end
+// reflects its neighbour's tangent about the end segment.
+fn strand_tangent(base: u32, k: u32, n: u32) -> vec3<f32> {
+    if n == 2u {
+        return safe_normalize(positions[base + 1u].xyz - positions[base].xyz);
+    }
+    if k > 0u && k + 1u < n {
+        return safe_normalize(positions[base + k + 1u].xyz - positions[base + k - 1u].xyz);
+    }
+    var inner = 1u;
+    var end_segment = positions[base + 1u].xyz - positions[base].xyz;
+    if k > 0u {
+        inner = n - 2u;
+        end_segment = positions[base + n - 1u].xyz - positions[base + n - 2u].xyz;
+    }
+    let t = safe_normalize(positions[base + inner + 1u].xyz - positions[base + inner - 1u].xyz);
+    let q = safe_normalize(end_segment);
+    if dot(q, q) == 0.0 {
+        return t;
+    }
+    if dot(t, t) == 0.0 {
+        return q;
+    }
+    return safe_normalize(2.0 * q * dot(t, q) - t);
 }
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOutput {
-    let vertex_count = u32(hair.width_counts.z);
-    let segments = vertex_count - 1u;
-    let strand = vertex_index / (segments * 6u);
-    let in_strand = vertex_index % (segments * 6u);
-    let segment = in_strand / 6u;
+    let segment_index = vertex_index / 6u;
+    let run = runs[find_run(segment_index)];
+    let n = max(run.vertex_count, 2u);
+    let local = segment_index - run.segment_offset;
+    let strand = local / (n - 1u);
+    let segment = local % (n - 1u);
     // Two triangles: (0,0) (1,0) (0,1) / (0,1) (1,0) (1,1) as (end, side).
     var ends = array<u32, 6>(0u, 1u, 0u, 0u, 1u, 1u);
     var sides = array<f32, 6>(-1.0, -1.0, 1.0, 1.0, -1.0, 1.0);
-    let corner = in_strand % 6u;
+    let corner = vertex_index % 6u;
     let k = segment + ends[corner];
-    let p = strand_point(strand, k, vertex_count);
-    let previous = strand_point(strand, max(k, 1u) - 1u, vertex_count);
-    let next = strand_point(strand, min(k + 1u, vertex_count - 1u), vertex_count);
-    var tangent = next - previous;
-    if dot(tangent, tangent) < 1e-20 {
+    let base = run.vertex_offset + strand * n;
+    let vertex = positions[base + k];
+    let p = vertex.xyz;
+    var tangent = strand_tangent(base, k, n);
+    if dot(tangent, tangent) == 0.0 {
         tangent = vec3<f32>(0.0, 1.0, 0.0);
     }
-    tangent = normalize(tangent);
     let to_camera = hair.camera_position.xyz - p;
     var side = cross(tangent, to_camera);
     if dot(side, side) < 1e-20 {
         side = cross(tangent, vec3<f32>(0.0, 0.0, 1.0));
     }
-    let along = f32(k) / f32(vertex_count - 1u);
-    // Taper toward the tip.
-    let half_width = 0.5 * hair.width_counts.x * (1.0 - 0.6 * along);
+    let along = vertex.w;
+    // Taper toward the tip; thicker where strand LOD dropped strands.
+    let half_width = 0.5 * hair.width.x * run.thickness * (1.0 - 0.6 * along);
     let world = p + normalize(side) * sides[corner] * half_width;
     var out: VertexOutput;
     out.clip = hair.view_projection * vec4<f32>(world, 1.0);

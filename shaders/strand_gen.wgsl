@@ -8,17 +8,45 @@
 //   root uv; an op whose amplitude is zero costs nothing.
 // CPU mirror: hairloom_core::runtime::TexturePath::strand_gen (same steps; its styling
 // arithmetic is f64, this is f32).
-// Output: `positions[strand_in_batch * vertex_count + k]` = (position, along); roots start at
-// `first_strand`, so batches share one roots buffer and one bounded output buffer.
+// Roots are never stored per strand: root `i` is sample `i % per_bundle` of bundle
+// `i / per_bundle`, placed on the bundle's block (mirror: runtime::strand_root).
+// Work arrives as runs (bundle-level work: culling, strand and vertex LOD, done per frame):
+// consecutive strands of one bundle at one vertex count. Output:
+// `positions[run.vertex_offset + strand * run.vertex_count + k]` = (position, along), one
+// bounded scratch buffer per batch of runs; odd vertices morph toward their neighbours'
+// midpoint by the run's γ (eq. 11).
 // Structs: keep in sync with core/src/gpu_types.rs.
 
 struct StrandGenParams {
     position_offset: vec4<f32>,
     texture_size: vec4<u32>,
+    vertex_total: u32,
+    run_count: u32,
+    filtering: u32,
+    first_run: u32,
+    per_bundle: u32,
+    sample_set: u32,
+    _padding: vec2<u32>,
+}
+
+struct BundleGpu {
+    origin_texel: vec2<f32>,
+    layers: u32,
+    styling: u32,
+    rotation: u32,
+    triangle: u32,
+    _padding: vec2<u32>,
+}
+
+struct StrandRun {
+    first_root: u32,
     strand_count: u32,
     vertex_count: u32,
-    filtering: u32,
-    first_strand: u32,
+    vertex_offset: u32,
+    segment_offset: u32,
+    gamma: f32,
+    thickness: f32,
+    _padding: u32,
 }
 
 struct StrandRoot {
@@ -63,7 +91,7 @@ const TAU: f32 = 6.283185307179586;
 const NOISE_KEY_SPAN: f32 = 16.0;
 
 @group(0) @binding(0) var<uniform> params: StrandGenParams;
-@group(0) @binding(1) var<storage, read> roots: array<StrandRoot>;
+@group(0) @binding(1) var<storage, read> bundles: array<BundleGpu>;
 @group(0) @binding(2) var hair_mesh: texture_3d<f32>;
 @group(0) @binding(3) var linear_clamp: sampler;
 @group(0) @binding(4) var<storage, read_write> positions: array<vec4<f32>>;
@@ -72,6 +100,10 @@ const NOISE_KEY_SPAN: f32 = 16.0;
 @group(0) @binding(7) var u_texture: texture_3d<f32>;
 @group(0) @binding(8) var v_texture: texture_3d<f32>;
 @group(0) @binding(9) var<storage, read> styling: array<Styling>;
+@group(0) @binding(10) var<storage, read> runs: array<StrandRun>;
+// Progressive root samples: `sample_set` for quads (bundle-corner coordinates), then
+// `sample_set` for triangles (barycentric).
+@group(0) @binding(11) var<storage, read> samples: array<vec2<f32>>;
 
 // Trilinear filtering in f32 with textureLoad: the "exact" switch (mirror: sample_trilinear
 // with Filtering::Exact). Texel centres sit at i + 0.5; clamp to the edge.
@@ -295,41 +327,113 @@ fn twist(s: Styling, p: vec3<f32>, centre: vec3<f32>, axis: vec3<f32>, w: f32) -
     return centre + o * c + cross(axis, o) * sn + axis * dot(axis, o) * (1.0 - c);
 }
 
+// Mirror: runtime::strand_root (Atlas::sample_block_coords).
+fn strand_root(root_index: u32) -> StrandRoot {
+    let bundle = bundles[root_index / params.per_bundle];
+    let sample_index = root_index % params.per_bundle;
+    var coords: vec2<f32>;
+    var centre: vec2<f32>;
+    if bundle.triangle != 0u {
+        // Barycentric (s, t) to block coordinates (s / (1 − t), t).
+        let sample = samples[params.sample_set + sample_index];
+        let denominator = 1.0 - sample.y;
+        var s = 0.0;
+        if denominator > 0.0 {
+            s = clamp(sample.x / denominator, 0.0, 1.0);
+        }
+        coords = vec2<f32>(s, sample.y);
+        centre = vec2<f32>(0.5, 1.0 / 3.0);
+    } else {
+        // `rotation` quarter turns (s, t) ↦ (t, 1 − s).
+        coords = samples[sample_index];
+        for (var turn = 0u; turn < bundle.rotation; turn++) {
+            coords = vec2<f32>(coords.y, 1.0 - coords.x);
+        }
+        centre = vec2<f32>(0.5, 0.5);
+    }
+    var root: StrandRoot;
+    root.texel = bundle.origin_texel + coords;
+    root.centre_texel = bundle.origin_texel + centre;
+    root.layers = bundle.layers;
+    root.styling = bundle.styling;
+    return root;
+}
+
+// The run holding scratch vertex `vertex` (binary search over the batch's runs).
+fn find_run(vertex: u32) -> u32 {
+    var low = params.first_run;
+    var high = params.first_run + params.run_count - 1u;
+    while low < high {
+        let middle = (low + high + 1u) / 2u;
+        if runs[middle].vertex_offset <= vertex {
+            low = middle;
+        } else {
+            high = middle - 1u;
+        }
+    }
+    return low;
+}
+
+struct StrandInput {
+    root: StrandRoot,
+    style: Styling,
+    root_uv: vec2<f32>,
+    length_fraction: f32,
+}
+
+// Vertex k of n of a styled strand (mirror: TexturePath::styled_strand_at).
+fn styled_vertex(input: StrandInput, k: u32, n: u32) -> vec3<f32> {
+    let root = input.root;
+    let s = input.style;
+    let along = f32(k) / f32(n - 1u);
+    let tau = f32(root.layers) * input.length_fraction * along;
+    var p = strand_position(root.texel, root.layers, tau);
+    if k == 0u {
+        return p;
+    }
+    let layer_coord = vec3<f32>(root.texel, tau + 0.5);
+    let u = normalize_or(fetch(u_texture, layer_coord).xyz, vec3<f32>(1.0, 0.0, 0.0));
+    let v = normalize_or(fetch(v_texture, layer_coord).xyz, vec3<f32>(0.0, 1.0, 0.0));
+    let w_axis = normalize_or(cross(u, v), perpendicular(u));
+    let w = fetch(w_texture, layer_coord).x;
+    if s.twist_turns_per_m != 0.0 {
+        let centre = strand_position(root.centre_texel, root.layers, tau);
+        p = twist(s, p, centre, w_axis, w);
+    }
+    return p + styling_offset(s, u, v, input.root_uv, w, along);
+}
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    let index = id.x;
-    if params.vertex_count < 2u || index >= params.strand_count * params.vertex_count {
+    let vertex = id.x;
+    if params.run_count == 0u || vertex >= params.vertex_total {
         return;
     }
-    let strand = index / params.vertex_count;
-    let k = index % params.vertex_count;
-    let root = roots[params.first_strand + strand];
+    let run = runs[find_run(vertex)];
+    let n = max(run.vertex_count, 2u);
+    let local = vertex - run.vertex_offset;
+    let strand = local / n;
+    let k = local % n;
+    let root = strand_root(run.first_root + strand);
     var style_index = root.styling;
     if style_index >= arrayLength(&styling) {
         style_index = 0u;
     }
-    let s = styling[style_index];
-    let texel = root.texel;
+    var input: StrandInput;
+    input.root = root;
+    input.style = styling[style_index];
     // Root uv: always exact (it seeds every per-strand random value).
-    let root_uv = fetch_exact(uv_texture, vec3<f32>(texel, 0.5)).xy;
-    var length_fraction = 1.0;
-    if s.length_fraction > 0.0 {
-        length_fraction = 1.0 - s.length_fraction * strand_random(s, root_uv, 5u);
+    input.root_uv = fetch_exact(uv_texture, vec3<f32>(root.texel, 0.5)).xy;
+    input.length_fraction = 1.0;
+    if input.style.length_fraction > 0.0 {
+        input.length_fraction = 1.0
+            - input.style.length_fraction * strand_random(input.style, input.root_uv, 5u);
     }
-    let along = f32(k) / f32(params.vertex_count - 1u);
-    let tau = f32(root.layers) * length_fraction * along;
-    var p = strand_position(texel, root.layers, tau);
-    if k > 0u {
-        let layer_coord = vec3<f32>(texel, tau + 0.5);
-        let u = normalize_or(fetch(u_texture, layer_coord).xyz, vec3<f32>(1.0, 0.0, 0.0));
-        let v = normalize_or(fetch(v_texture, layer_coord).xyz, vec3<f32>(0.0, 1.0, 0.0));
-        let w_axis = normalize_or(cross(u, v), perpendicular(u));
-        let w = fetch(w_texture, layer_coord).x;
-        if s.twist_turns_per_m != 0.0 {
-            let centre = strand_position(root.centre_texel, root.layers, tau);
-            p = twist(s, p, centre, w_axis, w);
-        }
-        p += styling_offset(s, u, v, root_uv, w, along);
+    var p = styled_vertex(input, k, n);
+    if run.gamma > 0.0 && k % 2u == 1u && k + 1u < n {
+        // Eq. 11: odd vertices slide toward their neighbours' midpoint.
+        let middle = 0.5 * (styled_vertex(input, k - 1u, n) + styled_vertex(input, k + 1u, n));
+        p = mix(p, middle, run.gamma);
     }
-    positions[index] = vec4<f32>(p, along);
+    positions[vertex] = vec4<f32>(p, f32(k) / f32(n - 1u));
 }

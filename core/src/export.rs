@@ -298,9 +298,9 @@ impl Default for RuntimeExportOptions {
             precision: Precision::F32,
             strands_per_bundle: 64,
             lod: LodEntry {
-                alpha_strands: 1.0,
-                alpha_vertices: 1.0,
-                lambda: 0.5,
+                alpha_strands: crate::lod::DEFAULT_ALPHA_STRANDS,
+                alpha_vertices: crate::lod::DEFAULT_ALPHA_VERTICES,
+                lambda: crate::lod::DEFAULT_LAMBDA,
                 max_vertices_log2: 5,
             },
             sample_seed: 1,

@@ -13,13 +13,76 @@ pub struct StrandGenParams {
     pub position_offset: [f32; 4],
     /// Hair-mesh texture width, height, depth (w unused).
     pub texture_size: [u32; 4],
-    pub strand_count: u32,
-    /// Vertices per strand (`2^e + 1`).
-    pub vertex_count: u32,
+    /// Vertices this dispatch writes (the batch's runs together).
+    pub vertex_total: u32,
+    /// The batch's runs: `runs[first_run .. first_run + run_count]`.
+    pub run_count: u32,
     /// 0: exact (manual) filtering, 1: hardware filtering.
     pub filtering: u32,
-    /// Index of this dispatch's first strand in the roots buffer (batches share one buffer).
-    pub first_strand: u32,
+    pub first_run: u32,
+    /// Roots per bundle: root `i` is sample `i % per_bundle` of bundle `i / per_bundle`.
+    pub per_bundle: u32,
+    /// Samples per domain in the samples buffer (quads first, then triangles).
+    pub sample_set: u32,
+    pub _padding: [u32; 2],
+}
+
+/// One bundle's placement on the root slice: what the shader needs to turn a root sample into
+/// texel coordinates (mirror: `runtime::strand_root`).
+/// Keep in sync with `shaders/strand_gen.wgsl` (`BundleGpu`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BundleGpu {
+    /// Texel coordinates of block corner 0's centre (origin + 0.5).
+    pub origin_texel: [f32; 2],
+    pub layers: u32,
+    /// Index into the styling array (0 = global, `g + 1` = group `g`).
+    pub styling: u32,
+    /// Quarter turns of quad samples (`corner_of_block[0]`); triangles are never rotated.
+    pub rotation: u32,
+    /// 1 for triangles (barycentric samples), 0 for quads.
+    pub triangle: u32,
+    pub _padding: [u32; 2],
+}
+
+impl BundleGpu {
+    pub fn new(block: &crate::atlas::BundleBlock, styling: u32) -> Self {
+        let triangle = crate::atlas::Atlas::is_triangle(block);
+        Self {
+            origin_texel: [block.origin[0] as f32 + 0.5, block.origin[1] as f32 + 0.5],
+            layers: block.layers,
+            styling,
+            rotation: if triangle {
+                0
+            } else {
+                block.corner_of_block[0] as u32 % 4
+            },
+            triangle: triangle as u32,
+            _padding: [0; 2],
+        }
+    }
+}
+
+/// Consecutive strands of one bundle drawn at one vertex level of detail: the unit the
+/// bundle-level work (culling, strand and vertex LOD) hands to the strand-level work.
+/// Keep in sync with `shaders/strand_gen.wgsl` and `shaders/preview_hair.wgsl` (`StrandRun`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StrandRun {
+    /// Index of the run's first root (bundle × roots per bundle + sample).
+    pub first_root: u32,
+    pub strand_count: u32,
+    /// Vertices per strand of this run (`2^e + 1`).
+    pub vertex_count: u32,
+    /// Offset of the run's first vertex in the batch's scratch buffer.
+    pub vertex_offset: u32,
+    /// Offset of the run's first segment among the batch's segments (for drawing).
+    pub segment_offset: u32,
+    /// Eq. 12 morph factor of odd vertices toward the coarser level.
+    pub gamma: f32,
+    /// Eq. 8 width factor compensating for dropped strands.
+    pub thickness: f32,
+    pub _padding: u32,
 }
 
 /// One strand's root on the root slice.

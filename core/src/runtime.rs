@@ -256,38 +256,105 @@ impl RuntimeTextures {
         roots
     }
 
-    /// Roots of a document's bundles, each with its styling group (see
-    /// [`crate::styling::StylingSet::group_of`]).
+    /// Each block's index into the styling array for a document's styling: 0 = global,
+    /// `g + 1` = group `g` (see [`crate::styling::StylingSet::group_of`]).
+    pub fn block_styling(&self, styling: &crate::styling::StylingSet) -> Vec<u32> {
+        self.atlas
+            .blocks
+            .iter()
+            .map(|block| styling.group_of(block.bundle).map_or(0, |g| g as u32 + 1))
+            .collect()
+    }
+
+    /// Roots of a document's bundles, each with its styling index.
     pub fn document_roots(
         &self,
         styling: &crate::styling::StylingSet,
         samples: &RootSamples,
         per_bundle: usize,
     ) -> Vec<crate::gpu_types::StrandRoot> {
-        self.strand_roots(samples, per_bundle, |_, block| {
-            styling.group_of(block.bundle).map_or(0, |g| g as u32 + 1)
+        let block_styling = self.block_styling(styling);
+        self.strand_roots(samples, per_bundle, |index, _| block_styling[index])
+    }
+
+    /// The control points block `block` samples (positions plus the offset), slice by slice.
+    fn block_points(&self, block: &BundleBlock) -> impl Iterator<Item = (u32, Vec3)> + '_ {
+        let texture = &self.hair_mesh;
+        let slices = (SLICES_PER_SEGMENT * block.layers + 1).min(texture.depth);
+        let xs = block.origin[0]..(block.origin[0] + 2).min(texture.width);
+        let ys = block.origin[1]..(block.origin[1] + 2).min(texture.height);
+        (0..slices).flat_map(move |z| {
+            let xs = xs.clone();
+            ys.clone().flat_map(move |y| {
+                xs.clone()
+                    .map(move |x| (z, texture.get(x, y, z).truncate() + self.position_offset))
+            })
         })
     }
 
-    /// Bounding box of every control point the bundles' blocks sample (positions plus the
-    /// offset), from the hair-mesh texture alone: the same box for a project and for its
-    /// exported runtime bundle. `None` without bundles.
+    /// Bounding box of every control point the bundles' blocks sample, from the hair-mesh
+    /// texture alone: the same box for a project and for its exported runtime bundle. `None`
+    /// without bundles.
     pub fn hair_bounds(&self) -> Option<(Vec3, Vec3)> {
-        let texture = &self.hair_mesh;
         let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         for block in &self.atlas.blocks {
-            let slices = (SLICES_PER_SEGMENT * block.layers + 1).min(texture.depth);
-            for z in 0..slices {
-                for y in block.origin[1]..(block.origin[1] + 2).min(texture.height) {
-                    for x in block.origin[0]..(block.origin[0] + 2).min(texture.width) {
-                        let p = texture.get(x, y, z).truncate() + self.position_offset;
-                        lo = lo.min(p);
-                        hi = hi.max(p);
-                    }
-                }
+            for (_, p) in self.block_points(block) {
+                lo = lo.min(p);
+                hi = hi.max(p);
             }
         }
         (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// Per block: a bounding sphere of its control points and the length of its first
+    /// column's layer polygon — the inputs of strand and vertex LOD.
+    pub fn bundle_bounds(&self) -> Vec<crate::lod::BundleBounds> {
+        self.atlas
+            .blocks
+            .iter()
+            .map(|block| {
+                let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+                for (_, p) in self.block_points(block) {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+                let centre = (lo + hi) * 0.5;
+                let radius_m = self
+                    .block_points(block)
+                    .map(|(_, p)| p.distance(centre))
+                    .fold(0.0f32, f32::max);
+                let roots: Vec<Vec3> = self
+                    .block_points(block)
+                    .filter(|&(slice, _)| slice == 0)
+                    .map(|(_, p)| p)
+                    .collect();
+                let root_size_m = roots
+                    .iter()
+                    .flat_map(|a| roots.iter().map(move |b| a.distance(*b)))
+                    .fold(0.0f32, f32::max);
+                let (x, y) = (block.origin[0], block.origin[1]);
+                let strand_length_m = (0..block.layers)
+                    .map(|k| {
+                        let at = |layer: u32| {
+                            self.hair_mesh
+                                .get(
+                                    x,
+                                    y,
+                                    (SLICES_PER_SEGMENT * layer).min(self.hair_mesh.depth - 1),
+                                )
+                                .truncate()
+                        };
+                        at(k).distance(at(k + 1))
+                    })
+                    .sum();
+                crate::lod::BundleBounds {
+                    centre,
+                    radius_m,
+                    root_size_m,
+                    strand_length_m,
+                }
+            })
+            .collect()
     }
 
     /// Bytes the five textures take on the GPU: RGBA hair mesh, u and v (4 channels), R w,
@@ -517,28 +584,52 @@ impl TexturePath<'_> {
             .collect()
     }
 
-    /// CPU mirror of the `strand_gen` compute stage: `vertex_count` vertices of every root,
-    /// strand-major, with `styling[root.styling]` (an out-of-range index uses the global
-    /// parameters, `styling[0]`, as the shader does).
+    /// CPU mirror of the `strand_gen` compute stage for one batch: the vertices of every
+    /// run, in scratch order (`run.vertex_offset + strand · vertex_count + k`), with
+    /// `styling[root.styling]` (an out-of-range index uses `styling[0]`, as the shader does)
+    /// and eq. 11 morphing of odd vertices by the run's γ.
     pub fn strand_gen(
         &self,
         roots: &[crate::gpu_types::StrandRoot],
+        runs: &[crate::gpu_types::StrandRun],
         styling: &[&crate::styling::StylingParams],
-        vertex_count: usize,
     ) -> Vec<Vec3> {
         let default = crate::styling::StylingParams::default();
-        roots
-            .iter()
-            .flat_map(|root| {
+        let mut out = Vec::new();
+        for run in runs {
+            for strand in 0..run.strand_count {
+                let root = &roots[(run.first_root + strand) as usize];
                 let params = styling
                     .get(root.styling as usize)
                     .or(styling.first())
                     .copied()
                     .unwrap_or(&default);
-                self.styled_strand_at(root, vertex_count, params)
-            })
-            .collect()
+                let points = self.styled_strand_at(root, run.vertex_count as usize, params);
+                let mut points: Vec<DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
+                crate::lod::morph_odd_vertices(&mut points, run.gamma as f64);
+                out.extend(points.iter().map(|p| p.as_vec3()));
+            }
+        }
+        out
     }
+}
+
+/// One run over the first `root_count` roots at `vertex_count` vertices, no morphing:
+/// generation without LOD, in one batch.
+pub fn full_detail_runs(root_count: usize, vertex_count: u32) -> Vec<crate::gpu_types::StrandRun> {
+    if root_count == 0 {
+        return Vec::new();
+    }
+    vec![crate::gpu_types::StrandRun {
+        first_root: 0,
+        strand_count: root_count as u32,
+        vertex_count,
+        vertex_offset: 0,
+        segment_offset: 0,
+        gamma: 0.0,
+        thickness: 1.0,
+        _padding: 0,
+    }]
 }
 
 #[cfg(test)]

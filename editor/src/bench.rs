@@ -29,14 +29,28 @@ pub enum Which {
         #[arg(long, default_value_t = 8)]
         strands: u32,
     },
-    /// GPU strand generation (timestamp queries) at 10K / 100K / 300K strands, exact vs
-    /// hardware filtering, f32 vs f16 textures, with memory against explicit storage.
+    /// GPU strand generation and frames (timestamp queries) at 10K / 100K / 300K strands:
+    /// generation alone, frames with LOD off and on (near and far), and the same strands
+    /// drawn from a pre-generated vertex buffer (the explicit-storage baseline), exact vs
+    /// hardware filtering, f16 vs f32 textures; time and memory ratios side by side.
     Gpu {
         #[arg(long)]
         project: Option<std::path::PathBuf>,
-        /// Vertices per strand: 2^N + 1.
+        /// Vertices per strand at full detail: 2^N + 1.
         #[arg(long, default_value_t = 5)]
         vertices_log2: u32,
+        /// Strand counts to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 100_000, 300_000])]
+        strands: Vec<usize>,
+        /// Frame size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x720")]
+        size: String,
+        /// Texture precisions to measure, comma-separated (f16, f32).
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("f16"), String::from("f32")])]
+        textures: Vec<String>,
+        /// Measured runs per row after one warm-up (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
     },
     /// Styled strand vertices per second on all cores at 10K and 100K strands.
     Cpu {
@@ -57,7 +71,30 @@ pub fn run(which: Which) -> anyhow::Result<()> {
         Which::Gpu {
             project,
             vertices_log2,
-        } => gpu(project, vertices_log2.min(8)),
+            strands,
+            size,
+            textures,
+            runs,
+        } => {
+            let precisions = textures
+                .iter()
+                .map(|t| match t.as_str() {
+                    "f16" => Ok(hairloom_core::runtime::Precision::F16),
+                    "f32" => Ok(hairloom_core::runtime::Precision::F32),
+                    other => Err(anyhow::anyhow!(
+                        "--textures takes f16 and f32, not {other:?}"
+                    )),
+                })
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            gpu(
+                project,
+                vertices_log2.min(8),
+                &strands,
+                &size,
+                &precisions,
+                runs,
+            )
+        }
     }
 }
 
@@ -154,107 +191,258 @@ pub fn machine() -> String {
     format!("{model}, {cores} cores")
 }
 
-fn gpu(project: Option<std::path::PathBuf>, vertices_log2: u32) -> anyhow::Result<()> {
-    use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures};
+/// Median of `runs` measurements by wall time (after one warm-up), or the first error.
+fn median_timing<T: Copy, E>(
+    mut measure: impl FnMut() -> Result<T, E>,
+    runs: usize,
+    wall_ms: impl Fn(&T) -> f64,
+) -> Result<T, E> {
+    measure()?;
+    let mut timings = Vec::with_capacity(runs);
+    for _ in 0..runs.max(1) {
+        timings.push(measure()?);
+    }
+    timings.sort_by(|a, b| wall_ms(a).total_cmp(&wall_ms(b)));
+    Ok(timings[timings.len() / 2])
+}
+
+/// GPU milliseconds when timestamp queries exist and mean something, else wall milliseconds
+/// from submission to idle (marked `*`). A CPU adapter (lavapipe) runs passes on the same
+/// cores as everything else and its compute timestamps do not cover the work, so wall time is
+/// its true cost.
+fn gpu_or_wall(trust_timestamps: bool, gpu_ms: Option<f64>, wall_ms: f64) -> (f64, &'static str) {
+    match gpu_ms {
+        Some(ms) if ms > 0.0 && trust_timestamps => (ms, ""),
+        _ => (wall_ms, "*"),
+    }
+}
+
+fn gpu(
+    project: Option<std::path::PathBuf>,
+    vertices_log2: u32,
+    counts: &[usize],
+    size: &str,
+    precisions: &[hairloom_core::runtime::Precision],
+    runs: usize,
+) -> anyhow::Result<()> {
+    use hairloom_core::lod::LodSettings;
+    use hairloom_core::runtime::{Filtering, RootSamples, RuntimeTextures};
     use hairloom_render::device::{GpuContext, describe};
-    use hairloom_render::strand_gen::StrandGenRenderer;
+    use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, PreviewScene};
+    use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
     let path = project.unwrap_or_else(|| {
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
             .join("../assets/samples/head_long_wavy.hairloom")
     });
-    let project = hairloom_core::project::load(&path)?;
-    let mesh = &project.document.hair_mesh;
+    let (width, height) = size
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
+        .filter(|&(w, h)| w > 0 && h > 0 && w <= 8192 && h <= 8192)
+        .ok_or_else(|| anyhow::anyhow!("--size must look like 960x540"))?;
+    let document = hairloom_core::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
-    let renderer = StrandGenRenderer::new(&context);
-    let vertex_count = (1u32 << vertices_log2) + 1;
+    let generator = StrandGenRenderer::new(&context);
+    let preview = PreviewRenderer::new(&context);
+    let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
+    let styling = hairloom_core::gpu_types::styling_array(&document.styling);
+    let max_binding = context.device.limits().max_storage_buffer_binding_size;
+    let trust = !context.is_cpu();
     println!(
-        "GPU strand generation (positions from the hair-mesh texture; no styling yet): {}",
+        "GPU strand generation and drawing (styled, {vertex_count} vertices per strand at full detail): {}",
         path.display()
     );
     println!("adapter: {}", describe(&context.adapter_info));
     println!("machine: {}", machine());
     println!(
-        "{:>8} {:>8} {:>9} {:>10} {:>9} {:>11} {:>10} {:>12} {:>12} {:>8}",
-        "strands",
-        "textures",
-        "filtering",
-        "GPU ms",
-        "wall ms",
-        "M verts/s",
-        "scratch MB",
-        "textures MB",
-        "explicit MB",
-        "ratio"
+        "frame: {width}x{height}, {}× MSAA; times are GPU timestamps (* = wall time from submit to idle: no usable timestamps, e.g. a CPU adapter)",
+        preview.sample_count
     );
-    for precision in [Precision::F32, Precision::F16] {
-        let textures = RuntimeTextures::build(mesh, precision);
+    println!(
+        "{:>8} {:>4} {:>8} {:<22} {:>9} {:>9} {:>11} {:>10} {:>10} {:>9}",
+        "strands",
+        "tex",
+        "filter",
+        "mode",
+        "vertices",
+        "ms",
+        "vs stored",
+        "scratch MB",
+        "memory MB",
+        "mem ratio"
+    );
+    for &precision in precisions {
+        let textures = RuntimeTextures::build(&document.hair_mesh, precision);
         let bundles = textures.atlas.blocks.len().max(1);
-        for target in [10_000usize, 100_000, 300_000] {
+        let (lo, hi) = textures
+            .hair_bounds()
+            .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
+        let pad = (hi - lo) * 0.05;
+        let direction = glam::Vec3::new(0.75, 0.25, 1.0);
+        let near = Camera::framing(lo - pad, hi + pad, direction);
+        // The same head four times further away: what LOD is for.
+        let far = Camera {
+            eye: near.target + (near.eye - near.target) * 4.0,
+            ..near
+        };
+        for &target in counts {
             let per_bundle = target.div_ceil(bundles);
-            let samples = hairloom_core::runtime::RootSamples::progressive(
+            let samples = RootSamples::progressive(
                 hairloom_core::strands::sample_set_size(per_bundle as u32),
                 1,
             );
-            let roots = textures.document_roots(&project.document.styling, &samples, per_bundle);
-            let hair = renderer.upload(
+            let block_styling = textures.block_styling(&document.styling);
+            let hair = generator.upload(
                 &context,
                 &textures,
-                &roots,
-                &hairloom_core::gpu_types::styling_array(&project.document.styling),
+                &samples,
+                per_bundle,
+                &block_styling,
+                &styling,
             );
-            let vertices = roots.len() as f64 * vertex_count as f64;
-            // Explicit storage: every strand vertex as three f32.
-            let explicit_mb = vertices * 12.0 / 1e6;
-            let textures_mb = textures.gpu_bytes() as f64 / 1e6;
+            let full = full_detail_plan(hair.root_count, vertex_count);
+            let stored_bytes = full.vertices as u64 * 16;
+            let hair_mb = hair.bytes as f64 / 1e6;
             for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
-                let time = || renderer.time_generation(&context, &hair, vertex_count, filtering);
-                // One warm-up run (pipeline compilation, first-touch allocations), then the median of 3.
-                let _ = time();
-                let mut runs = Vec::new();
-                for _ in 0..3 {
-                    match time() {
-                        Ok(timing) => runs.push(timing),
-                        Err(error) => {
-                            println!(
-                                "{:>8} {:>8?} {:>9?}   skipped: {error}",
-                                roots.len(),
-                                precision,
-                                filtering
-                            );
-                            break;
-                        }
-                    }
-                }
-                if runs.is_empty() {
-                    continue;
-                }
-                runs.sort_by(|a, b| a.wall_ms.total_cmp(&b.wall_ms));
-                let timing = runs[runs.len() / 2];
-                let gpu_ms = timing.gpu_ms.unwrap_or(f64::NAN);
-                let rate_ms = if gpu_ms.is_finite() && gpu_ms > 0.0 {
-                    gpu_ms
+                let filter_name = if filtering == Filtering::Exact {
+                    "exact"
                 } else {
-                    timing.wall_ms
+                    "hardware"
                 };
-                println!(
-                    "{:>8} {:>8} {:>9} {:>10.2} {:>9.2} {:>11.1} {:>10.1} {:>12.3} {:>12.1} {:>7.0}×",
-                    roots.len(),
-                    format!("{precision:?}"),
-                    if filtering == Filtering::Exact {
-                        "exact"
-                    } else {
-                        "hardware"
-                    },
-                    gpu_ms,
-                    timing.wall_ms,
-                    vertices / rate_ms / 1e3,
-                    timing.scratch_bytes as f64 / 1e6,
-                    textures_mb,
-                    explicit_mb,
-                    explicit_mb / textures_mb
+                let row = |mode: &str,
+                           drawn: usize,
+                           ms: (f64, &str),
+                           versus: Option<f64>,
+                           scratch: u64,
+                           memory: f64,
+                           ratio: Option<f64>| {
+                    println!(
+                        "{:>8} {:>4} {:>8} {:<22} {:>9} {:>8.2}{:1} {:>11} {:>10.1} {:>10.2} {:>9}",
+                        hair.root_count,
+                        format!("{precision:?}"),
+                        filter_name,
+                        mode,
+                        drawn,
+                        ms.0,
+                        ms.1,
+                        versus.map_or("".into(), |v| format!("{v:.2}×")),
+                        scratch as f64 / 1e6,
+                        memory,
+                        ratio.map_or("".into(), |r| format!("{r:.0}×")),
+                    );
+                };
+                let generation = match median_timing(
+                    || generator.time_generation(&context, &hair, &full, filtering),
+                    runs,
+                    |t| t.wall_ms,
+                ) {
+                    Ok(timing) => timing,
+                    Err(error) => {
+                        println!(
+                            "{:>8} {:>4?} {:>8}   skipped: {error}",
+                            hair.root_count, precision, filter_name
+                        );
+                        continue;
+                    }
+                };
+                // The explicit-storage baseline: the same strands generated once into a
+                // persistent vertex buffer, then only drawn.
+                let stored = if stored_bytes <= max_binding {
+                    Some(generator.store(&context, &hair, &full, filtering)?)
+                } else {
+                    None
+                };
+                let scene = |hair_source, camera| PreviewScene {
+                    body_positions: &document.body.positions,
+                    body_triangles: &document.body.triangles,
+                    hair: hair_source,
+                    vertex_count,
+                    strand_width_m: (hi - lo).length() * 0.0012,
+                    root_color: [0.018, 0.008, 0.004],
+                    tip_color: [0.16, 0.075, 0.03],
+                    body_color: [0.55, 0.38, 0.30],
+                    camera,
+                };
+                let frame = |source, camera| {
+                    median_timing(
+                        || preview.time_frame(&context, &scene(source, camera), width, height),
+                        runs,
+                        |t| t.wall_ms,
+                    )
+                };
+                let stored_frame = match &stored {
+                    Some(buffer) => Some(frame(
+                        HairSource::Stored {
+                            buffer,
+                            strand_count: hair.root_count,
+                        },
+                        near,
+                    )?),
+                    None => None,
+                };
+                let stored_ms = stored_frame.map(|t| gpu_or_wall(trust, t.gpu_ms, t.wall_ms).0);
+                let explicit_mb = stored_bytes as f64 / 1e6;
+                row(
+                    "generate only",
+                    full.vertices,
+                    gpu_or_wall(trust, generation.gpu_ms, generation.wall_ms),
+                    None,
+                    generation.scratch_bytes,
+                    hair_mb,
+                    Some(explicit_mb / hair_mb),
                 );
+                for (mode, camera, enabled) in [
+                    ("frame, LOD off", near, false),
+                    ("frame, LOD on", near, true),
+                    ("frame ×4 far, LOD off", far, false),
+                    ("frame ×4 far, LOD on", far, true),
+                ] {
+                    let lod = LodSettings {
+                        enabled,
+                        ..LodSettings::default()
+                    };
+                    let timing = frame(
+                        HairSource::Generated {
+                            generator: &generator,
+                            hair: &hair,
+                            filtering,
+                            lod,
+                        },
+                        camera,
+                    )?;
+                    let ms = gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms);
+                    row(
+                        mode,
+                        timing.vertices,
+                        ms,
+                        stored_ms.map(|s| s / ms.0),
+                        timing.scratch_bytes,
+                        hair_mb,
+                        Some(explicit_mb / hair_mb),
+                    );
+                }
+                match stored_frame {
+                    Some(timing) => row(
+                        "frame, stored vertices",
+                        full.vertices,
+                        gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms),
+                        Some(1.0),
+                        0,
+                        explicit_mb,
+                        Some(1.0),
+                    ),
+                    None => println!(
+                        "{:>8} {:>4?} {:>8} {:<22} skipped: {explicit_mb:.0} MB exceeds the adapter's storage binding limit",
+                        hair.root_count, precision, filter_name, "frame, stored vertices"
+                    ),
+                }
             }
         }
     }
+    println!(
+        "vs stored: stored-vertex frame time ÷ this row's time (> 1: faster than the baseline)."
+    );
+    println!(
+        "memory: textures + roots + styling on the GPU (stored: the vertex buffer); mem ratio: stored vertex bytes ÷ this memory."
+    );
     Ok(())
 }

@@ -99,6 +99,18 @@ enum Command {
         /// Texture filtering in the generation shader.
         #[arg(long, value_enum, default_value_t = FilteringArg::Exact)]
         filtering: FilteringArg,
+        /// Draw every strand at full detail (no strand or vertex LOD).
+        #[arg(long)]
+        no_lod: bool,
+        /// Strand LOD α (eq. 7): larger keeps more strands at a distance.
+        #[arg(long, default_value_t = hairloom_core::lod::DEFAULT_ALPHA_STRANDS)]
+        alpha_strands: f64,
+        /// Vertex LOD α (eq. 7): larger keeps more vertices at a distance.
+        #[arg(long, default_value_t = hairloom_core::lod::DEFAULT_ALPHA_VERTICES)]
+        alpha_vertices: f64,
+        /// Vertex LOD morph window λ in [0, 1] (eq. 10-12); 0 switches levels abruptly.
+        #[arg(long, default_value_t = hairloom_core::lod::DEFAULT_LAMBDA)]
+        lambda: f64,
     },
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
     Adapters,
@@ -183,7 +195,18 @@ fn main() -> ExitCode {
             vertices_log2,
             precision,
             filtering,
+            no_lod,
+            alpha_strands,
+            alpha_vertices,
+            lambda,
         }) => {
+            let lod_values = [alpha_strands, alpha_vertices, lambda];
+            if lod_values.iter().any(|v| !v.is_finite() || *v < 0.0) || lambda > 1.0 {
+                eprintln!(
+                    "error: --alpha-strands and --alpha-vertices must be finite and ≥ 0, --lambda in [0, 1]"
+                );
+                return ExitCode::from(2);
+            }
             if vertices_log2 > 8 {
                 eprintln!("error: --vertices-log2 {vertices_log2} is more than 8");
                 return ExitCode::from(2);
@@ -195,6 +218,13 @@ fn main() -> ExitCode {
                 vertices_log2,
                 precision: precision.into(),
                 filtering: filtering.into(),
+                lod: hairloom_core::lod::LodSettings {
+                    enabled: !no_lod,
+                    cull: true,
+                    alpha_strands,
+                    alpha_vertices,
+                    lambda,
+                },
             };
             render::run(&input, &out, &settings)
         }

@@ -9,7 +9,8 @@ use std::path::Path;
 use anyhow::{Context, bail};
 use glam::Vec3;
 use hairloom_core::document::BodyMesh;
-use hairloom_core::gpu_types::{StrandRoot, StylingGpu, styling_array};
+use hairloom_core::gpu_types::{StylingGpu, styling_array};
+use hairloom_core::lod::LodSettings;
 use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures};
 use hairloom_core::strands::sample_set_size;
 use hairloom_render::device::{GpuContext, describe};
@@ -34,6 +35,7 @@ pub struct RenderSettings {
     /// Texture precision of a project render (a runtime bundle has its own).
     pub precision: Precision,
     pub filtering: Filtering,
+    pub lod: LodSettings,
 }
 
 impl Default for RenderSettings {
@@ -45,6 +47,7 @@ impl Default for RenderSettings {
             vertices_log2: PREVIEW_VERTICES_LOG2,
             precision: Precision::F32,
             filtering: Filtering::Exact,
+            lod: LodSettings::default(),
         }
     }
 }
@@ -84,11 +87,15 @@ pub fn parse_view(view: &str) -> anyhow::Result<Vec3> {
     })
 }
 
-/// What the GPU needs to draw a head of hair: the runtime textures, roots, styling and the
-/// opaque body. Built from a project or read from a runtime bundle.
+/// What the GPU needs to draw a head of hair: the runtime textures, root samples, each
+/// bundle's styling index, the styling array and the opaque body. Built from a project or
+/// read from a runtime bundle.
 pub struct RenderableHair {
     pub textures: RuntimeTextures,
-    pub roots: Vec<StrandRoot>,
+    pub samples: RootSamples,
+    pub per_bundle: usize,
+    /// Per atlas block: 0 = global styling, `g + 1` = group `g`.
+    pub block_styling: Vec<u32>,
     pub styling: Vec<StylingGpu>,
     pub body: BodyMesh,
 }
@@ -101,12 +108,11 @@ impl RenderableHair {
         strands_per_bundle: u32,
     ) -> Self {
         let textures = RuntimeTextures::build(&document.hair_mesh, precision);
-        let samples = RootSamples::progressive(sample_set_size(strands_per_bundle), SAMPLE_SEED);
-        let roots =
-            textures.document_roots(&document.styling, &samples, strands_per_bundle as usize);
         Self {
+            samples: RootSamples::progressive(sample_set_size(strands_per_bundle), SAMPLE_SEED),
+            per_bundle: strands_per_bundle as usize,
+            block_styling: textures.block_styling(&document.styling),
             textures,
-            roots,
             styling: styling_array(&document.styling),
             body: document.body.clone(),
         }
@@ -127,7 +133,14 @@ impl RenderableHair {
                 );
             }
             Ok(Self {
-                roots: bundle.strand_roots(per_bundle as usize),
+                samples: bundle.root_samples(),
+                per_bundle: per_bundle as usize,
+                block_styling: bundle
+                    .manifest
+                    .bundles
+                    .iter()
+                    .map(|b| (b.styling_group + 1) as u32)
+                    .collect(),
                 styling: styling_array(&bundle.manifest.styling),
                 textures: bundle.textures,
                 body: bundle.body,
@@ -152,11 +165,18 @@ pub fn render_pixels(
     width: u32,
     height: u32,
     direction: Vec3,
-    vertices_log2: u32,
-    filtering: Filtering,
+    settings: &RenderSettings,
 ) -> anyhow::Result<(Vec<u8>, String)> {
+    let (vertices_log2, filtering) = (settings.vertices_log2, settings.filtering);
     let generator = StrandGenRenderer::new(context);
-    let gpu_hair = generator.upload(context, &hair.textures, &hair.roots, &hair.styling);
+    let gpu_hair = generator.upload(
+        context,
+        &hair.textures,
+        &hair.samples,
+        hair.per_bundle,
+        &hair.block_styling,
+        &hair.styling,
+    );
     let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
     // Frame the hair (the head scan's shoulders would make it tiny), padded by a margin.
     let (lo, hi) = hair
@@ -173,6 +193,7 @@ pub fn render_pixels(
             generator: &generator,
             hair: &gpu_hair,
             filtering,
+            lod: settings.lod,
         },
         vertex_count,
         strand_width_m: (hi - lo).length() * 0.0012,
@@ -183,9 +204,13 @@ pub fn render_pixels(
         camera,
     };
     let pixels = renderer.render(context, &scene, width, height)?;
+    let plan = renderer.plan(&scene, width, height);
     let summary = format!(
-        "{width}x{height}, {} strands × {vertex_count} vertices generated on the GPU ({:?} filtering, {:?} textures), {}× MSAA, on {}",
-        hair.roots.len(),
+        "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), {}× MSAA, on {}",
+        plan.strands,
+        gpu_hair.root_count,
+        plan.vertices,
+        if settings.lod.enabled { "on" } else { "off" },
         filtering,
         hair.textures.precision,
         renderer.sample_count,
@@ -218,15 +243,7 @@ pub fn run(input: &Path, out: &Path, settings: &RenderSettings) -> anyhow::Resul
     let direction = parse_view(&settings.view)?;
     let hair = RenderableHair::load(input, settings)?;
     let context = GpuContext::new_headless()?;
-    let (pixels, summary) = render_pixels(
-        &context,
-        &hair,
-        width,
-        height,
-        direction,
-        settings.vertices_log2,
-        settings.filtering,
-    )?;
+    let (pixels, summary) = render_pixels(&context, &hair, width, height, direction, settings)?;
     write_png(out, &pixels, width, height)?;
     println!("{}: {summary}", out.display());
     Ok(())

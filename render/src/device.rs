@@ -32,6 +32,13 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
 }
 
+impl GpuContext {
+    /// Whether the adapter is a software rasteriser running on the CPU (lavapipe).
+    pub fn is_cpu(&self) -> bool {
+        self.adapter_info.device_type == wgpu::DeviceType::Cpu
+    }
+}
+
 fn instance() -> wgpu::Instance {
     wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
 }

@@ -13,7 +13,8 @@ use hairloom_core::runtime::Filtering;
 use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, PassTimer, read_buffer, submit_timed};
-use crate::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batches};
+use crate::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
+use hairloom_core::lod::{FramePlan, LodCamera, LodSettings, plan_frame};
 
 pub const HAIR_SHADER: &str = include_str!("../../shaders/preview_hair.wgsl");
 pub const BODY_SHADER: &str = include_str!("../../shaders/preview_body.wgsl");
@@ -29,8 +30,10 @@ pub struct HairUniforms {
     pub camera_position: [f32; 4],
     pub root_color: [f32; 4],
     pub tip_color: [f32; 4],
-    /// Ribbon width (x), strand count (y), vertices per strand (z), unused (w).
-    pub width_counts: [f32; 4],
+    /// Ribbon width in model units (x); y, z, w unused.
+    pub width: [f32; 4],
+    /// The batch's runs: first run (x) and run count (y); z, w unused.
+    pub batch: [u32; 4],
 }
 
 /// Keep in sync with `shaders/preview_body.wgsl` (`BodyUniforms`).
@@ -80,6 +83,7 @@ impl Camera {
 }
 
 /// Where the strand vertices of a frame come from.
+#[derive(Clone, Copy)]
 pub enum HairSource<'a> {
     /// Strand-major vertices in memory (xyz, w = fraction along the strand), uploaded for
     /// the frame: the CPU reference generator's output.
@@ -89,11 +93,13 @@ pub enum HairSource<'a> {
         buffer: &'a wgpu::Buffer,
         strand_count: usize,
     },
-    /// Generated from the runtime textures in this frame, batch by batch.
+    /// Generated from the runtime textures in this frame, batch by batch, after the
+    /// bundle-level work (culling, strand and vertex LOD) planned the frame.
     Generated {
         generator: &'a StrandGenRenderer,
         hair: &'a GpuHair,
         filtering: Filtering,
+        lod: LodSettings,
     },
 }
 
@@ -102,7 +108,7 @@ pub struct PreviewScene<'a> {
     pub body_positions: &'a [[f32; 3]],
     pub body_triangles: &'a [[u32; 3]],
     pub hair: HairSource<'a>,
-    /// Vertices per strand.
+    /// Vertices per strand at full detail (`2^e + 1`).
     pub vertex_count: u32,
     pub strand_width_m: f32,
     pub root_color: [f32; 3],
@@ -123,15 +129,15 @@ pub struct PreviewRenderer {
 impl PreviewRenderer {
     pub fn new(context: &GpuContext) -> Self {
         let device = &context.device;
-        let flags = context
-            .adapter
-            .get_texture_format_features(COLOR_FORMAT)
-            .flags;
-        let sample_count = if flags.sample_count_supported(4) {
-            4
-        } else {
-            1
-        };
+        let flags = |format| context.adapter.get_texture_format_features(format).flags;
+        let (color, depth) = (flags(COLOR_FORMAT), flags(DEPTH_FORMAT));
+        // 8× where the adapter allows it for both targets, else 4×, else none.
+        let sample_count = [8, 4]
+            .into_iter()
+            .find(|&count| {
+                color.sample_count_supported(count) && depth.sample_count_supported(count)
+            })
+            .unwrap_or(1);
         let uniform_entry = |size: usize| wgpu::BindGroupLayoutEntry {
             binding: 0,
             visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
@@ -153,6 +159,18 @@ impl PreviewRenderer {
                         ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: false,
                         min_binding_size: wgpu::BufferSize::new(16),
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::VERTEX,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(size_of::<
+                            hairloom_core::gpu_types::StrandRun,
+                        >() as u64),
                     },
                     count: None,
                 },
@@ -286,7 +304,8 @@ impl PreviewRenderer {
         width: u32,
         height: u32,
     ) -> Result<FrameTiming, PreviewError> {
-        let passes = 1 + 2 * self.batch_count(scene);
+        let plan = self.plan(scene, width, height);
+        let passes = 1 + 2 * plan.batches.len().max(1);
         let timer = PassTimer::new(context, passes);
         let frame = self.encode_frame(context, scene, width, height, timer.as_ref())?;
         let (wall_ms, gpu_ms) =
@@ -295,13 +314,39 @@ impl PreviewRenderer {
             gpu_ms,
             wall_ms,
             scratch_bytes: frame.scratch_bytes,
+            strands: plan.strands,
+            vertices: plan.vertices,
         })
     }
 
-    fn batch_count(&self, scene: &PreviewScene) -> usize {
+    /// The bundle-level work of a frame: which strands at which detail, in batches.
+    pub fn plan(&self, scene: &PreviewScene, width: u32, height: u32) -> FramePlan {
+        let (width, height) = (width.max(1), height.max(1));
         match &scene.hair {
-            HairSource::Generated { hair, .. } => batches(hair.root_count).count(),
-            _ => 1,
+            HairSource::Generated { hair, lod, .. } => {
+                let camera = LodCamera {
+                    eye: scene.camera.eye,
+                    view_projection: scene.camera.view_projection(width as f32 / height as f32),
+                    fov_y_rad: scene.camera.fov_y_rad,
+                    resolution_px: height as f32,
+                };
+                let max_log2 = scene.vertex_count.saturating_sub(1).max(1).ilog2();
+                plan_frame(
+                    &hair.bundles,
+                    hair.per_bundle,
+                    max_log2,
+                    &camera,
+                    lod,
+                    batch_vertex_limit(scene.vertex_count),
+                )
+            }
+            HairSource::Vertices(vertices) => stored_plan(
+                vertices.len() / scene.vertex_count.max(1) as usize,
+                scene.vertex_count,
+            ),
+            HairSource::Stored { strand_count, .. } => {
+                stored_plan(*strand_count, scene.vertex_count)
+            }
         }
     }
 
@@ -389,7 +434,8 @@ impl PreviewRenderer {
                 scene.tip_color[2],
                 1.0,
             ],
-            width_counts: [scene.strand_width_m, 0.0, scene.vertex_count as f32, 0.0],
+            width: [scene.strand_width_m, 0.0, 0.0, 0.0],
+            batch: [0; 4],
         };
         let buffer = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -403,11 +449,6 @@ impl PreviewRenderer {
             bytemuck::bytes_of(&body_uniforms),
             wgpu::BufferUsages::UNIFORM,
         );
-        let hair_uniform_buffer = buffer(
-            "preview_hair_uniforms",
-            bytemuck::bytes_of(&hair_uniforms),
-            wgpu::BufferUsages::UNIFORM,
-        );
         let body_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("preview_body"),
             layout: &self.body_layout,
@@ -416,34 +457,41 @@ impl PreviewRenderer {
                 resource: body_uniform_buffer.as_entire_binding(),
             }],
         });
-        let hair_group = |strands: &wgpu::Buffer| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("preview_hair"),
-                layout: &self.hair_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: hair_uniform_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: strands.as_entire_binding(),
-                    },
-                ],
-            })
+        let plan = self.plan(scene, width, height);
+        let generator_runs = match &scene.hair {
+            HairSource::Generated {
+                generator,
+                filtering,
+                ..
+            } => {
+                generator
+                    .check_filtering(context, *filtering)
+                    .map_err(PreviewError::Generation)?;
+                Some(generator.upload_runs(context, &plan))
+            }
+            _ => None,
         };
-        let vertex_count = scene.vertex_count;
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("preview"),
-        });
-
-        // The hair's draws: (bind group, strands) per batch, generation recorded as it goes.
-        enum Draws {
-            Stored(wgpu::Buffer, usize),
-            Borrowed(usize),
-            Generated(Vec<std::ops::Range<usize>>, wgpu::Buffer),
-        }
-        let draws = match &scene.hair {
+        let stored_runs;
+        let runs_buffer = match &generator_runs {
+            Some(runs) => runs,
+            None => {
+                let mut runs: Vec<_> = plan.batches.iter().flatten().copied().collect();
+                if runs.is_empty() {
+                    runs.push(Default::default());
+                }
+                stored_runs = buffer(
+                    "preview_runs",
+                    bytemuck::cast_slice(&runs),
+                    wgpu::BufferUsages::STORAGE,
+                );
+                &stored_runs
+            }
+        };
+        // Where the hair's vertices live: uploaded now, already stored, or a scratch buffer
+        // that each batch's generation overwrites.
+        let uploaded;
+        let scratch;
+        let (strands_buffer, scratch_bytes): (&wgpu::Buffer, u64) = match &scene.hair {
             HairSource::Vertices(vertices) => {
                 let placeholder = [[0.0f32; 4]];
                 let data = if vertices.is_empty() {
@@ -451,45 +499,26 @@ impl PreviewRenderer {
                 } else {
                     vertices
                 };
-                let strands = vertices.len() / vertex_count.max(1) as usize;
-                Draws::Stored(
-                    buffer(
-                        "preview_strands",
-                        bytemuck::cast_slice(data),
-                        wgpu::BufferUsages::STORAGE,
-                    ),
-                    strands,
-                )
+                uploaded = buffer(
+                    "preview_strands",
+                    bytemuck::cast_slice(data),
+                    wgpu::BufferUsages::STORAGE,
+                );
+                (&uploaded, 0)
             }
-            HairSource::Stored { strand_count, .. } => Draws::Borrowed(*strand_count),
-            HairSource::Generated {
-                generator,
-                hair,
-                filtering,
-            } => {
-                generator
-                    .check_filtering(context, *filtering)
-                    .map_err(PreviewError::Generation)?;
-                Draws::Generated(
-                    batches(hair.root_count).collect(),
-                    generator.scratch(context, hair.root_count, vertex_count),
-                )
+            HairSource::Stored { buffer, .. } => (buffer, 0),
+            HairSource::Generated { generator, .. } => {
+                scratch = generator.scratch(context, &plan);
+                (&scratch, scratch.size())
             }
-        };
-        let scratch_bytes = match &draws {
-            Draws::Generated(_, scratch) => scratch.size(),
-            _ => 0,
         };
         let (view, resolve_view) = match &msaa_view {
             Some(msaa_view) => (msaa_view, Some(&resolved_view)),
             None => (&resolved_view, None),
         };
-        // One render pass per hair batch (after its generation pass) plus the body's; the
-        // last pass resolves the multisampled target.
-        let pass_count = 1 + match &draws {
-            Draws::Generated(ranges, _) => ranges.len(),
-            _ => 1,
-        };
+        // The body's pass, then one render pass per hair batch (after its generation pass);
+        // the last pass resolves the multisampled target.
+        let pass_count = 1 + plan.batches.len().max(1);
         let mut pass_index = 0;
         let mut begin_pass = |encoder: &mut wgpu::CommandEncoder| {
             let first = pass_index == 0;
@@ -539,6 +568,9 @@ impl PreviewRenderer {
                 // Each pass ends (drops) before the next is begun; wgpu checks this at run time.
                 .forget_lifetime()
         };
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("preview"),
+        });
         let body_vertices;
         let body_indices;
         {
@@ -561,48 +593,66 @@ impl PreviewRenderer {
                 pass.draw_indexed(0..scene.body_triangles.len() as u32 * 3, 0, 0..1);
             }
         }
-        let segments = vertex_count.saturating_sub(1);
-        let mut draw =
-            |encoder: &mut wgpu::CommandEncoder, strands: &wgpu::Buffer, count: usize| {
-                let group = hair_group(strands);
-                let mut pass = begin_pass(encoder);
-                if count > 0 && segments > 0 {
-                    pass.set_pipeline(&self.hair_pipeline);
-                    pass.set_bind_group(0, &group, &[]);
-                    pass.draw(0..count as u32 * segments * 6, 0..1);
-                }
-            };
-        match (&draws, &scene.hair) {
-            (Draws::Stored(buffer, count), _) => draw(&mut encoder, buffer, *count),
-            (Draws::Borrowed(count), HairSource::Stored { buffer, .. }) => {
-                draw(&mut encoder, buffer, *count)
-            }
-            (
-                Draws::Generated(ranges, scratch),
-                HairSource::Generated {
-                    generator,
+        let mut first_run = 0;
+        for batch in &plan.batches {
+            if let HairSource::Generated {
+                generator,
+                hair,
+                filtering,
+                ..
+            } = &scene.hair
+            {
+                generator.encode(
+                    context,
+                    &mut encoder,
                     hair,
-                    filtering,
-                },
-            ) => {
-                for range in ranges {
-                    generator.encode(
-                        context,
-                        &mut encoder,
-                        hair,
-                        range.clone(),
-                        vertex_count,
-                        *filtering,
-                        scratch,
-                        timer.and_then(|t| t.compute_pass()),
-                    );
-                    draw(&mut encoder, scratch, range.len());
-                }
-                if ranges.is_empty() {
-                    draw(&mut encoder, scratch, 0);
-                }
+                    runs_buffer,
+                    first_run,
+                    batch,
+                    *filtering,
+                    strands_buffer,
+                    timer.and_then(|t| t.compute_pass()),
+                );
             }
-            _ => unreachable!("draws are built from the scene's source"),
+            let uniforms = HairUniforms {
+                batch: [first_run as u32, batch.len() as u32, 0, 0],
+                ..hair_uniforms
+            };
+            let uniform_buffer = buffer(
+                "preview_hair_uniforms",
+                bytemuck::bytes_of(&uniforms),
+                wgpu::BufferUsages::UNIFORM,
+            );
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview_hair"),
+                layout: &self.hair_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: uniform_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: strands_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: runs_buffer.as_entire_binding(),
+                    },
+                ],
+            });
+            let mut pass = begin_pass(&mut encoder);
+            let segments = FramePlan::batch_segments(batch) as u32;
+            if segments > 0 {
+                pass.set_pipeline(&self.hair_pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                pass.draw(0..segments * 6, 0..1);
+            }
+            first_run += batch.len();
+        }
+        if plan.batches.is_empty() {
+            // Nothing to draw: the resolving pass still runs.
+            drop(begin_pass(&mut encoder));
         }
         Ok(EncodedFrame {
             encoder,
@@ -630,6 +680,24 @@ pub struct FrameTiming {
     pub wall_ms: f64,
     /// Transient scratch of generation (0 for stored vertices).
     pub scratch_bytes: u64,
+    /// Strands and vertices drawn after culling and LOD.
+    pub strands: usize,
+    pub vertices: usize,
+}
+
+/// Stored vertices: one run over every strand, one batch.
+fn stored_plan(strand_count: usize, vertex_count: u32) -> FramePlan {
+    let runs = hairloom_core::runtime::full_detail_runs(strand_count, vertex_count);
+    FramePlan {
+        strands: strand_count,
+        vertices: strand_count * vertex_count as usize,
+        batches: if runs.is_empty() {
+            Vec::new()
+        } else {
+            vec![runs]
+        },
+        culled_bundles: 0,
+    }
 }
 
 /// Why a frame could not be drawn.

@@ -5,13 +5,12 @@
 //!
 //! CPU mirror: `hairloom_core::runtime::TexturePath::strand_gen`.
 
-use std::ops::Range;
-
 use hairloom_core::export::TexelFormat;
 use hairloom_core::gpu_types::{
-    FILTERING_EXACT, FILTERING_HARDWARE, StrandGenParams, StrandRoot, StylingGpu,
+    BundleGpu, FILTERING_EXACT, FILTERING_HARDWARE, StrandGenParams, StrandRun, StylingGpu,
 };
-use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures, Texture3d};
+use hairloom_core::lod::{BundleBounds, FramePlan};
+use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures, Texture3d};
 use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, read_buffer};
@@ -46,17 +45,38 @@ const WORKGROUP_SIZE: u32 = 64;
 /// vertices, under the 64 MB bound).
 pub const BATCH_STRANDS: usize = 32_768;
 
-/// Bytes of the scratch buffer for `strand_count` strands of `vertex_count` vertices: one
-/// batch at most.
-pub fn scratch_bytes(strand_count: usize, vertex_count: u32) -> u64 {
-    (BATCH_STRANDS.min(strand_count.max(1)) as u64) * vertex_count as u64 * 16
+/// Vertices of one batch: [`BATCH_STRANDS`] strands at full detail.
+pub fn batch_vertex_limit(max_vertex_count: u32) -> usize {
+    BATCH_STRANDS * max_vertex_count as usize
 }
 
-/// The strand ranges of the batches covering `strand_count` strands.
-pub fn batches(strand_count: usize) -> impl Iterator<Item = Range<usize>> {
-    (0..strand_count)
-        .step_by(BATCH_STRANDS)
-        .map(move |start| start..(start + BATCH_STRANDS).min(strand_count))
+/// Bytes of the scratch buffer `plan` needs: its largest batch (at most
+/// [`batch_vertex_limit`] vertices), 16 bytes per vertex.
+pub fn scratch_bytes(plan: &FramePlan) -> u64 {
+    let vertices = plan
+        .batches
+        .iter()
+        .map(|b| FramePlan::batch_vertices(b))
+        .max()
+        .unwrap_or(0);
+    (vertices.max(1) * 16) as u64
+}
+
+/// Every root at `vertex_count` vertices, no LOD, split into batches of [`BATCH_STRANDS`]
+/// strands: what generation without a camera does.
+pub fn full_detail_plan(root_count: usize, vertex_count: u32) -> FramePlan {
+    let mut plan = FramePlan::default();
+    for start in (0..root_count).step_by(BATCH_STRANDS) {
+        let strands = BATCH_STRANDS.min(root_count - start);
+        let mut runs = hairloom_core::runtime::full_detail_runs(strands, vertex_count);
+        for run in &mut runs {
+            run.first_root += start as u32;
+        }
+        plan.batches.push(runs);
+        plan.strands += strands;
+        plan.vertices += strands * vertex_count as usize;
+    }
+    plan
 }
 
 /// Measured cost of generating a set of strands.
@@ -73,7 +93,8 @@ pub struct GenerationTiming {
 }
 
 /// Everything generation reads, uploaded once (the game's per-asset data): the five
-/// textures, the roots and the styling array.
+/// textures, one placement per bundle, the root sample sets and the styling array. Nothing
+/// is stored per strand.
 pub struct GpuHair {
     pub precision: Precision,
     pub position_offset: [f32; 3],
@@ -83,9 +104,16 @@ pub struct GpuHair {
     w: wgpu::TextureView,
     u: wgpu::TextureView,
     v: wgpu::TextureView,
-    roots: wgpu::Buffer,
+    bundle_buffer: wgpu::Buffer,
+    samples: wgpu::Buffer,
+    sample_set: u32,
+    /// Strands at full detail: bundles × `per_bundle`.
     pub root_count: usize,
     styling: wgpu::Buffer,
+    /// Bounds of every bundle (block order) for LOD and culling.
+    pub bundles: Vec<BundleBounds>,
+    /// Roots per bundle (roots are bundle-major).
+    pub per_bundle: u32,
     /// Bytes of the textures, roots and styling on the GPU.
     pub bytes: u64,
 }
@@ -194,7 +222,7 @@ impl StrandGenRenderer {
                             ),
                         },
                     ),
-                    entry(1, storage(true, size_of::<StrandRoot>() as u64)),
+                    entry(1, storage(true, size_of::<BundleGpu>() as u64)),
                     entry(2, texture),
                     entry(3, wgpu::BindingType::Sampler(sampler_type)),
                     entry(4, storage(false, 16)),
@@ -203,6 +231,8 @@ impl StrandGenRenderer {
                     entry(7, texture),
                     entry(8, texture),
                     entry(9, storage(true, size_of::<StylingGpu>() as u64)),
+                    entry(10, storage(true, size_of::<StrandRun>() as u64)),
+                    entry(11, storage(true, 8)),
                 ],
             });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -240,13 +270,18 @@ impl StrandGenRenderer {
         }
     }
 
-    /// Uploads the five textures of `textures` (f32 or f16 as built), the strand roots and
-    /// the styling array (index 0 = global parameters).
+    /// Uploads the five textures of `textures` (f32 or f16 as built), every bundle's block
+    /// placement with its styling index (`block_styling[i]` for block `i`: 0 = global,
+    /// `g + 1` = group `g`), the first `per_bundle` root samples of each domain and the
+    /// styling array. Root `i` is then sample `i % per_bundle` of block `i / per_bundle`, as
+    /// `RuntimeTextures::strand_roots` lays roots out on the CPU.
     pub fn upload(
         &self,
         context: &GpuContext,
         textures: &RuntimeTextures,
-        roots: &[StrandRoot],
+        samples: &RootSamples,
+        per_bundle: usize,
+        block_styling: &[u32],
         styling: &[StylingGpu],
     ) -> GpuHair {
         let precision = textures.precision;
@@ -265,12 +300,29 @@ impl StrandGenRenderer {
                     usage: wgpu::BufferUsages::STORAGE,
                 })
         };
-        let placeholder_root = [StrandRoot::default()];
-        let roots_bytes: &[u8] = bytemuck::cast_slice(if roots.is_empty() {
-            &placeholder_root
-        } else {
-            roots
-        });
+        let per_bundle = per_bundle
+            .min(samples.quad.len())
+            .min(samples.triangle.len());
+        let mut bundles: Vec<BundleGpu> = textures
+            .atlas
+            .blocks
+            .iter()
+            .enumerate()
+            .map(|(i, block)| BundleGpu::new(block, block_styling.get(i).copied().unwrap_or(0)))
+            .collect();
+        let block_count = bundles.len();
+        if bundles.is_empty() {
+            bundles.push(BundleGpu::default());
+        }
+        let sample_set = per_bundle.max(1);
+        let mut sample_data: Vec<[f32; 2]> = Vec::with_capacity(2 * sample_set);
+        for set in [&samples.quad, &samples.triangle] {
+            sample_data.extend(set.iter().take(sample_set));
+            sample_data.resize(
+                sample_data.len().div_ceil(sample_set) * sample_set,
+                [0.0; 2],
+            );
+        }
         let default_styling = [StylingGpu::from(
             &hairloom_core::styling::StylingParams::default(),
         )];
@@ -279,6 +331,8 @@ impl StrandGenRenderer {
         } else {
             styling
         });
+        let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
+        let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         GpuHair {
             precision,
             position_offset: textures.position_offset.to_array(),
@@ -292,10 +346,19 @@ impl StrandGenRenderer {
             w,
             u,
             v,
-            roots: buffer("strand_gen_roots", roots_bytes),
-            root_count: roots.len(),
+            bundle_buffer: buffer("strand_gen_bundles", bundle_bytes),
+            samples: buffer("strand_gen_samples", sample_bytes),
+            sample_set: sample_set as u32,
+            root_count: block_count * per_bundle,
             styling: buffer("strand_gen_styling", styling_bytes),
-            bytes: a + b + c + d + e + roots_bytes.len() as u64 + styling_bytes.len() as u64,
+            bundles: textures.bundle_bounds(),
+            per_bundle: per_bundle as u32,
+            bytes: a
+                + b
+                + c
+                + d
+                + e
+                + (bundle_bytes.len() + sample_bytes.len() + styling_bytes.len()) as u64,
         }
     }
 
@@ -313,8 +376,23 @@ impl StrandGenRenderer {
         Ok(())
     }
 
-    /// Records the generation of strands `batch` of `hair` into `output` (which must hold
-    /// `batch.len() × vertex_count` vec4s) as one compute pass of `encoder`.
+    /// Uploads the runs of every batch of `plan`, one after another.
+    pub fn upload_runs(&self, context: &GpuContext, plan: &FramePlan) -> wgpu::Buffer {
+        let mut runs: Vec<StrandRun> = plan.batches.iter().flatten().copied().collect();
+        if runs.is_empty() {
+            runs.push(StrandRun::default());
+        }
+        context
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("strand_gen_runs"),
+                contents: bytemuck::cast_slice(&runs),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+    }
+
+    /// Records the generation of one batch (`runs[first_run..][..batch.len()]` of the uploaded
+    /// `runs` buffer, equal to `batch`) into `output` as one compute pass of `encoder`.
     #[expect(
         clippy::too_many_arguments,
         reason = "one dispatch's resources, passed through unchanged"
@@ -324,13 +402,15 @@ impl StrandGenRenderer {
         context: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         hair: &GpuHair,
-        batch: Range<usize>,
-        vertex_count: u32,
+        runs: &wgpu::Buffer,
+        first_run: usize,
+        batch: &[StrandRun],
         filtering: Filtering,
         output: &wgpu::Buffer,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
     ) {
         let device = &context.device;
+        let vertex_total = FramePlan::batch_vertices(batch) as u32;
         let params = StrandGenParams {
             position_offset: [
                 hair.position_offset[0],
@@ -344,13 +424,16 @@ impl StrandGenRenderer {
                 hair.texture_size[2],
                 0,
             ],
-            strand_count: batch.len() as u32,
-            vertex_count,
+            vertex_total,
+            run_count: batch.len() as u32,
             filtering: match filtering {
                 Filtering::Exact => FILTERING_EXACT,
                 Filtering::Hardware8Bit => FILTERING_HARDWARE,
             },
-            first_strand: batch.start as u32,
+            first_run: first_run as u32,
+            per_bundle: hair.per_bundle.max(1),
+            sample_set: hair.sample_set,
+            _padding: [0; 2],
         };
         let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("strand_gen_params"),
@@ -373,7 +456,7 @@ impl StrandGenRenderer {
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
-                    resource: hair.roots.as_entire_binding(),
+                    resource: hair.bundle_buffer.as_entire_binding(),
                 },
                 view(2, &hair.hair_mesh),
                 wgpu::BindGroupEntry {
@@ -392,6 +475,14 @@ impl StrandGenRenderer {
                     binding: 9,
                     resource: hair.styling.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 10,
+                    resource: runs.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 11,
+                    resource: hair.samples.as_entire_binding(),
+                },
             ],
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -400,54 +491,51 @@ impl StrandGenRenderer {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        let vertices = batch.len() as u64 * vertex_count as u64;
-        pass.dispatch_workgroups((vertices as u32).div_ceil(WORKGROUP_SIZE), 1, 1);
+        pass.dispatch_workgroups(vertex_total.div_ceil(WORKGROUP_SIZE), 1, 1);
     }
 
-    /// A scratch buffer for one batch of `hair`'s strands.
-    pub fn scratch(
-        &self,
-        context: &GpuContext,
-        strand_count: usize,
-        vertex_count: u32,
-    ) -> wgpu::Buffer {
+    /// A scratch buffer for the largest batch of `plan`.
+    pub fn scratch(&self, context: &GpuContext, plan: &FramePlan) -> wgpu::Buffer {
         context.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("strand_gen_scratch"),
-            size: scratch_bytes(strand_count, vertex_count),
+            size: scratch_bytes(plan),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         })
     }
 
-    /// Generates every strand in batches into one reused scratch buffer and measures the GPU
+    /// Generates every batch of `plan` into one reused scratch buffer and measures the GPU
     /// time (nothing is read back: this is the cost of generation).
     pub fn time_generation(
         &self,
         context: &GpuContext,
         hair: &GpuHair,
-        vertex_count: u32,
+        plan: &FramePlan,
         filtering: Filtering,
     ) -> Result<GenerationTiming, StrandGenError> {
         self.check_filtering(context, filtering)?;
         let device = &context.device;
-        let batches: Vec<Range<usize>> = batches(hair.root_count).collect();
-        let output = self.scratch(context, hair.root_count, vertex_count);
-        let timer = crate::device::PassTimer::new(context, batches.len());
+        let output = self.scratch(context, plan);
+        let runs = self.upload_runs(context, plan);
+        let timer = crate::device::PassTimer::new(context, plan.batches.len());
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("strand_gen_timing"),
         });
-        for batch in &batches {
+        let mut first_run = 0;
+        for batch in &plan.batches {
             let timestamp_writes = timer.as_ref().and_then(|t| t.compute_pass());
             self.encode(
                 context,
                 &mut encoder,
                 hair,
-                batch.clone(),
-                vertex_count,
+                &runs,
+                first_run,
+                batch,
                 filtering,
                 &output,
                 timestamp_writes,
             );
+            first_run += batch.len();
         }
         let (wall_ms, gpu_ms) = crate::device::submit_timed(context, encoder, timer)
             .map_err(StrandGenError::Readback)?;
@@ -455,25 +543,77 @@ impl StrandGenRenderer {
             gpu_ms,
             wall_ms,
             scratch_bytes: output.size(),
-            batches: batches.len(),
+            batches: plan.batches.len(),
         })
     }
 
-    /// Generates every strand of `hair` and reads the vertices back, strand-major:
-    /// (position, fraction along the strand).
+    /// Generates every batch of `plan` once into a persistent vertex buffer (batch after
+    /// batch): the explicit-storage baseline, which a renderer then only draws.
+    pub fn store(
+        &self,
+        context: &GpuContext,
+        hair: &GpuHair,
+        plan: &FramePlan,
+        filtering: Filtering,
+    ) -> Result<wgpu::Buffer, StrandGenError> {
+        self.check_filtering(context, filtering)?;
+        let device = &context.device;
+        let output = self.scratch(context, plan);
+        let runs = self.upload_runs(context, plan);
+        let stored = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("stored_strands"),
+            size: (plan.vertices.max(1) * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let (mut first_run, mut offset) = (0, 0u64);
+        for batch in &plan.batches {
+            let bytes = FramePlan::batch_vertices(batch) as u64 * 16;
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("strand_gen_store"),
+            });
+            self.encode(
+                context,
+                &mut encoder,
+                hair,
+                &runs,
+                first_run,
+                batch,
+                filtering,
+                &output,
+                None,
+            );
+            encoder.copy_buffer_to_buffer(&output, 0, &stored, offset, bytes);
+            context.queue.submit([encoder.finish()]);
+            first_run += batch.len();
+            offset += bytes;
+        }
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| StrandGenError::Readback(e.to_string()))?;
+        Ok(stored)
+    }
+
+    /// Generates every batch of `plan` and reads the vertices back, batch after batch in
+    /// scratch order: (position, fraction along the strand).
     pub fn generate_positions(
         &self,
         context: &GpuContext,
         hair: &GpuHair,
-        vertex_count: u32,
+        plan: &FramePlan,
         filtering: Filtering,
     ) -> Result<Vec<[f32; 4]>, StrandGenError> {
         self.check_filtering(context, filtering)?;
         let device = &context.device;
-        let output = self.scratch(context, hair.root_count, vertex_count);
-        let mut positions = Vec::with_capacity(hair.root_count * vertex_count as usize);
-        for batch in batches(hair.root_count) {
-            let bytes = batch.len() as u64 * vertex_count as u64 * 16;
+        let output = self.scratch(context, plan);
+        let runs = self.upload_runs(context, plan);
+        let mut positions = Vec::with_capacity(plan.vertices);
+        let mut first_run = 0;
+        for batch in &plan.batches {
+            let bytes = FramePlan::batch_vertices(batch) as u64 * 16;
+            if bytes == 0 {
+                continue;
+            }
             let readback = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("strand_gen_readback"),
                 size: bytes,
@@ -487,12 +627,14 @@ impl StrandGenRenderer {
                 context,
                 &mut encoder,
                 hair,
+                &runs,
+                first_run,
                 batch,
-                vertex_count,
                 filtering,
                 &output,
                 None,
             );
+            first_run += batch.len();
             encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
             context.queue.submit([encoder.finish()]);
             let data = read_buffer(context, &readback).map_err(StrandGenError::Readback)?;

@@ -60,7 +60,7 @@ fn wgsl_struct_size(module: &naga::Module, name: &str) -> Option<u32> {
 
 #[test]
 fn gpu_structs_match_their_wgsl() {
-    use hairloom_core::gpu_types::{StrandGenParams, StrandRoot, StylingGpu};
+    use hairloom_core::gpu_types::{BundleGpu, StrandGenParams, StrandRoot, StrandRun, StylingGpu};
     use hairloom_render::preview::{BODY_SHADER, BodyUniforms, HAIR_SHADER, HairUniforms};
     use hairloom_render::strand_gen::SHADER_SOURCE;
     for (source, name, rust_size) in [
@@ -71,6 +71,9 @@ fn gpu_structs_match_their_wgsl() {
         ),
         (SHADER_SOURCE, "StrandRoot", size_of::<StrandRoot>()),
         (SHADER_SOURCE, "Styling", size_of::<StylingGpu>()),
+        (SHADER_SOURCE, "BundleGpu", size_of::<BundleGpu>()),
+        (SHADER_SOURCE, "StrandRun", size_of::<StrandRun>()),
+        (HAIR_SHADER, "StrandRun", size_of::<StrandRun>()),
         (HAIR_SHADER, "HairUniforms", size_of::<HairUniforms>()),
         (BODY_SHADER, "BodyUniforms", size_of::<BodyUniforms>()),
     ] {

@@ -7,7 +7,7 @@ use hairloom_core::gpu_types::styling_array;
 use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures, TexturePath};
 use hairloom_core::styling::{StylingGroup, StylingParams, Twist};
 use hairloom_render::device::GpuContext;
-use hairloom_render::strand_gen::StrandGenRenderer;
+use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
 
 fn context() -> Option<GpuContext> {
     match GpuContext::new_headless() {
@@ -67,20 +67,23 @@ fn gpu_strands_match_the_cpu_mirror() {
             let textures = RuntimeTextures::build(mesh, precision);
             let roots = textures.document_roots(&document.styling, &samples, 6);
             assert!(roots.iter().any(|r| r.styling == 1) && roots.iter().any(|r| r.styling == 0));
-            let hair = renderer.upload(&context, &textures, &roots, &styling);
+            let block_styling = textures.block_styling(&document.styling);
+            let hair = renderer.upload(&context, &textures, &samples, 6, &block_styling, &styling);
+            assert_eq!(hair.root_count, roots.len());
             let vertex_count = 17u32;
+            let plan = full_detail_plan(roots.len(), vertex_count);
             for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
-                let positions =
-                    match renderer.generate_positions(&context, &hair, vertex_count, filtering) {
-                        Ok(positions) => positions,
-                        Err(error) => panic!("{name} {precision:?} {filtering:?}: {error}"),
-                    };
+                let positions = match renderer.generate_positions(&context, &hair, &plan, filtering)
+                {
+                    Ok(positions) => positions,
+                    Err(error) => panic!("{name} {precision:?} {filtering:?}: {error}"),
+                };
                 assert_eq!(positions.len(), roots.len() * vertex_count as usize);
                 let mirror = TexturePath {
                     textures: &textures,
                     filtering,
                 };
-                let expected = mirror.strand_gen(&roots, &params, vertex_count as usize);
+                let expected = mirror.strand_gen(&roots, &plan.batches[0], &params);
                 let mut worst = 0.0f32;
                 for (got, expected) in positions.iter().zip(&expected) {
                     let got = glam::Vec3::new(got[0], got[1], got[2]);
@@ -122,13 +125,16 @@ fn generation_runs_in_batches_with_bounded_scratch() {
     let large = textures.document_roots(&document.styling, &samples, 160);
     assert!(large.len() > BATCH_STRANDS);
     let vertex_count = 5;
-    let small_hair = renderer.upload(&context, &textures, &small, &styling);
-    let large_hair = renderer.upload(&context, &textures, &large, &styling);
+    let block_styling = textures.block_styling(&document.styling);
+    let small_hair = renderer.upload(&context, &textures, &samples, 4, &block_styling, &styling);
+    let large_hair = renderer.upload(&context, &textures, &samples, 160, &block_styling, &styling);
+    let small_plan = full_detail_plan(small.len(), vertex_count);
+    let large_plan = full_detail_plan(large.len(), vertex_count);
     let a = renderer
-        .time_generation(&context, &small_hair, vertex_count, Filtering::Exact)
+        .time_generation(&context, &small_hair, &small_plan, Filtering::Exact)
         .expect("timing");
     let b = renderer
-        .time_generation(&context, &large_hair, vertex_count, Filtering::Exact)
+        .time_generation(&context, &large_hair, &large_plan, Filtering::Exact)
         .expect("timing");
     assert_eq!((a.batches, b.batches), (1, 2));
     // Scratch is one batch, whatever the strand count.
@@ -140,7 +146,7 @@ fn generation_runs_in_batches_with_bounded_scratch() {
     // Batched read-back gives every strand once, in order: the second batch's first strand
     // is the root the first batch ended before.
     let positions = renderer
-        .generate_positions(&context, &large_hair, vertex_count, Filtering::Exact)
+        .generate_positions(&context, &large_hair, &large_plan, Filtering::Exact)
         .expect("positions");
     assert_eq!(positions.len(), large.len() * vertex_count as usize);
     let mirror = TexturePath {
@@ -148,8 +154,13 @@ fn generation_runs_in_batches_with_bounded_scratch() {
         filtering: Filtering::Exact,
     };
     let params = [&document.styling.global];
-    let boundary = &large[BATCH_STRANDS..BATCH_STRANDS + 1];
-    let expected = mirror.strand_gen(boundary, &params, vertex_count as usize);
+    let boundary = &large_plan.batches[1][..1];
+    assert_eq!(boundary[0].first_root as usize, BATCH_STRANDS);
+    let expected: Vec<_> = mirror
+        .strand_gen(&large, boundary, &params)
+        .into_iter()
+        .take(vertex_count as usize)
+        .collect();
     let got = &positions[BATCH_STRANDS * vertex_count as usize..][..vertex_count as usize];
     for (g, e) in got.iter().zip(&expected) {
         assert!(
@@ -168,4 +179,70 @@ fn generation_runs_in_batches_with_bounded_scratch() {
             "{ta} {tb}"
         );
     }
+}
+
+#[test]
+fn lod_runs_match_the_cpu_mirror_with_morphing() {
+    use hairloom_core::lod::{LodCamera, LodSettings, plan_frame};
+    let Some(context) = context() else { return };
+    let renderer = StrandGenRenderer::new(&context);
+    let document = sample("head_long_wavy");
+    let textures = RuntimeTextures::build(&document.hair_mesh, Precision::F32);
+    let styling = styling_array(&document.styling);
+    let samples = RootSamples::progressive(256, 1);
+    let roots = textures.document_roots(&document.styling, &samples, 32);
+    let block_styling = textures.block_styling(&document.styling);
+    let hair = renderer.upload(&context, &textures, &samples, 32, &block_styling, &styling);
+    // A camera far enough for partial strand counts, several vertex levels and morphing.
+    let (lo, hi) = textures.hair_bounds().expect("hair");
+    let centre = (lo + hi) * 0.5;
+    let eye = centre + glam::Vec3::new(0.0, 0.0, 6.0);
+    let fov_y_rad = 30f32.to_radians();
+    let camera = LodCamera {
+        eye,
+        view_projection: glam::Mat4::perspective_rh(fov_y_rad, 1.0, 0.01, 100.0)
+            * glam::Mat4::look_at_rh(eye, centre, glam::Vec3::Y),
+        fov_y_rad,
+        resolution_px: 1080.0,
+    };
+    // A small batch limit, so runs split across batches too.
+    // A wide morph window (λ = 1) so that many bundles sit between two vertex levels.
+    let lod = LodSettings {
+        alpha_strands: 0.02,
+        alpha_vertices: 0.005,
+        lambda: 1.0,
+        ..LodSettings::default()
+    };
+    let plan = plan_frame(&hair.bundles, 32, 5, &camera, &lod, 4000);
+    let runs: Vec<_> = plan.batches.iter().flatten().collect();
+    assert!(
+        plan.strands > 0 && plan.strands < roots.len(),
+        "{}",
+        plan.strands
+    );
+    assert!(runs.iter().any(|r| r.gamma > 0.0), "no run morphs");
+    assert!(runs.iter().any(|r| r.vertex_count < 33), "no vertex LOD");
+    assert!(plan.batches.len() > 1);
+    let positions = renderer
+        .generate_positions(&context, &hair, &plan, Filtering::Exact)
+        .expect("positions");
+    assert_eq!(positions.len(), plan.vertices);
+    let mirror = TexturePath {
+        textures: &textures,
+        filtering: Filtering::Exact,
+    };
+    let params = [&document.styling.global];
+    let expected: Vec<_> = plan
+        .batches
+        .iter()
+        .flat_map(|batch| mirror.strand_gen(&roots, batch, &params))
+        .collect();
+    let size = document.hair_mesh.size() as f32;
+    let worst = positions
+        .iter()
+        .zip(&expected)
+        .map(|(g, e)| glam::Vec3::new(g[0], g[1], g[2]).distance(*e))
+        .fold(0.0f32, f32::max);
+    eprintln!("LOD runs: max |GPU − CPU mirror| = {worst:.3e} (size {size:.3})");
+    assert!(worst <= 1e-5 * size, "{worst}");
 }
