@@ -442,7 +442,7 @@ fn gpu(
         "vs stored: stored-vertex frame time ÷ this row's time (> 1: faster than the baseline)."
     );
     println!(
-        "memory: textures + roots + styling on the GPU (stored: the vertex buffer); mem ratio: stored vertex bytes ÷ this memory."
+        "memory: textures + bundle placements + root samples + styling on the GPU (stored: the vertex buffer); mem ratio: stored vertex bytes ÷ this memory."
     );
     Ok(())
 }
