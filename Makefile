@@ -11,8 +11,11 @@ export XDG_RUNTIME_DIR ?= /tmp/hairloom-runtime
 # `make test`, which installs them.
 export HAIRLOOM_REQUIRE_GPU ?= 1
 export HAIRLOOM_REQUIRE_VALIDATORS ?= 1
+export HAIRLOOM_REQUIRE_DISPLAY ?= 1
 
 APT_PACKAGES := mesa-vulkan-drivers libvulkan1
+# A virtual X display and a screenshot tool for the editor's window smoke test.
+DISPLAY_PACKAGES := xvfb x11-apps
 # Third-party validators of the exports: Khronos glTF-Validator and ktx-parse (npm, pinned in
 # tools/validate/package-lock.json) and Pixar's USD (PyPI usd-core) in a private venv.
 VALIDATE_VENV := target/validate-venv
@@ -42,6 +45,10 @@ gpu-deps:
 
 # gpu-deps plus the export validators.
 deps: gpu-deps
+	@missing=""; for p in $(DISPLAY_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ] && command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
+	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; \
+	fi
 	@tools=""; command -v npm >/dev/null || tools="$$tools nodejs npm"; \
 	python3 -c 'import venv, ensurepip' 2>/dev/null || tools="$$tools python3-venv"; \
 	if [ -n "$$tools" ] && command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
@@ -53,14 +60,19 @@ deps: gpu-deps
 
 RENDER_OUT ?= out/$(notdir $(SAMPLE:.hairloom=.png))
 
-# The interactive editor is not built yet: render the sample headless (software Vulkan when
-# there is no GPU) and say where the picture is.
+# With a display: the editor on the bundled sample. Without one: render the sample headless
+# (software Vulkan when there is no GPU) and say where the picture is.
 run: toolchain gpu-deps
 	$(CARGO) build --release -p hairloom-editor
-	./target/release/hairloom check $(SAMPLE)
-	./target/release/hairloom info $(SAMPLE)
-	./target/release/hairloom render $(SAMPLE) --out $(RENDER_OUT)
-	@echo "Rendered $(SAMPLE) to $(RENDER_OUT)"
+	@if [ -n "$$DISPLAY$$WAYLAND_DISPLAY" ]; then \
+	  ./target/release/hairloom $(SAMPLE); \
+	else \
+	  echo "no display: rendering $(SAMPLE) headless"; \
+	  ./target/release/hairloom check $(SAMPLE) && \
+	  ./target/release/hairloom info $(SAMPLE) && \
+	  ./target/release/hairloom render $(SAMPLE) --out $(RENDER_OUT) && \
+	  echo "Rendered $(SAMPLE) to $(RENDER_OUT)"; \
+	fi
 
 test: toolchain deps
 	$(CARGO) test --workspace --all-targets

@@ -195,6 +195,7 @@ impl DocumentDiff {
             && self.columns.is_empty()
             && self.w_mode.is_none()
             && self.name.is_none()
+            && self.styling.is_none()
     }
 
     fn write(&self, document: &mut Document, forward: bool) -> Result<(), HistoryMismatch> {
@@ -245,6 +246,13 @@ impl DocumentDiff {
         }
         if let Some(swap) = &self.name {
             document.name = if forward {
+                swap.after.clone()
+            } else {
+                swap.before.clone()
+            };
+        }
+        if let Some(swap) = &self.styling {
+            document.styling = if forward {
                 swap.after.clone()
             } else {
                 swap.before.clone()

@@ -228,7 +228,7 @@ fn gpu(
     use hairloom_core::lod::LodSettings;
     use hairloom_core::runtime::{Filtering, RootSamples, RuntimeTextures};
     use hairloom_render::device::{GpuContext, describe};
-    use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, PreviewScene};
+    use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
     use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
     let path = project.unwrap_or_else(|| {
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -351,16 +351,14 @@ fn gpu(
                 } else {
                     None
                 };
-                let scene = |hair_source, camera| PreviewScene {
-                    body_positions: &document.body.positions,
-                    body_triangles: &document.body.triangles,
-                    hair: hair_source,
-                    vertex_count,
-                    strand_width_m: (hi - lo).length() * 0.0012,
-                    root_color: [0.018, 0.008, 0.004],
-                    tip_color: [0.16, 0.075, 0.03],
-                    body_color: [0.55, 0.38, 0.30],
-                    camera,
+                let scene = |hair_source, camera| {
+                    hairloom_editor::render::default_scene(
+                        &document.body,
+                        hair_source,
+                        vertex_count,
+                        (lo, hi),
+                        camera,
+                    )
                 };
                 let frame = |source, camera| {
                     median_timing(

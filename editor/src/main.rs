@@ -15,7 +15,8 @@ use hairloom_core::runtime::{Filtering, Precision};
 mod accuracy;
 mod bench;
 mod export;
-mod render;
+
+use hairloom_editor::render;
 
 #[derive(Parser)]
 #[command(
@@ -23,7 +24,10 @@ mod render;
     version,
     about = "Hair-mesh modeling and styling editor"
 )]
+#[command(args_conflicts_with_subcommands = true)]
 struct Cli {
+    /// A project to open in the editor (without one, the editor opens a bundled sample).
+    file: Option<PathBuf>,
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -156,12 +160,7 @@ impl From<FilteringArg> for Filtering {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => {
-            eprintln!(
-                "The interactive editor is not built yet; use a subcommand (see `hairloom --help`)."
-            );
-            return ExitCode::from(2);
-        }
+        None => return editor(cli.file.as_deref()),
         Some(Command::Check { file }) => return check(&file),
         Some(Command::Info { file, json }) => info(&file, json),
         Some(Command::Import {
@@ -235,6 +234,41 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             eprintln!("error: {error:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Opens the interactive editor on `file`, or on the embedded sample.
+fn editor(file: Option<&Path>) -> ExitCode {
+    use hairloom_editor::app::{EditorState, HairloomApp};
+    let state = match file {
+        Some(path) => match EditorState::open(path) {
+            Ok(state) => state,
+            Err(error) => {
+                eprintln!("error: {error}");
+                return ExitCode::from(2);
+            }
+        },
+        None => EditorState::sample(),
+    };
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([1400.0, 900.0])
+            .with_title(state.title()),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    match eframe::run_native(
+        "Hairloom",
+        options,
+        Box::new(|cc| Ok(Box::new(HairloomApp::new(cc, state)))),
+    ) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!(
+                "error: cannot open the editor window: {error}\n(no display? `hairloom render FILE --out PICTURE.png` works headless)"
+            );
             ExitCode::from(2)
         }
     }

@@ -158,6 +158,29 @@ impl RenderableHair {
     }
 }
 
+/// The look every Hairloom picture shares (renders, the editor's viewport, benchmarks):
+/// brown strands a little over a thousandth of the hair's size wide, a skin-toned body.
+pub fn default_scene<'a>(
+    body: &'a BodyMesh,
+    hair: HairSource<'a>,
+    vertex_count: u32,
+    (lo, hi): (Vec3, Vec3),
+    camera: Camera,
+) -> PreviewScene<'a> {
+    PreviewScene {
+        body_positions: &body.positions,
+        body_triangles: &body.triangles,
+        hair,
+        vertex_count,
+        strand_width_m: (hi - lo).length() * 0.0012,
+        // Linear colours (the target is sRGB): dark brown roots, lighter tips.
+        root_color: [0.018, 0.008, 0.004],
+        tip_color: [0.16, 0.075, 0.03],
+        body_color: [0.55, 0.38, 0.30],
+        camera,
+    }
+}
+
 /// Draws `hair` seen from `direction`; returns RGBA8 pixels and a one-line description.
 pub fn render_pixels(
     context: &GpuContext,
@@ -186,23 +209,18 @@ pub fn render_pixels(
     let pad = (hi - lo) * 0.05;
     let camera = Camera::framing(lo - pad, hi + pad, direction);
     let renderer = PreviewRenderer::new(context);
-    let scene = PreviewScene {
-        body_positions: &hair.body.positions,
-        body_triangles: &hair.body.triangles,
-        hair: HairSource::Generated {
+    let scene = default_scene(
+        &hair.body,
+        HairSource::Generated {
             generator: &generator,
             hair: &gpu_hair,
             filtering,
             lod: settings.lod,
         },
         vertex_count,
-        strand_width_m: (hi - lo).length() * 0.0012,
-        // Linear colours (the target is sRGB): dark brown roots, lighter tips.
-        root_color: [0.018, 0.008, 0.004],
-        tip_color: [0.16, 0.075, 0.03],
-        body_color: [0.55, 0.38, 0.30],
+        (lo, hi),
         camera,
-    };
+    );
     let pixels = renderer.render(context, &scene, width, height)?;
     let plan = renderer.plan(&scene, width, height);
     let summary = format!(

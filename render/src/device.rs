@@ -33,6 +33,16 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
+    /// Wraps a device someone else created (the editor's window, through eframe).
+    pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        Self {
+            adapter_info: adapter.get_info(),
+            adapter,
+            device,
+            queue,
+        }
+    }
+
     /// Whether the adapter is a software rasteriser running on the CPU (lavapipe).
     pub fn is_cpu(&self) -> bool {
         self.adapter_info.device_type == wgpu::DeviceType::Cpu

@@ -127,6 +127,10 @@ pub struct PreviewRenderer {
 }
 
 impl PreviewRenderer {
+    /// The non-sRGB view format of a [`Self::render_texture`] result: sampling it returns the
+    /// sRGB-encoded bytes, which is what egui composites.
+    pub const UI_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
     pub fn new(context: &GpuContext) -> Self {
         let device = &context.device;
         let flags = |format| context.adapter.get_texture_format_features(format).flags;
@@ -294,6 +298,20 @@ impl PreviewRenderer {
         Ok(pixels)
     }
 
+    /// Renders `scene` into a new `width × height` sRGB texture that can be sampled (an
+    /// editor viewport shows it); the work is submitted, not waited for.
+    pub fn render_texture(
+        &self,
+        context: &GpuContext,
+        scene: &PreviewScene,
+        width: u32,
+        height: u32,
+    ) -> Result<wgpu::Texture, PreviewError> {
+        let frame = self.encode_frame(context, scene, width, height, None)?;
+        context.queue.submit([frame.encoder.finish()]);
+        Ok(frame.resolved)
+    }
+
     /// Renders one frame of `scene` without reading it back and measures it: GPU time of
     /// every pass (generation and drawing) by timestamp queries where the adapter has them,
     /// and wall time from submission to idle.
@@ -372,6 +390,9 @@ impl PreviewRenderer {
             height,
             depth_or_array_layers: 1,
         };
+        // The colour target may also be viewed without the sRGB suffix: UIs that composite
+        // gamma-encoded bytes (egui) sample it that way (see `PreviewRenderer::UI_VIEW_FORMAT`).
+        let ui_view = [Self::UI_VIEW_FORMAT];
         let target =
             |label: &str, format: wgpu::TextureFormat, samples: u32, usage: wgpu::TextureUsages| {
                 device.create_texture(&wgpu::TextureDescriptor {
@@ -382,14 +403,20 @@ impl PreviewRenderer {
                     dimension: wgpu::TextureDimension::D2,
                     format,
                     usage,
-                    view_formats: &[],
+                    view_formats: if format == COLOR_FORMAT && samples == 1 {
+                        &ui_view
+                    } else {
+                        &[]
+                    },
                 })
             };
         let resolved = target(
             "preview_color",
             COLOR_FORMAT,
             1,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let msaa = (self.sample_count > 1).then(|| {
             target(

@@ -413,3 +413,22 @@ fn mismatched_history_is_an_error_not_corruption() {
     );
     assert_eq!(history.undo.len(), 1, "the step stays available");
 }
+
+#[test]
+fn a_styling_only_change_is_recorded_and_undone() {
+    // Regression: a diff that changed only the styling counted as empty, so styling edits
+    // were silently left out of the history.
+    let document = hairloom_core::project::load(&hairloom_tests::sample_paths()[0])
+        .expect("sample")
+        .document;
+    let mut after = document.clone();
+    after.styling.global.wave.amplitude_m += 0.01;
+    let command = Command::record("wave", &document, &after).expect("recorded");
+    let mut history = History::default();
+    history.push(command);
+    let mut current = after.clone();
+    history.undo(&mut current).expect("undo");
+    assert_eq!(current, document);
+    history.redo(&mut current).expect("redo");
+    assert_eq!(current, after);
+}

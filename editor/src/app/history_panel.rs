@@ -1,0 +1,40 @@
+//! History panel: every command of the project's history, oldest first; clicking one undoes
+//! or redoes to just after it ("Original" goes back to the start). Redo entries are greyed.
+
+use super::state::EditorState;
+
+#[derive(Default)]
+pub struct HistoryPanel;
+
+impl HistoryPanel {
+    pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
+        ui.heading("History");
+        let history = &state.project.history;
+        let applied = history.undo.len();
+        let labels: Vec<String> = history
+            .undo
+            .iter()
+            .chain(history.redo.iter().rev())
+            .map(|c| c.label().to_string())
+            .collect();
+        let mut jump = None;
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            if ui.selectable_label(applied == 0, "Original").clicked() {
+                jump = Some(0);
+            }
+            for (i, label) in labels.iter().enumerate() {
+                let text = if i < applied {
+                    egui::RichText::new(label)
+                } else {
+                    egui::RichText::new(label).weak()
+                };
+                if ui.selectable_label(applied == i + 1, text).clicked() {
+                    jump = Some(i + 1);
+                }
+            }
+        });
+        if let Some(position) = jump.filter(|&p| p != applied) {
+            state.jump_to(position);
+        }
+    }
+}

@@ -1,0 +1,203 @@
+//! The editor's model: the project (document + history), where it lives on disk, and the
+//! edit in progress. No egui here — panels call these methods, tests call them directly.
+//!
+//! Every change to the document goes through a [`Transaction`], so every change is one undo
+//! step: a slider drag is begun on the first movement and committed on release.
+
+use std::path::{Path, PathBuf};
+
+use hairloom_core::document::Document;
+use hairloom_core::history::Transaction;
+use hairloom_core::project::{self, Project};
+
+/// The sample the editor opens with no file, embedded so it works from any folder.
+const SAMPLE_PROJECT: &[u8] = include_bytes!("../../../assets/samples/head_long_wavy.hairloom");
+const SAMPLE_NAME: &str = "head_long_wavy.hairloom (sample)";
+
+pub struct EditorState {
+    pub project: Project,
+    /// Where Save writes; `None` for the embedded sample until Save As.
+    pub path: Option<PathBuf>,
+    /// The document as last loaded or saved (unsaved changes = differs from it).
+    saved: Document,
+    edit: Option<Transaction>,
+    /// Increments whenever the document changes (the viewport rebuilds its GPU data).
+    pub revision: u64,
+    /// The last message for the status bar (errors included).
+    pub message: String,
+}
+
+impl EditorState {
+    fn with_project(project: Project, path: Option<PathBuf>, message: String) -> Self {
+        Self {
+            saved: project.document.clone(),
+            project,
+            path,
+            edit: None,
+            revision: 0,
+            message,
+        }
+    }
+
+    /// The embedded sample project.
+    pub fn sample() -> Self {
+        let project = project::from_bytes(SAMPLE_PROJECT, Path::new(SAMPLE_NAME))
+            .expect("the embedded sample is a valid project (checked by `make test`)");
+        Self::with_project(project, None, format!("opened {SAMPLE_NAME}"))
+    }
+
+    /// Opens a project file; the error names the file and the problem.
+    pub fn open(path: &Path) -> Result<Self, project::ProjectError> {
+        let project = project::load(path)?;
+        Ok(Self::with_project(
+            project,
+            Some(path.to_path_buf()),
+            format!("opened {}", path.display()),
+        ))
+    }
+
+    pub fn document(&self) -> &Document {
+        &self.project.document
+    }
+
+    /// Title for the window and the status bar.
+    pub fn title(&self) -> String {
+        let name = self
+            .path
+            .as_deref()
+            .and_then(Path::file_name)
+            .map_or(SAMPLE_NAME.to_string(), |n| {
+                n.to_string_lossy().into_owned()
+            });
+        format!(
+            "{}{name} — Hairloom",
+            if self.is_dirty() { "● " } else { "" }
+        )
+    }
+
+    pub fn is_dirty(&self) -> bool {
+        self.project.document != self.saved
+    }
+
+    /// Starts an edit (one undo step) unless one is running; returns the document to change.
+    pub fn edit(&mut self, label: &str) -> &mut Document {
+        if self.edit.is_none() {
+            self.edit = Some(Transaction::begin(&self.project.document, label));
+        }
+        self.revision += 1;
+        &mut self.project.document
+    }
+
+    /// Ends the running edit: one command in the history if anything changed.
+    pub fn commit_edit(&mut self) {
+        if let Some(edit) = self.edit.take() {
+            edit.commit(&mut self.project.history, &self.project.document);
+        }
+    }
+
+    pub fn can_undo(&self) -> bool {
+        !self.project.history.undo.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.project.history.redo.is_empty()
+    }
+
+    pub fn undo(&mut self) {
+        self.commit_edit();
+        match self.project.history.undo(&mut self.project.document) {
+            Ok(Some(label)) => self.changed(format!("undid {label}")),
+            Ok(None) => self.message = "nothing to undo".into(),
+            Err(error) => self.message = format!("undo failed: {error}"),
+        }
+    }
+
+    pub fn redo(&mut self) {
+        self.commit_edit();
+        match self.project.history.redo(&mut self.project.document) {
+            Ok(Some(label)) => self.changed(format!("redid {label}")),
+            Ok(None) => self.message = "nothing to redo".into(),
+            Err(error) => self.message = format!("redo failed: {error}"),
+        }
+    }
+
+    /// Undoes or redoes until `position` commands are applied.
+    pub fn jump_to(&mut self, position: usize) {
+        self.commit_edit();
+        match self
+            .project
+            .history
+            .jump_to(&mut self.project.document, position)
+        {
+            Ok(()) => self.changed(format!("history step {position}")),
+            Err(error) => self.message = format!("history jump failed: {error}"),
+        }
+    }
+
+    fn changed(&mut self, message: String) {
+        self.revision += 1;
+        self.message = message;
+    }
+
+    /// Saves to the current path (Save As for the embedded sample).
+    pub fn save(&mut self) -> Result<PathBuf, String> {
+        let Some(path) = self.path.clone() else {
+            return Err("the sample has no file yet: use Save As".into());
+        };
+        self.save_as(&path)
+    }
+
+    pub fn save_as(&mut self, path: &Path) -> Result<PathBuf, String> {
+        self.commit_edit();
+        match project::save(path, &self.project) {
+            Ok(()) => {
+                self.path = Some(path.to_path_buf());
+                self.saved = self.project.document.clone();
+                self.message = format!("saved {}", path.display());
+                Ok(path.to_path_buf())
+            }
+            Err(error) => {
+                self.message = format!("save failed: {error}");
+                Err(self.message.clone())
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_edit_is_one_undo_step_and_undo_restores_the_document() {
+        let mut state = EditorState::sample();
+        let original = state.document().clone();
+        for step in 1..=5 {
+            state.edit("curl").styling.global.curl.radius_m = 0.001 * step as f64;
+        }
+        state.commit_edit();
+        assert!(state.is_dirty());
+        assert_eq!(state.project.history.undo.len(), 1);
+        state.undo();
+        assert_eq!(state.document(), &original);
+        assert!(!state.is_dirty());
+        state.redo();
+        assert_eq!(state.document().styling.global.curl.radius_m, 0.005);
+    }
+
+    #[test]
+    fn save_and_reopen_round_trips_and_clears_dirty() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut state = EditorState::sample();
+        assert!(state.save().is_err(), "the sample needs Save As");
+        state.edit("wave").styling.global.wave.amplitude_m = 0.02;
+        state.commit_edit();
+        let path = dir.path().join("styled.hairloom");
+        state.save_as(&path).expect("save");
+        assert!(!state.is_dirty());
+        let reopened = EditorState::open(&path).expect("open");
+        assert_eq!(reopened.project, state.project);
+        let bad = dir.path().join("missing.hairloom");
+        assert!(EditorState::open(&bad).is_err());
+    }
+}

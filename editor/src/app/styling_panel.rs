@@ -1,0 +1,242 @@
+//! Styling panel: every op's parameters as sliders (with numeric entry by dragging or
+//! double-click), for the global parameters or one styling group. A slider drag is one undo
+//! step; keyboard and typed changes commit at once.
+
+use hairloom_core::styling::StylingParams;
+
+use super::state::EditorState;
+
+type Field = fn(&mut StylingParams) -> &mut f64;
+
+/// One slider: label, field, range, unit suffix.
+type SliderSpec = (&'static str, Field, (f64, f64), &'static str);
+
+/// Every slider, grouped by op.
+const OPS: &[(&str, &[SliderSpec])] = &[
+    (
+        "Curl",
+        &[
+            ("Curl radius", |p| &mut p.curl.radius_m, (0.0, 0.03), " m"),
+            (
+                "Curl turns",
+                |p| &mut p.curl.turns_per_m,
+                (0.0, 80.0),
+                " /m",
+            ),
+            ("Curl ramp-in", |p| &mut p.curl.ramp_in_m, (0.0, 0.2), " m"),
+            (
+                "Curl radius jitter",
+                |p| &mut p.curl.radius_jitter,
+                (0.0, 1.0),
+                "",
+            ),
+        ],
+    ),
+    (
+        "Twist",
+        &[(
+            "Twist turns",
+            |p| &mut p.twist.turns_per_m,
+            (-20.0, 20.0),
+            " /m",
+        )],
+    ),
+    (
+        "Noise",
+        &[
+            (
+                "Noise amplitude",
+                |p| &mut p.noise.amplitude_m,
+                (0.0, 0.03),
+                " m",
+            ),
+            (
+                "Noise frequency",
+                |p| &mut p.noise.frequency_per_m,
+                (0.0, 100.0),
+                " /m",
+            ),
+        ],
+    ),
+    (
+        "Clump",
+        &[
+            ("Clump strength", |p| &mut p.clump.strength, (0.0, 1.0), ""),
+            (
+                "Clumps per uv",
+                |p| &mut p.clump.clumps_per_uv,
+                (1.0, 200.0),
+                "",
+            ),
+            ("Clump radius", |p| &mut p.clump.radius_m, (0.0, 0.05), " m"),
+            (
+                "Clump tightening",
+                |p| &mut p.clump.tightening,
+                (0.0, 5.0),
+                "",
+            ),
+        ],
+    ),
+    (
+        "Frizz",
+        &[
+            (
+                "Frizz amplitude",
+                |p| &mut p.frizz.amplitude_m,
+                (0.0, 0.01),
+                " m",
+            ),
+            (
+                "Frizz frequency",
+                |p| &mut p.frizz.frequency_per_m,
+                (0.0, 400.0),
+                " /m",
+            ),
+            ("Frizz fraction", |p| &mut p.frizz.fraction, (0.0, 1.0), ""),
+        ],
+    ),
+    (
+        "Wave",
+        &[
+            (
+                "Wave amplitude",
+                |p| &mut p.wave.amplitude_m,
+                (0.0, 0.05),
+                " m",
+            ),
+            (
+                "Wave frequency",
+                |p| &mut p.wave.frequency_per_m,
+                (0.0, 40.0),
+                " /m",
+            ),
+            (
+                "Wave direction",
+                |p| &mut p.wave.direction_rad,
+                (-3.2, 3.2),
+                " rad",
+            ),
+            (
+                "Wave phase spread",
+                |p| &mut p.wave.phase_spread,
+                (0.0, 1.0),
+                "",
+            ),
+        ],
+    ),
+    (
+        "Length",
+        &[(
+            "Length variation",
+            |p| &mut p.length.fraction,
+            (0.0, 1.0),
+            "",
+        )],
+    ),
+    (
+        "Variation",
+        &[(
+            "Variation cells per uv",
+            |p| &mut p.variation_per_uv,
+            (1.0, 1000.0),
+            "",
+        )],
+    ),
+];
+
+#[derive(Default)]
+pub struct StylingPanel {
+    /// `None`: global parameters; `Some(g)`: styling group `g`.
+    pub group: Option<usize>,
+}
+
+impl StylingPanel {
+    pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
+        ui.heading("Styling");
+        let groups: Vec<String> = state
+            .document()
+            .styling
+            .groups
+            .iter()
+            .map(|g| g.name.clone())
+            .collect();
+        if self.group.is_some_and(|g| g >= groups.len()) {
+            self.group = None;
+        }
+        egui::ComboBox::from_label("Parameters of")
+            .selected_text(self.group.map_or("all bundles (global)".into(), |g| {
+                format!("group {}", groups[g])
+            }))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut self.group, None, "all bundles (global)");
+                for (g, name) in groups.iter().enumerate() {
+                    ui.selectable_value(&mut self.group, Some(g), format!("group {name}"));
+                }
+            });
+        let group = self.group;
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            for (op, fields) in OPS {
+                egui::CollapsingHeader::new(*op)
+                    .default_open(true)
+                    .show(ui, |ui| {
+                        for (label, field, (lo, hi), suffix) in fields.iter() {
+                            let mut current = selected(state, group).clone();
+                            let mut value = *field(&mut current);
+                            let response = ui.add(
+                                egui::Slider::new(&mut value, *lo..=*hi)
+                                    .text(*label)
+                                    .suffix(*suffix)
+                                    .clamping(egui::SliderClamping::Never),
+                            );
+                            if response.changed() && value.is_finite() {
+                                let document = state.edit(&format!("set {label}"));
+                                *field(params_mut(document, group)) = value;
+                                if let Err(error) = document.styling.validate() {
+                                    // Out of range (typed): put the old value back.
+                                    *field(params_mut(document, group)) = *field(&mut current);
+                                    state.message = error;
+                                }
+                            }
+                            commit_when_done(state, &response);
+                        }
+                    });
+            }
+            ui.horizontal(|ui| {
+                let mut seed = selected(state, group).seed;
+                let label = ui.label("Seed");
+                let response = ui
+                    .add(egui::DragValue::new(&mut seed))
+                    .labelled_by(label.id);
+                if response.changed() {
+                    params_mut(state.edit("set seed"), group).seed = seed;
+                }
+                commit_when_done(state, &response);
+            });
+        });
+    }
+}
+
+/// A drag is one undo step (committed on release); clicks, keys and typed values commit at
+/// once.
+fn commit_when_done(state: &mut EditorState, response: &egui::Response) {
+    if response.drag_stopped() || (response.changed() && !response.dragged()) {
+        state.commit_edit();
+    }
+}
+
+fn params_mut(
+    document: &mut hairloom_core::document::Document,
+    group: Option<usize>,
+) -> &mut StylingParams {
+    match group {
+        Some(g) => &mut document.styling.groups[g].params,
+        None => &mut document.styling.global,
+    }
+}
+
+fn selected(state: &EditorState, group: Option<usize>) -> &StylingParams {
+    match group {
+        Some(g) => &state.document().styling.groups[g].params,
+        None => &state.document().styling.global,
+    }
+}

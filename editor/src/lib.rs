@@ -1,0 +1,5 @@
+//! The Hairloom editor: the interactive app (`app`) and the headless render path it shares
+//! with the `hairloom render` command (`render`).
+
+pub mod app;
+pub mod render;
