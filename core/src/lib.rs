@@ -17,6 +17,7 @@ pub mod import;
 pub mod interior;
 pub mod lod;
 pub mod mesh;
+pub mod pick;
 pub mod project;
 pub mod random;
 pub mod roots;

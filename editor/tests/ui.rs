@@ -86,3 +86,81 @@ fn ctrl_s_saves_a_file_that_reopens_equal() {
     let reopened = EditorState::open(&path).expect("reopen");
     assert_eq!(reopened.project, harness.state().state.project);
 }
+
+#[test]
+fn select_a_bundle_extrude_and_undo() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    let layers = original.hair_mesh.bundles[0].layers;
+    // Nothing selected: the tool says so and changes nothing.
+    harness.get_by_label("Extrude").click();
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original);
+    assert!(harness.state().state.message.contains("nothing selected"));
+
+    harness
+        .get_by_label(&format!("Bundle 0 · {layers} layers"))
+        .click();
+    harness.run();
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .selection
+            .iter()
+            .copied()
+            .collect::<Vec<_>>(),
+        [0]
+    );
+    harness.get_by_label("Extrude").click();
+    harness.run();
+    let extruded = &harness.state().state.document().hair_mesh;
+    assert_eq!(extruded.bundles[0].layers, layers + 1, "one more layer");
+    assert!(extruded.validate().is_ok());
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original, "undo restores");
+    // E extrudes too.
+    harness.key_press(egui::Key::E);
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().hair_mesh.bundles[0].layers,
+        layers + 1
+    );
+}
+
+#[test]
+fn a_click_in_the_viewport_selects_the_bundle_under_it() {
+    let mut harness = harness();
+    // The viewport fills the middle of the window; the hair covers its centre.
+    let centre = egui::pos2(620.0, 430.0);
+    harness.hover_at(centre);
+    harness.run();
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos: centre,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        harness.run();
+    }
+    let selection = harness.state().state.selection.clone();
+    assert_eq!(selection.len(), 1, "{}", harness.state().state.message);
+    // A click on empty space (top-left corner of the viewport) clears it.
+    let corner = egui::pos2(420.0, 50.0);
+    harness.hover_at(corner);
+    harness.run();
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos: corner,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        harness.run();
+    }
+    assert!(harness.state().state.selection.is_empty());
+}

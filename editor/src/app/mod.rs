@@ -5,18 +5,21 @@
 pub mod history_panel;
 pub mod state;
 pub mod styling_panel;
+pub mod tools_panel;
 pub mod viewport;
 
 pub use state::EditorState;
 
 use history_panel::HistoryPanel;
 use styling_panel::StylingPanel;
+use tools_panel::ToolsPanel;
 use viewport::Viewport;
 
 pub struct HairloomApp {
     pub state: EditorState,
     pub styling: StylingPanel,
     pub history: HistoryPanel,
+    pub tools: ToolsPanel,
     pub viewport: Viewport,
     title: String,
 }
@@ -28,6 +31,7 @@ impl HairloomApp {
             state,
             styling: StylingPanel::default(),
             history: HistoryPanel,
+            tools: ToolsPanel::default(),
             title: String::new(),
         }
     }
@@ -47,6 +51,12 @@ impl HairloomApp {
         }
         if ui.input_mut(|i| i.consume_shortcut(&save)) {
             let _ = self.state.save();
+        }
+        // Single-key tools only when no text field has the keyboard.
+        if !ui.ctx().egui_wants_keyboard_input()
+            && ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::E))
+        {
+            self.tools.extrude(&mut self.state);
         }
     }
 
@@ -76,6 +86,7 @@ impl HairloomApp {
             });
             ui.menu_button("View", |ui| {
                 let settings = &mut self.viewport.settings;
+                ui.checkbox(&mut settings.wireframe, "Hair-mesh wireframe");
                 ui.checkbox(&mut settings.lod.enabled, "Level of detail");
                 ui.add(
                     egui::Slider::new(&mut settings.strands_per_bundle, 1..=256)
@@ -141,12 +152,16 @@ impl eframe::App for HairloomApp {
         }
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        egui::Panel::left("history")
-            .default_size(180.0)
-            .show(ui, |ui| self.history.ui(ui, &mut self.state));
+        egui::Panel::left("tools")
+            .default_size(240.0)
+            .show(ui, |ui| {
+                self.tools.ui(ui, &mut self.state);
+                ui.separator();
+                self.history.ui(ui, &mut self.state);
+            });
         egui::Panel::right("styling")
             .default_size(320.0)
             .show(ui, |ui| self.styling.ui(ui, &mut self.state));
-        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport.ui(ui, &self.state));
+        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport.ui(ui, &mut self.state));
     }
 }

@@ -6,7 +6,11 @@
 
 use std::path::{Path, PathBuf};
 
+use std::collections::BTreeSet;
+
+use hairloom_core::HairMesh;
 use hairloom_core::document::Document;
+use hairloom_core::edit::{EditError, EditOutcome};
 use hairloom_core::history::Transaction;
 use hairloom_core::project::{self, Project};
 
@@ -25,6 +29,8 @@ pub struct EditorState {
     pub revision: u64,
     /// The last message for the status bar (errors included).
     pub message: String,
+    /// Selected bundles: view state, never saved and never in the history.
+    pub selection: BTreeSet<u32>,
 }
 
 impl EditorState {
@@ -36,6 +42,7 @@ impl EditorState {
             edit: None,
             revision: 0,
             message,
+            selection: BTreeSet::new(),
         }
     }
 
@@ -92,6 +99,32 @@ impl EditorState {
     pub fn commit_edit(&mut self) {
         if let Some(edit) = self.edit.take() {
             edit.commit(&mut self.project.history, &self.project.document);
+        }
+    }
+
+    /// Applies a hair-mesh edit of the selected bundles as one undo step; an error (named in
+    /// the status bar) leaves the document untouched.
+    pub fn edit_mesh(
+        &mut self,
+        label: &str,
+        edit: impl FnOnce(&HairMesh, &[u32]) -> Result<EditOutcome, EditError>,
+    ) -> bool {
+        self.commit_edit();
+        let selected: Vec<u32> = self.selection.iter().copied().collect();
+        match edit(&self.project.document.hair_mesh, &selected) {
+            Ok(outcome) => {
+                self.edit(label).hair_mesh = outcome.mesh;
+                self.commit_edit();
+                self.message = format!(
+                    "{label}: {} bundle(s) changed",
+                    outcome.affected_bundles.len()
+                );
+                true
+            }
+            Err(error) => {
+                self.message = format!("{label}: {error}");
+                false
+            }
         }
     }
 

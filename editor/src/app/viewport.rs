@@ -3,7 +3,8 @@
 //! drawn offscreen by the render crate and shown as an egui image.
 //!
 //! Navigation: drag (left or middle button) orbits, shift+drag pans, the wheel zooms,
-//! F frames the hair, numpad 1 / 3 / 7 look from the front / side / top.
+//! F frames the hair, numpad 1 / 3 / 7 look from the front / side / top. A click selects the
+//! bundle under the pointer (ctrl/shift+click adds or removes it; a click on nothing clears).
 
 use std::sync::Arc;
 
@@ -69,6 +70,8 @@ impl Orbit {
 /// What the viewport shows and how it generates strands.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
+    /// Overlay the hair mesh: layer faces and columns, interior vertices in a second colour.
+    pub wireframe: bool,
     pub strands_per_bundle: u32,
     pub precision: Precision,
     pub filtering: Filtering,
@@ -78,6 +81,7 @@ pub struct ViewSettings {
 impl Default for ViewSettings {
     fn default() -> Self {
         Self {
+            wireframe: false,
             strands_per_bundle: 32,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -122,6 +126,8 @@ pub struct Viewport {
     pub drawn_vertices: usize,
     pub adapter: String,
     pub error: Option<String>,
+    /// The box the camera frames (the drawn hair's), for picking with the same camera.
+    camera_bounds: Option<(Vec3, Vec3)>,
 }
 
 impl Viewport {
@@ -154,12 +160,19 @@ impl Viewport {
             drawn_strands: 0,
             drawn_vertices: 0,
             error: None,
+            camera_bounds: None,
         }
     }
 
-    pub fn ui(&mut self, ui: &mut egui::Ui, state: &EditorState) {
-        let (rect, response) = ui.allocate_exact_size(ui.available_size(), egui::Sense::drag());
+    pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
+        let (rect, response) =
+            ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
         self.navigate(ui, &response);
+        if response.clicked()
+            && let Some(pointer) = response.interact_pointer_pos()
+        {
+            self.select_at(ui, state, rect, pointer);
+        }
         let Some(gpu) = self.gpu.as_mut() else {
             ui.painter().text(
                 rect.center(),
@@ -170,7 +183,12 @@ impl Viewport {
             );
             return;
         };
-        let key = (state.revision, self.settings);
+        // The overlay does not change the picture: leave it out of what triggers GPU work.
+        let settings = ViewSettings {
+            wireframe: false,
+            ..self.settings
+        };
+        let key = (state.revision, settings);
         if self.uploaded != Some(key) {
             let hair = RenderableHair::from_document(
                 state.document(),
@@ -199,7 +217,7 @@ impl Viewport {
         ];
         let drawn = DrawnKey {
             revision: state.revision,
-            settings: self.settings,
+            settings,
             orbit: self.orbit,
             size,
         };
@@ -208,6 +226,7 @@ impl Viewport {
             match gpu.hair.as_ref() {
                 Some(hair) => {
                     let (lo, hi) = hair.bounds;
+                    self.camera_bounds = Some(hair.bounds);
                     let scene = default_scene(
                         &hair.body,
                         HairSource::Generated {
@@ -278,6 +297,120 @@ impl Viewport {
                 );
             }
             (None, None) => {}
+        }
+        self.paint_overlay(ui, state, rect);
+    }
+
+    /// The hair-mesh wireframe (when on) and the selected bundles' outlines, drawn over the
+    /// picture with the picture's camera (not depth-tested: an X-ray view).
+    fn paint_overlay(&self, ui: &egui::Ui, state: &EditorState, rect: egui::Rect) {
+        let mesh = &state.document().hair_mesh;
+        let Some((lo, hi)) = self.camera_bounds else {
+            return;
+        };
+        let view_projection = self
+            .orbit
+            .camera(lo, hi)
+            .view_projection(rect.width() / rect.height().max(1.0));
+        let project = |p: glam::DVec3| -> Option<egui::Pos2> {
+            let clip = view_projection * p.as_vec3().extend(1.0);
+            (clip.w > 1e-6).then(|| {
+                let ndc = clip.truncate() / clip.w;
+                egui::pos2(
+                    rect.left() + (ndc.x + 1.0) * 0.5 * rect.width(),
+                    rect.top() + (1.0 - ndc.y) * 0.5 * rect.height(),
+                )
+            })
+        };
+        let painter = ui.painter_at(rect);
+        let outline = |bundle: &hairloom_core::Bundle, stroke: egui::Stroke| {
+            for layer in 0..=bundle.layers as usize {
+                let corners: Vec<_> = bundle
+                    .vertices
+                    .iter()
+                    .filter_map(|&c| project(*mesh.columns.get(c as usize)?.positions.get(layer)?))
+                    .collect();
+                if corners.len() == bundle.vertices.len() {
+                    painter.add(egui::Shape::closed_line(corners, stroke));
+                }
+            }
+            for &c in &bundle.vertices {
+                let Some(column) = mesh.columns.get(c as usize) else {
+                    continue;
+                };
+                let points: Vec<_> = column.positions
+                    [..=(bundle.layers as usize).min(column.positions.len() - 1)]
+                    .iter()
+                    .filter_map(|p| project(*p))
+                    .collect();
+                painter.add(egui::Shape::line(points, stroke));
+            }
+        };
+        if self.settings.wireframe {
+            let stroke = egui::Stroke::new(
+                1.0,
+                egui::Color32::from_rgba_unmultiplied(120, 170, 230, 110),
+            );
+            for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
+                outline(bundle, stroke);
+            }
+            let topology = hairloom_core::Topology::build(mesh);
+            for (c, column) in mesh.columns.iter().enumerate() {
+                for (layer, p) in column.positions.iter().enumerate() {
+                    let Some(at) = project(*p) else { continue };
+                    let colour = if mesh.is_interior(&topology, c, layer) {
+                        egui::Color32::from_rgb(240, 200, 80) // placed automatically
+                    } else {
+                        egui::Color32::from_rgb(120, 200, 255) // shaped by the artist
+                    };
+                    painter.circle_filled(at, 1.8, colour);
+                }
+            }
+        }
+        let selected = egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 150, 40));
+        for &b in &state.selection {
+            if let Some(bundle) = mesh.bundles.get(b as usize) {
+                outline(bundle, selected);
+            }
+        }
+    }
+
+    /// Selects the bundle under `pointer` (see the module documentation).
+    fn select_at(
+        &self,
+        ui: &egui::Ui,
+        state: &mut EditorState,
+        rect: egui::Rect,
+        pointer: egui::Pos2,
+    ) {
+        let Some((lo, hi)) = self.camera_bounds.or_else(|| {
+            let (lo, hi) = state.document().hair_mesh.bounds()?;
+            Some((lo.as_vec3(), hi.as_vec3()))
+        }) else {
+            return;
+        };
+        let camera = self.orbit.camera(lo, hi);
+        let inverse = camera
+            .view_projection(rect.width() / rect.height().max(1.0))
+            .inverse();
+        let x = (pointer.x - rect.left()) / rect.width().max(1.0) * 2.0 - 1.0;
+        let y = 1.0 - (pointer.y - rect.top()) / rect.height().max(1.0) * 2.0;
+        let near = inverse.project_point3(Vec3::new(x, y, 0.0)).as_dvec3();
+        let far = inverse.project_point3(Vec3::new(x, y, 1.0)).as_dvec3();
+        let hit = hairloom_core::pick::pick_bundle(&state.document().hair_mesh, near, far - near);
+        let add = ui.input(|i| i.modifiers.command || i.modifiers.shift);
+        match hit {
+            Some((bundle, _)) => {
+                if !add {
+                    state.selection.clear();
+                }
+                if !state.selection.insert(bundle) {
+                    state.selection.remove(&bundle);
+                }
+                state.message = format!("bundle {bundle}");
+            }
+            None if !add => state.selection.clear(),
+            None => {}
         }
     }
 
