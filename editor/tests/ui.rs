@@ -131,36 +131,31 @@ fn select_a_bundle_extrude_and_undo() {
     );
 }
 
+/// A primary-button click at `pos` (the viewport has no accessible node to click by label).
+fn click_at(harness: &mut Harness<'static, HairloomApp>, pos: egui::Pos2) {
+    harness.hover_at(pos);
+    harness.run();
+    for pressed in [true, false] {
+        harness.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        harness.run();
+    }
+}
+
 #[test]
 fn a_click_in_the_viewport_selects_the_bundle_under_it() {
     let mut harness = harness();
     // The viewport fills the middle of the window; the hair covers its centre.
     let centre = egui::pos2(620.0, 430.0);
-    harness.hover_at(centre);
-    harness.run();
-    for pressed in [true, false] {
-        harness.event(egui::Event::PointerButton {
-            pos: centre,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: egui::Modifiers::NONE,
-        });
-        harness.run();
-    }
+    click_at(&mut harness, centre);
     let selection = harness.state().state.selection.clone();
     assert_eq!(selection.len(), 1, "{}", harness.state().state.message);
     // A click on empty space (top-left corner of the viewport) clears it.
     let corner = egui::pos2(420.0, 50.0);
-    harness.hover_at(corner);
-    harness.run();
-    for pressed in [true, false] {
-        harness.event(egui::Event::PointerButton {
-            pos: corner,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: egui::Modifiers::NONE,
-        });
-        harness.run();
-    }
+    click_at(&mut harness, corner);
     assert!(harness.state().state.selection.is_empty());
 }
