@@ -7,8 +7,21 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use hairloom_editor::app::{EditorState, HairloomApp};
 
+/// The app on the sample, with autosaves in a fresh folder (no recovery offer).
 fn harness() -> Harness<'static, HairloomApp> {
-    let mut harness = Harness::new_eframe(|cc| HairloomApp::new(cc, EditorState::sample()));
+    let recovery_dir = std::env::temp_dir().join(format!(
+        "hairloom-ui-test-{}-{:?}",
+        std::process::id(),
+        std::thread::current().id()
+    ));
+    let _ = std::fs::remove_dir_all(&recovery_dir);
+    let mut harness = Harness::new_eframe(move |cc| {
+        HairloomApp::with_recovery(
+            cc,
+            EditorState::sample(),
+            hairloom_editor::app::recovery::Recovery::in_dir(&recovery_dir),
+        )
+    });
     harness.set_size(egui::vec2(1400.0, 900.0));
     harness.run();
     harness
@@ -158,4 +171,60 @@ fn a_click_in_the_viewport_selects_the_bundle_under_it() {
     let corner = egui::pos2(420.0, 50.0);
     click_at(&mut harness, corner);
     assert!(harness.state().state.selection.is_empty());
+}
+
+#[test]
+fn unsaved_work_is_offered_for_recovery_on_the_next_start() {
+    use hairloom_editor::app::recovery::Recovery;
+    let dir = tempfile::tempdir().expect("temp dir");
+    // An earlier session with unsaved work (as autosave or quit leaves it).
+    let mut earlier = EditorState::sample();
+    earlier.edit("wave").styling.global.wave.amplitude_m = 0.017;
+    earlier.commit_edit();
+    Recovery::in_dir(dir.path())
+        .write(&earlier)
+        .expect("autosave");
+
+    let recovery_dir = dir.path().to_path_buf();
+    let mut harness = Harness::new_eframe(move |cc| {
+        HairloomApp::with_recovery(cc, EditorState::sample(), Recovery::in_dir(&recovery_dir))
+    });
+    harness.set_size(egui::vec2(1400.0, 900.0));
+    harness.run();
+    harness.get_by_label("Recover").click();
+    harness.run();
+    let state = &harness.state().state;
+    assert_eq!(
+        state.project, earlier.project,
+        "document and history recovered"
+    );
+    assert!(state.is_dirty());
+    assert!(harness.state().offer.is_none());
+
+    // Saving makes the recovery file unnecessary.
+    let path = dir.path().join("saved.hairloom");
+    harness.state_mut().state.path = Some(path.clone());
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    assert!(path.exists());
+    assert!(Recovery::in_dir(dir.path()).pending().is_none());
+}
+
+#[test]
+fn discarding_the_offer_removes_the_autosave() {
+    use hairloom_editor::app::recovery::Recovery;
+    let dir = tempfile::tempdir().expect("temp dir");
+    Recovery::in_dir(dir.path())
+        .write(&EditorState::sample())
+        .expect("autosave");
+    let recovery_dir = dir.path().to_path_buf();
+    let mut harness = Harness::new_eframe(move |cc| {
+        HairloomApp::with_recovery(cc, EditorState::sample(), Recovery::in_dir(&recovery_dir))
+    });
+    harness.set_size(egui::vec2(1400.0, 900.0));
+    harness.run();
+    harness.get_by_label("Discard").click();
+    harness.run();
+    assert!(Recovery::in_dir(dir.path()).pending().is_none());
+    assert!(!harness.state().state.is_dirty());
 }

@@ -94,11 +94,14 @@ fn the_editor_window_opens_and_draws() {
     std::thread::sleep(Duration::from_millis(800));
     let runtime_dir = std::env::temp_dir().join("hairloom-runtime");
     let _ = std::fs::create_dir_all(&runtime_dir);
+    // Its own recovery folder: no offer from (or autosave into) the user's.
+    let recovery_dir = tempfile::tempdir().expect("temp dir");
     let mut editor = KillOnDrop(
         Command::new(env!("CARGO_BIN_EXE_hairloom"))
             .env("DISPLAY", &display)
             .env_remove("WAYLAND_DISPLAY")
             .env("XDG_RUNTIME_DIR", &runtime_dir)
+            .env("HAIRLOOM_RECOVERY_DIR", recovery_dir.path())
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
             .spawn()

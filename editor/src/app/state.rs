@@ -31,6 +31,8 @@ pub struct EditorState {
     pub message: String,
     /// Selected bundles: view state, never saved and never in the history.
     pub selection: BTreeSet<u32>,
+    /// Recovered work counts as unsaved even where it equals a file on disk.
+    unsaved: bool,
 }
 
 impl EditorState {
@@ -43,6 +45,7 @@ impl EditorState {
             revision: 0,
             message,
             selection: BTreeSet::new(),
+            unsaved: false,
         }
     }
 
@@ -83,7 +86,13 @@ impl EditorState {
     }
 
     pub fn is_dirty(&self) -> bool {
-        self.project.document != self.saved
+        self.unsaved || self.project.document != self.saved
+    }
+
+    /// Marks the state as unsaved work (recovered from an autosave).
+    pub fn mark_unsaved(&mut self, message: String) {
+        self.unsaved = true;
+        self.message = message;
     }
 
     /// Starts an edit (one undo step) unless one is running; returns the document to change.
@@ -186,6 +195,7 @@ impl EditorState {
             Ok(()) => {
                 self.path = Some(path.to_path_buf());
                 self.saved = self.project.document.clone();
+                self.unsaved = false;
                 self.message = format!("saved {}", path.display());
                 Ok(path.to_path_buf())
             }
