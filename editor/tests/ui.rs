@@ -15,12 +15,14 @@ fn harness() -> Harness<'static, HairloomApp> {
         std::thread::current().id()
     ));
     let _ = std::fs::remove_dir_all(&recovery_dir);
+    harness_with_recovery(&recovery_dir)
+}
+
+/// The app on the sample, with its autosaves (and any offer) in `recovery_dir`.
+fn harness_with_recovery(recovery_dir: &std::path::Path) -> Harness<'static, HairloomApp> {
+    let recovery = hairloom_editor::app::recovery::Recovery::in_dir(recovery_dir);
     let mut harness = Harness::new_eframe(move |cc| {
-        HairloomApp::with_recovery(
-            cc,
-            EditorState::sample(),
-            hairloom_editor::app::recovery::Recovery::in_dir(&recovery_dir),
-        )
+        HairloomApp::with_recovery(cc, EditorState::sample(), recovery)
     });
     harness.set_size(egui::vec2(1400.0, 900.0));
     harness.run();
@@ -185,12 +187,7 @@ fn unsaved_work_is_offered_for_recovery_on_the_next_start() {
         .write(&earlier)
         .expect("autosave");
 
-    let recovery_dir = dir.path().to_path_buf();
-    let mut harness = Harness::new_eframe(move |cc| {
-        HairloomApp::with_recovery(cc, EditorState::sample(), Recovery::in_dir(&recovery_dir))
-    });
-    harness.set_size(egui::vec2(1400.0, 900.0));
-    harness.run();
+    let mut harness = harness_with_recovery(dir.path());
     harness.get_by_label("Recover").click();
     harness.run();
     let state = &harness.state().state;
@@ -217,12 +214,7 @@ fn discarding_the_offer_removes_the_autosave() {
     Recovery::in_dir(dir.path())
         .write(&EditorState::sample())
         .expect("autosave");
-    let recovery_dir = dir.path().to_path_buf();
-    let mut harness = Harness::new_eframe(move |cc| {
-        HairloomApp::with_recovery(cc, EditorState::sample(), Recovery::in_dir(&recovery_dir))
-    });
-    harness.set_size(egui::vec2(1400.0, 900.0));
-    harness.run();
+    let mut harness = harness_with_recovery(dir.path());
     harness.get_by_label("Discard").click();
     harness.run();
     assert!(Recovery::in_dir(dir.path()).pending().is_none());
