@@ -19,7 +19,6 @@
 
 struct StrandGenParams {
     position_offset: vec4<f32>,
-    texture_size: vec4<u32>,
     vertex_total: u32,
     run_count: u32,
     filtering: u32,

@@ -615,13 +615,14 @@ impl LoadedBundle {
         }
     }
 
-    /// Roots of `per_bundle` strands per bundle with each bundle's styling group: what a game
-    /// uploads from the bundle alone.
-    pub fn strand_roots(&self, per_bundle: usize) -> Vec<crate::gpu_types::StrandRoot> {
-        self.textures
-            .strand_roots(&self.root_samples(), per_bundle, |index, _| {
-                (self.manifest.bundles[index].styling_group + 1) as u32
-            })
+    /// Each bundle's index into the styling array (0 = global, `g + 1` = group `g`), in
+    /// block order: with [`Self::root_samples`], what a game uploads to generate strands.
+    pub fn block_styling(&self) -> Vec<u32> {
+        self.manifest
+            .bundles
+            .iter()
+            .map(|b| (b.styling_group + 1) as u32)
+            .collect()
     }
 }
 

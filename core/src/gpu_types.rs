@@ -11,8 +11,6 @@ use bytemuck::{Pod, Zeroable};
 pub struct StrandGenParams {
     /// Added to every sampled position (xyz; w unused).
     pub position_offset: [f32; 4],
-    /// Hair-mesh texture width, height, depth (w unused).
-    pub texture_size: [u32; 4],
     /// Vertices this dispatch writes (the batch's runs together).
     pub vertex_total: u32,
     /// The batch's runs: `runs[first_run .. first_run + run_count]`.

@@ -226,7 +226,7 @@ fn gpu(
     runs: usize,
 ) -> anyhow::Result<()> {
     use hairloom_core::lod::LodSettings;
-    use hairloom_core::runtime::{Filtering, RootSamples, RuntimeTextures};
+    use hairloom_core::runtime::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
     use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
@@ -234,17 +234,12 @@ fn gpu(
         std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
             .join("../assets/samples/head_long_wavy.hairloom")
     });
-    let (width, height) = size
-        .split_once('x')
-        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
-        .filter(|&(w, h)| w > 0 && h > 0 && w <= 8192 && h <= 8192)
-        .ok_or_else(|| anyhow::anyhow!("--size must look like 960x540"))?;
+    let (width, height) = hairloom_editor::render::parse_size(size)?;
     let document = hairloom_core::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
     let generator = StrandGenRenderer::new(&context);
     let preview = PreviewRenderer::new(&context);
     let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
-    let styling = hairloom_core::gpu_types::styling_array(&document.styling);
     let max_binding = context.device.limits().max_storage_buffer_binding_size;
     let trust = !context.is_cpu();
     println!(
@@ -271,9 +266,11 @@ fn gpu(
         "mem ratio"
     );
     for &precision in precisions {
-        let textures = RuntimeTextures::build(&document.hair_mesh, precision);
-        let bundles = textures.atlas.blocks.len().max(1);
-        let (lo, hi) = textures
+        let mut renderable =
+            hairloom_editor::render::RenderableHair::from_document(&document, precision, 1);
+        let bundles = renderable.textures.atlas.blocks.len().max(1);
+        let (lo, hi) = renderable
+            .textures
             .hair_bounds()
             .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
         let pad = (hi - lo) * 0.05;
@@ -285,20 +282,8 @@ fn gpu(
             ..near
         };
         for &target in counts {
-            let per_bundle = target.div_ceil(bundles);
-            let samples = RootSamples::progressive(
-                hairloom_core::strands::sample_set_size(per_bundle as u32),
-                1,
-            );
-            let block_styling = textures.block_styling(&document.styling);
-            let hair = generator.upload(
-                &context,
-                &textures,
-                &samples,
-                per_bundle,
-                &block_styling,
-                &styling,
-            );
+            renderable.set_strands_per_bundle(target.div_ceil(bundles) as u32);
+            let hair = renderable.upload(&context, &generator);
             let full = full_detail_plan(hair.root_count, vertex_count);
             let stored_bytes = full.vertices as u64 * 16;
             let hair_mb = hair.bytes as f64 / 1e6;

@@ -15,7 +15,7 @@ use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures}
 use hairloom_core::strands::sample_set_size;
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, PreviewScene};
-use hairloom_render::strand_gen::StrandGenRenderer;
+use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
 
 /// Vertices per strand in previews by default: 2^4 + 1.
 pub const PREVIEW_VERTICES_LOG2: u32 = 4;
@@ -52,7 +52,7 @@ impl Default for RenderSettings {
     }
 }
 
-fn parse_size(size: &str) -> anyhow::Result<(u32, u32)> {
+pub fn parse_size(size: &str) -> anyhow::Result<(u32, u32)> {
     let (w, h) = size
         .split_once('x')
         .context("--size must look like 960x960")?;
@@ -108,14 +108,38 @@ impl RenderableHair {
         strands_per_bundle: u32,
     ) -> Self {
         let textures = RuntimeTextures::build(&document.hair_mesh, precision);
-        Self {
-            samples: RootSamples::progressive(sample_set_size(strands_per_bundle), SAMPLE_SEED),
-            per_bundle: strands_per_bundle as usize,
+        let mut hair = Self {
+            samples: RootSamples {
+                quad: Vec::new(),
+                triangle: Vec::new(),
+            },
+            per_bundle: 0,
             block_styling: textures.block_styling(&document.styling),
             textures,
             styling: styling_array(&document.styling),
             body: document.body.clone(),
-        }
+        };
+        hair.set_strands_per_bundle(strands_per_bundle);
+        hair
+    }
+
+    /// Draws `strands_per_bundle` strands per bundle from the sample set an export of that
+    /// count would write.
+    pub fn set_strands_per_bundle(&mut self, strands_per_bundle: u32) {
+        self.samples = RootSamples::progressive(sample_set_size(strands_per_bundle), SAMPLE_SEED);
+        self.per_bundle = strands_per_bundle as usize;
+    }
+
+    /// Uploads everything generation reads (once per change of the hair, not per frame).
+    pub fn upload(&self, context: &GpuContext, generator: &StrandGenRenderer) -> GpuHair {
+        generator.upload(
+            context,
+            &self.textures,
+            &self.samples,
+            self.per_bundle,
+            &self.block_styling,
+            &self.styling,
+        )
     }
 
     /// A project file, or a runtime bundle folder (the game's input).
@@ -135,12 +159,7 @@ impl RenderableHair {
             Ok(Self {
                 samples: bundle.root_samples(),
                 per_bundle: per_bundle as usize,
-                block_styling: bundle
-                    .manifest
-                    .bundles
-                    .iter()
-                    .map(|b| (b.styling_group + 1) as u32)
-                    .collect(),
+                block_styling: bundle.block_styling(),
                 styling: styling_array(&bundle.manifest.styling),
                 textures: bundle.textures,
                 body: bundle.body,
@@ -192,14 +211,7 @@ pub fn render_pixels(
 ) -> anyhow::Result<(Vec<u8>, String)> {
     let (vertices_log2, filtering) = (settings.vertices_log2, settings.filtering);
     let generator = StrandGenRenderer::new(context);
-    let gpu_hair = generator.upload(
-        context,
-        &hair.textures,
-        &hair.samples,
-        hair.per_bundle,
-        &hair.block_styling,
-        &hair.styling,
-    );
+    let gpu_hair = hair.upload(context, &generator);
     let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
     // Frame the hair (the head scan's shoulders would make it tiny), padded by a margin.
     let (lo, hi) = hair
@@ -221,8 +233,8 @@ pub fn render_pixels(
         (lo, hi),
         camera,
     );
-    let pixels = renderer.render(context, &scene, width, height)?;
     let plan = renderer.plan(&scene, width, height);
+    let pixels = renderer.render(context, &scene, &plan, width, height)?;
     let summary = format!(
         "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), {}× MSAA, on {}",
         plan.strands,

@@ -248,15 +248,17 @@ impl PreviewRenderer {
         }
     }
 
-    /// Renders `scene` into a `width × height` image; returns RGBA8 (sRGB) rows, top first.
+    /// Renders `scene` into a `width × height` image following `plan` (from [`Self::plan`]
+    /// for the same scene and size); returns RGBA8 (sRGB) rows, top first.
     pub fn render(
         &self,
         context: &GpuContext,
         scene: &PreviewScene,
+        plan: &FramePlan,
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, PreviewError> {
-        let frame = self.encode_frame(context, scene, width, height, None)?;
+        let frame = self.encode_frame(context, scene, plan, width, height, None)?;
         let (width, height) = (frame.width, frame.height);
         // Rows of a texture-to-buffer copy are padded to 256 bytes.
         let padded_row = (width * 4).div_ceil(256) * 256;
@@ -298,16 +300,17 @@ impl PreviewRenderer {
         Ok(pixels)
     }
 
-    /// Renders `scene` into a new `width × height` sRGB texture that can be sampled (an
-    /// editor viewport shows it); the work is submitted, not waited for.
+    /// Renders `scene` following `plan` into a new `width × height` sRGB texture that can be
+    /// sampled (an editor viewport shows it); the work is submitted, not waited for.
     pub fn render_texture(
         &self,
         context: &GpuContext,
         scene: &PreviewScene,
+        plan: &FramePlan,
         width: u32,
         height: u32,
     ) -> Result<wgpu::Texture, PreviewError> {
-        let frame = self.encode_frame(context, scene, width, height, None)?;
+        let frame = self.encode_frame(context, scene, plan, width, height, None)?;
         context.queue.submit([frame.encoder.finish()]);
         Ok(frame.resolved)
     }
@@ -325,7 +328,7 @@ impl PreviewRenderer {
         let plan = self.plan(scene, width, height);
         let passes = 1 + 2 * plan.batches.len().max(1);
         let timer = PassTimer::new(context, passes);
-        let frame = self.encode_frame(context, scene, width, height, timer.as_ref())?;
+        let frame = self.encode_frame(context, scene, &plan, width, height, timer.as_ref())?;
         let (wall_ms, gpu_ms) =
             submit_timed(context, frame.encoder, timer).map_err(PreviewError::Readback)?;
         Ok(FrameTiming {
@@ -374,6 +377,7 @@ impl PreviewRenderer {
         &self,
         context: &GpuContext,
         scene: &PreviewScene,
+        plan: &FramePlan,
         width: u32,
         height: u32,
         timer: Option<&PassTimer>,
@@ -484,7 +488,6 @@ impl PreviewRenderer {
                 resource: body_uniform_buffer.as_entire_binding(),
             }],
         });
-        let plan = self.plan(scene, width, height);
         let generator_runs = match &scene.hair {
             HairSource::Generated {
                 generator,
@@ -494,7 +497,7 @@ impl PreviewRenderer {
                 generator
                     .check_filtering(context, *filtering)
                     .map_err(PreviewError::Generation)?;
-                Some(generator.upload_runs(context, &plan))
+                Some(generator.upload_runs(context, plan))
             }
             _ => None,
         };
@@ -535,7 +538,7 @@ impl PreviewRenderer {
             }
             HairSource::Stored { buffer, .. } => (buffer, 0),
             HairSource::Generated { generator, .. } => {
-                scratch = generator.scratch(context, &plan);
+                scratch = generator.scratch(context, plan);
                 (&scratch, scratch.size())
             }
         };

@@ -96,9 +96,7 @@ pub struct GenerationTiming {
 /// textures, one placement per bundle, the root sample sets and the styling array. Nothing
 /// is stored per strand.
 pub struct GpuHair {
-    pub precision: Precision,
     pub position_offset: [f32; 3],
-    pub texture_size: [u32; 3],
     hair_mesh: wgpu::TextureView,
     uv: wgpu::TextureView,
     w: wgpu::TextureView,
@@ -334,13 +332,7 @@ impl StrandGenRenderer {
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         GpuHair {
-            precision,
             position_offset: textures.position_offset.to_array(),
-            texture_size: [
-                textures.hair_mesh.width,
-                textures.hair_mesh.height,
-                textures.hair_mesh.depth,
-            ],
             hair_mesh,
             uv,
             w,
@@ -417,12 +409,6 @@ impl StrandGenRenderer {
                 hair.position_offset[1],
                 hair.position_offset[2],
                 0.0,
-            ],
-            texture_size: [
-                hair.texture_size[0],
-                hair.texture_size[1],
-                hair.texture_size[2],
-                0,
             ],
             vertex_total,
             run_count: batch.len() as u32,
@@ -547,31 +533,29 @@ impl StrandGenRenderer {
         })
     }
 
-    /// Generates every batch of `plan` once into a persistent vertex buffer (batch after
-    /// batch): the explicit-storage baseline, which a renderer then only draws.
-    pub fn store(
+    /// Generates `plan` batch after batch, one submission each: `finish` receives the
+    /// batch's encoder (generation recorded), the scratch buffer and the batch's bytes, adds
+    /// what it needs (copies) and submits.
+    fn each_batch(
         &self,
         context: &GpuContext,
         hair: &GpuHair,
         plan: &FramePlan,
         filtering: Filtering,
-    ) -> Result<wgpu::Buffer, StrandGenError> {
+        mut finish: impl FnMut(wgpu::CommandEncoder, &wgpu::Buffer, u64) -> Result<(), StrandGenError>,
+    ) -> Result<(), StrandGenError> {
         self.check_filtering(context, filtering)?;
-        let device = &context.device;
         let output = self.scratch(context, plan);
         let runs = self.upload_runs(context, plan);
-        let stored = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("stored_strands"),
-            size: (plan.vertices.max(1) * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let (mut first_run, mut offset) = (0, 0u64);
+        let mut first_run = 0;
         for batch in &plan.batches {
             let bytes = FramePlan::batch_vertices(batch) as u64 * 16;
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("strand_gen_store"),
-            });
+            let mut encoder =
+                context
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("strand_gen"),
+                    });
             self.encode(
                 context,
                 &mut encoder,
@@ -583,12 +567,44 @@ impl StrandGenRenderer {
                 &output,
                 None,
             );
-            encoder.copy_buffer_to_buffer(&output, 0, &stored, offset, bytes);
-            context.queue.submit([encoder.finish()]);
             first_run += batch.len();
-            offset += bytes;
+            if bytes > 0 {
+                finish(encoder, &output, bytes)?;
+            }
         }
-        device
+        Ok(())
+    }
+
+    /// Generates every batch of `plan` once into a persistent vertex buffer (batch after
+    /// batch): the explicit-storage baseline, which a renderer then only draws.
+    pub fn store(
+        &self,
+        context: &GpuContext,
+        hair: &GpuHair,
+        plan: &FramePlan,
+        filtering: Filtering,
+    ) -> Result<wgpu::Buffer, StrandGenError> {
+        let stored = context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("stored_strands"),
+            size: (plan.vertices.max(1) * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut offset = 0u64;
+        self.each_batch(
+            context,
+            hair,
+            plan,
+            filtering,
+            |mut encoder, output, bytes| {
+                encoder.copy_buffer_to_buffer(output, 0, &stored, offset, bytes);
+                context.queue.submit([encoder.finish()]);
+                offset += bytes;
+                Ok(())
+            },
+        )?;
+        context
+            .device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| StrandGenError::Readback(e.to_string()))?;
         Ok(stored)
@@ -603,43 +619,26 @@ impl StrandGenRenderer {
         plan: &FramePlan,
         filtering: Filtering,
     ) -> Result<Vec<[f32; 4]>, StrandGenError> {
-        self.check_filtering(context, filtering)?;
-        let device = &context.device;
-        let output = self.scratch(context, plan);
-        let runs = self.upload_runs(context, plan);
         let mut positions = Vec::with_capacity(plan.vertices);
-        let mut first_run = 0;
-        for batch in &plan.batches {
-            let bytes = FramePlan::batch_vertices(batch) as u64 * 16;
-            if bytes == 0 {
-                continue;
-            }
-            let readback = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("strand_gen_readback"),
-                size: bytes,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("strand_gen"),
-            });
-            self.encode(
-                context,
-                &mut encoder,
-                hair,
-                &runs,
-                first_run,
-                batch,
-                filtering,
-                &output,
-                None,
-            );
-            first_run += batch.len();
-            encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
-            context.queue.submit([encoder.finish()]);
-            let data = read_buffer(context, &readback).map_err(StrandGenError::Readback)?;
-            positions.extend_from_slice(bytemuck::cast_slice(&data));
-        }
+        self.each_batch(
+            context,
+            hair,
+            plan,
+            filtering,
+            |mut encoder, output, bytes| {
+                let readback = context.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("strand_gen_readback"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                });
+                encoder.copy_buffer_to_buffer(output, 0, &readback, 0, bytes);
+                context.queue.submit([encoder.finish()]);
+                let data = read_buffer(context, &readback).map_err(StrandGenError::Readback)?;
+                positions.extend_from_slice(bytemuck::cast_slice(&data));
+                Ok(())
+            },
+        )?;
         Ok(positions)
     }
 }

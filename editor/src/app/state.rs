@@ -18,6 +18,12 @@ use hairloom_core::project::{self, Project};
 const SAMPLE_PROJECT: &[u8] = include_bytes!("../../../assets/samples/head_long_wavy.hairloom");
 const SAMPLE_NAME: &str = "head_long_wavy.hairloom (sample)";
 
+/// A fresh document revision number (process-wide).
+fn next_revision() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
 pub struct EditorState {
     pub project: Project,
     /// Where Save writes; `None` for the embedded sample until Save As.
@@ -25,7 +31,8 @@ pub struct EditorState {
     /// The document as last loaded or saved (unsaved changes = differs from it).
     saved: Document,
     edit: Option<Transaction>,
-    /// Increments whenever the document changes (the viewport rebuilds its GPU data).
+    /// Changes whenever the document changes (the viewport rebuilds its GPU data). Unique
+    /// across states, so a state replacing another (opened, recovered) never reuses one.
     pub revision: u64,
     /// The last message for the status bar (errors included).
     pub message: String,
@@ -42,7 +49,7 @@ impl EditorState {
             project,
             path,
             edit: None,
-            revision: 0,
+            revision: next_revision(),
             message,
             selection: BTreeSet::new(),
             unsaved: false,
@@ -100,7 +107,7 @@ impl EditorState {
         if self.edit.is_none() {
             self.edit = Some(Transaction::begin(&self.project.document, label));
         }
-        self.revision += 1;
+        self.revision = next_revision();
         &mut self.project.document
     }
 
@@ -177,7 +184,7 @@ impl EditorState {
     }
 
     fn changed(&mut self, message: String) {
-        self.revision += 1;
+        self.revision = next_revision();
         self.message = message;
     }
 

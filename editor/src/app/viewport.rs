@@ -128,6 +128,9 @@ pub struct Viewport {
     pub error: Option<String>,
     /// The box the camera frames (the drawn hair's), for picking with the same camera.
     camera_bounds: Option<(Vec3, Vec3)>,
+    /// Per column and layer, whether the vertex is interior, for the document revision it
+    /// was computed at (the wireframe marks them; recomputed only when the document changes).
+    interior: Option<(u64, Vec<Vec<bool>>)>,
 }
 
 impl Viewport {
@@ -161,6 +164,7 @@ impl Viewport {
             drawn_vertices: 0,
             error: None,
             camera_bounds: None,
+            interior: None,
         }
     }
 
@@ -196,14 +200,7 @@ impl Viewport {
                 self.settings.strands_per_bundle,
             );
             gpu.hair = hair.textures.hair_bounds().map(|bounds| UploadedHair {
-                gpu: gpu.generator.upload(
-                    &gpu.context,
-                    &hair.textures,
-                    &hair.samples,
-                    hair.per_bundle,
-                    &hair.block_styling,
-                    &hair.styling,
-                ),
+                gpu: hair.upload(&gpu.context, &gpu.generator),
                 bounds,
                 body: hair.body,
             });
@@ -244,7 +241,7 @@ impl Viewport {
                     self.drawn_vertices = plan.vertices;
                     match gpu
                         .preview
-                        .render_texture(&gpu.context, &scene, size[0], size[1])
+                        .render_texture(&gpu.context, &scene, &plan, size[0], size[1])
                     {
                         Ok(texture) => {
                             // egui composites gamma-encoded bytes: sample the sRGB image raw.
@@ -303,7 +300,7 @@ impl Viewport {
 
     /// The hair-mesh wireframe (when on) and the selected bundles' outlines, drawn over the
     /// picture with the picture's camera (not depth-tested: an X-ray view).
-    fn paint_overlay(&self, ui: &egui::Ui, state: &EditorState, rect: egui::Rect) {
+    fn paint_overlay(&mut self, ui: &egui::Ui, state: &EditorState, rect: egui::Rect) {
         let mesh = &state.document().hair_mesh;
         let Some((lo, hi)) = self.camera_bounds else {
             return;
@@ -354,11 +351,29 @@ impl Viewport {
             for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
                 outline(bundle, stroke);
             }
-            let topology = hairloom_core::Topology::build(mesh);
+            if self
+                .interior
+                .as_ref()
+                .is_none_or(|(r, _)| *r != state.revision)
+            {
+                let topology = hairloom_core::Topology::build(mesh);
+                let interior = (0..mesh.columns.len())
+                    .map(|c| {
+                        (0..mesh.columns[c].positions.len())
+                            .map(|layer| mesh.is_interior(&topology, c, layer))
+                            .collect()
+                    })
+                    .collect();
+                self.interior = Some((state.revision, interior));
+            }
+            let interior = self.interior.as_ref().map(|(_, i)| i);
             for (c, column) in mesh.columns.iter().enumerate() {
                 for (layer, p) in column.positions.iter().enumerate() {
                     let Some(at) = project(*p) else { continue };
-                    let colour = if mesh.is_interior(&topology, c, layer) {
+                    let is_interior = interior
+                        .and_then(|i| i.get(c)?.get(layer).copied())
+                        .unwrap_or(false);
+                    let colour = if is_interior {
                         egui::Color32::from_rgb(240, 200, 80) // placed automatically
                     } else {
                         egui::Color32::from_rgb(120, 200, 255) // shaped by the artist
