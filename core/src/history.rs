@@ -15,7 +15,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::document::Document;
+use crate::document::{BodyMesh, Document};
 use crate::mesh::{Bundle, Column, WMode};
 use crate::styling::StylingSet;
 
@@ -142,11 +142,41 @@ impl<T: Clone + PartialEq> VecDiff<T> {
     }
 }
 
-/// A before/after pair of a small value.
+/// A before/after pair of a value.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Swap<T> {
     pub before: T,
     pub after: T,
+}
+
+impl<T: Clone + PartialEq> Swap<T> {
+    /// The pair when the value changed.
+    fn between(before: &T, after: &T) -> Option<Self> {
+        (before != after).then(|| Self {
+            before: before.clone(),
+            after: after.clone(),
+        })
+    }
+
+    /// Refuses to write when `value` is not the side this entry starts from.
+    fn check(&self, value: &T, forward: bool, path: &str) -> Result<(), HistoryMismatch> {
+        let expected = if forward { &self.before } else { &self.after };
+        if value != expected {
+            return Err(HistoryMismatch {
+                path: path.into(),
+                message: "the document does not hold the value this history entry changed".into(),
+            });
+        }
+        Ok(())
+    }
+
+    fn write(&self, target: &mut T, forward: bool) {
+        *target = if forward {
+            self.after.clone()
+        } else {
+            self.before.clone()
+        };
+    }
 }
 
 /// Everything one command changed in a [`Document`].
@@ -161,32 +191,25 @@ pub struct DocumentDiff {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<Swap<String>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<Swap<String>>,
+    /// Boxed: a body is large and only an import changes it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<Box<Swap<BodyMesh>>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     /// Boxed: a styling set is large and most commands do not change it.
     pub styling: Option<Box<Swap<StylingSet>>>,
 }
 
 impl DocumentDiff {
     pub fn between(before: &Document, after: &Document) -> Self {
-        let swap = |b: &WMode, a: &WMode| {
-            (b != a).then_some(Swap {
-                before: *b,
-                after: *a,
-            })
-        };
         Self {
             bundles: VecDiff::between(&before.hair_mesh.bundles, &after.hair_mesh.bundles),
             columns: VecDiff::between(&before.hair_mesh.columns, &after.hair_mesh.columns),
-            w_mode: swap(&before.hair_mesh.w_mode, &after.hair_mesh.w_mode),
-            name: (before.name != after.name).then(|| Swap {
-                before: before.name.clone(),
-                after: after.name.clone(),
-            }),
-            styling: (before.styling != after.styling).then(|| {
-                Box::new(Swap {
-                    before: before.styling.clone(),
-                    after: after.styling.clone(),
-                })
-            }),
+            w_mode: Swap::between(&before.hair_mesh.w_mode, &after.hair_mesh.w_mode),
+            name: Swap::between(&before.name, &after.name),
+            source: Swap::between(&before.source, &after.source),
+            body: Swap::between(&before.body, &after.body).map(Box::new),
+            styling: Swap::between(&before.styling, &after.styling).map(Box::new),
         }
     }
 
@@ -195,42 +218,29 @@ impl DocumentDiff {
             && self.columns.is_empty()
             && self.w_mode.is_none()
             && self.name.is_none()
+            && self.source.is_none()
+            && self.body.is_none()
             && self.styling.is_none()
     }
 
     fn write(&self, document: &mut Document, forward: bool) -> Result<(), HistoryMismatch> {
-        // Check everything on a copy of the small fields first so a mismatch never leaves
-        // the document half-written: vectors are checked inside `write` before any change,
-        // and the small swaps are checked here before the vectors are touched.
+        // Check every whole-value swap before anything is written so a mismatch never
+        // leaves the document half-written; vectors are checked inside their `write`
+        // before any change, on a copy of the bundles.
         if let Some(swap) = &self.w_mode {
-            let expected = if forward { swap.before } else { swap.after };
-            if document.hair_mesh.w_mode != expected {
-                return Err(HistoryMismatch {
-                    path: "hair_mesh.w_mode".into(),
-                    message: "the document does not hold the value this history entry changed"
-                        .into(),
-                });
-            }
+            swap.check(&document.hair_mesh.w_mode, forward, "hair_mesh.w_mode")?;
         }
         if let Some(swap) = &self.name {
-            let expected = if forward { &swap.before } else { &swap.after };
-            if &document.name != expected {
-                return Err(HistoryMismatch {
-                    path: "name".into(),
-                    message: "the document does not hold the value this history entry changed"
-                        .into(),
-                });
-            }
+            swap.check(&document.name, forward, "name")?;
+        }
+        if let Some(swap) = &self.source {
+            swap.check(&document.source, forward, "source")?;
+        }
+        if let Some(swap) = &self.body {
+            swap.check(&document.body, forward, "body")?;
         }
         if let Some(swap) = &self.styling {
-            let expected = if forward { &swap.before } else { &swap.after };
-            if &document.styling != expected {
-                return Err(HistoryMismatch {
-                    path: "styling".into(),
-                    message: "the document does not hold the value this history entry changed"
-                        .into(),
-                });
-            }
+            swap.check(&document.styling, forward, "styling")?;
         }
         let mut bundles = document.hair_mesh.bundles.clone();
         self.bundles
@@ -242,21 +252,19 @@ impl DocumentDiff {
         )?;
         document.hair_mesh.bundles = bundles;
         if let Some(swap) = &self.w_mode {
-            document.hair_mesh.w_mode = if forward { swap.after } else { swap.before };
+            swap.write(&mut document.hair_mesh.w_mode, forward);
         }
         if let Some(swap) = &self.name {
-            document.name = if forward {
-                swap.after.clone()
-            } else {
-                swap.before.clone()
-            };
+            swap.write(&mut document.name, forward);
+        }
+        if let Some(swap) = &self.source {
+            swap.write(&mut document.source, forward);
+        }
+        if let Some(swap) = &self.body {
+            swap.write(&mut document.body, forward);
         }
         if let Some(swap) = &self.styling {
-            document.styling = if forward {
-                swap.after.clone()
-            } else {
-                swap.before.clone()
-            };
+            swap.write(&mut document.styling, forward);
         }
         Ok(())
     }

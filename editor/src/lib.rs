@@ -2,4 +2,5 @@
 //! with the `hairloom render` command (`render`).
 
 pub mod app;
+pub mod files;
 pub mod render;

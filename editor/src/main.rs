@@ -7,16 +7,14 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::{Parser, Subcommand, ValueEnum};
 use hairloom_core::project;
 use hairloom_core::runtime::{Filtering, Precision};
 
 mod accuracy;
 mod bench;
-mod export;
 
-use hairloom_editor::render;
+use hairloom_editor::{files, render};
 
 #[derive(Parser)]
 #[command(
@@ -72,7 +70,7 @@ enum Command {
         #[arg(long, default_value_t = 64)]
         strands_per_bundle: u32,
         /// Strands have 2^N + 1 vertices.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = files::EXPORT_VERTICES_LOG2)]
         vertices_log2: u32,
         /// Runtime texture precision.
         #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
@@ -177,7 +175,7 @@ fn main() -> ExitCode {
             strands_per_bundle,
             vertices_log2,
             precision,
-        }) => export::run(
+        }) => files::run(
             &project,
             runtime.as_deref(),
             &strands,
@@ -345,45 +343,14 @@ fn import(
     scale: f64,
     generate_uv: bool,
 ) -> anyhow::Result<()> {
-    use hairloom_core::import::{ImportOptions, import_file};
-    if !(scale.is_finite() && scale > 0.0) {
-        anyhow::bail!("--scale must be a positive number, got {scale}");
-    }
-    let options = ImportOptions {
+    let options = hairloom_core::import::ImportOptions {
         mesh_name: mesh,
         scale,
-        ..ImportOptions::default()
+        ..hairloom_core::import::ImportOptions::default()
     };
-    let imported = import_file(scalp, &options)?;
-    let mut hair_mesh = imported.to_hair_mesh(|_| true);
-    if generate_uv || !imported.has_uv {
-        hairloom_core::uv::generate_uv(&mut hair_mesh, None);
-    }
-    let name = scalp
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scalp".into());
-    let mut document = hairloom_core::Document::new(name, hair_mesh);
-    document.source = format!("imported from {}", scalp.display());
-    document.body = imported.to_body();
-    document
-        .validate()
-        .with_context(|| format!("{} produced an invalid document", scalp.display()))?;
+    let (document, summary) = files::scalp_document(scalp, &options, generate_uv)?;
     project::save(out, &hairloom_core::Project::new(document))?;
-    println!(
-        "{} → {}: {} quads, {} triangles ({} source triangles, {} collapsed by welding){}",
-        scalp.display(),
-        out.display(),
-        imported.quad_count(),
-        imported.triangle_count(),
-        imported.source_triangles,
-        imported.degenerate_triangles,
-        if imported.has_uv {
-            ""
-        } else {
-            "; uv generated (the file has no TEXCOORD_0)"
-        }
-    );
+    println!("{summary} → {}", out.display());
     Ok(())
 }
 

@@ -7,6 +7,8 @@
 //! `HAIRLOOM_UPDATE_GOLDEN=1 cargo test -p hairloom-editor --test render_golden`; on a
 //! mismatch the new image is written under `target/golden-failures/` and its path printed.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -54,17 +56,6 @@ fn render(args: &[&std::ffi::OsStr], out: &Path) -> Option<image::RgbaImage> {
     }
     assert!(output.status.success(), "render {args:?}: {stderr}");
     Some(image::open(out).expect("a PNG").to_rgba8())
-}
-
-fn mean_error(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
-    assert_eq!(a.dimensions(), b.dimensions());
-    let total: u64 = a
-        .as_raw()
-        .iter()
-        .zip(b.as_raw())
-        .map(|(x, y)| x.abs_diff(*y) as u64)
-        .sum();
-    total as f64 / a.as_raw().len() as f64
 }
 
 #[test]
@@ -130,14 +121,7 @@ fn samples_match_their_golden_images() {
         };
         // A golden image must show something: hair and body cover part of the frame.
         let background = image.get_pixel(0, 0).0;
-        let drawn = image
-            .pixels()
-            .filter(|p| {
-                p.0.iter()
-                    .zip(&background)
-                    .any(|(a, b)| a.abs_diff(*b) > 12)
-            })
-            .count();
+        let drawn = common::drawn_pixels(&image, background);
         assert!(
             drawn > image.as_raw().len() / 4 / 20,
             "{name}: only {drawn} pixels drawn"
@@ -149,7 +133,7 @@ fn samples_match_their_golden_images() {
             continue;
         }
         let error = match image::open(&golden_path) {
-            Ok(golden) => mean_error(&image, &golden.to_rgba8()),
+            Ok(golden) => common::mean_error(&image, &golden.to_rgba8()),
             Err(e) => {
                 eprintln!("{}: {e}", golden_path.display());
                 f64::INFINITY
@@ -198,6 +182,6 @@ fn the_golden_comparison_sees_a_changed_picture() {
     let golden = image::open(root().join("editor/tests/golden/head_long_wavy.png"))
         .expect("golden image")
         .to_rgba8();
-    let error = mean_error(&side, &golden);
+    let error = common::mean_error(&side, &golden);
     assert!(error > 5.0 * MEAN_ERROR_TOLERANCE, "{error}");
 }

@@ -5,24 +5,38 @@
 use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
+use hairloom_editor::app::files::{DialogAnswer, ScriptedDialogs};
 use hairloom_editor::app::{EditorState, HairloomApp};
 
-/// The app on the sample, with autosaves in a fresh folder (no recovery offer).
-fn harness() -> Harness<'static, HairloomApp> {
+/// A fresh folder for one test's autosaves and recent-files list (no recovery offer).
+fn fresh_recovery_dir() -> std::path::PathBuf {
     let recovery_dir = std::env::temp_dir().join(format!(
         "hairloom-ui-test-{}-{:?}",
         std::process::id(),
         std::thread::current().id()
     ));
     let _ = std::fs::remove_dir_all(&recovery_dir);
-    harness_with_recovery(&recovery_dir)
+    recovery_dir
+}
+
+/// The app on the sample, with autosaves in a fresh folder (no recovery offer).
+fn harness() -> Harness<'static, HairloomApp> {
+    harness_with_recovery(&fresh_recovery_dir())
 }
 
 /// The app on the sample, with its autosaves (and any offer) in `recovery_dir`.
 fn harness_with_recovery(recovery_dir: &std::path::Path) -> Harness<'static, HairloomApp> {
+    harness_with(recovery_dir, ScriptedDialogs::default())
+}
+
+/// The app on the sample with scripted file-dialog answers.
+fn harness_with(
+    recovery_dir: &std::path::Path,
+    dialogs: ScriptedDialogs,
+) -> Harness<'static, HairloomApp> {
     let recovery = hairloom_editor::app::recovery::Recovery::in_dir(recovery_dir);
     let mut harness = Harness::new_eframe(move |cc| {
-        HairloomApp::with_recovery(cc, EditorState::sample(), recovery)
+        HairloomApp::with_recovery(cc, EditorState::sample(), recovery).with_dialogs(dialogs)
     });
     harness.set_size(egui::vec2(1400.0, 900.0));
     harness.run();
@@ -219,4 +233,225 @@ fn discarding_the_offer_removes_the_autosave() {
     harness.run();
     assert!(Recovery::in_dir(dir.path()).pending().is_none());
     assert!(!harness.state().state.is_dirty());
+}
+
+/// Clicks File ▸ `item`.
+fn file_menu(harness: &mut Harness<'static, HairloomApp>, item: &str) {
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label(item).click();
+    // Steps, not `run`: an export keeps repainting its progress bar.
+    for _ in 0..4 {
+        harness.step();
+    }
+}
+
+/// Makes an undoable change so the document has unsaved work.
+fn make_unsaved_change(harness: &mut Harness<'static, HairloomApp>) {
+    harness
+        .get_by_role_and_label(Role::Slider, "Wave amplitude")
+        .set_value_accesskit(0.013);
+    harness.run();
+    assert!(harness.state().state.is_dirty());
+}
+
+#[test]
+fn save_on_the_sample_asks_where_and_the_file_becomes_recent() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("mine"); // the extension is added
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Chosen(path.clone())]),
+    );
+    make_unsaved_change(&mut harness);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    let saved = dir.path().join("mine.hairloom");
+    assert!(saved.exists(), "{}", harness.state().state.message);
+    assert!(!harness.state().state.is_dirty());
+    assert_eq!(harness.state().state.path.as_deref(), Some(saved.as_path()));
+    assert!(harness.state().recent.paths[0].ends_with("mine.hairloom"));
+    let reopened = EditorState::open(&saved).expect("reopen");
+    assert_eq!(reopened.project, harness.state().state.project);
+
+    // File ▸ Open Recent lists it; New then reopening it from the list gets it back.
+    file_menu(&mut harness, "New");
+    assert!(
+        harness
+            .state()
+            .state
+            .document()
+            .hair_mesh
+            .bundles
+            .is_empty()
+    );
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label("Open Recent").hover();
+    harness.run();
+    harness.get_by_label(&saved.display().to_string()).click();
+    harness.run();
+    assert_eq!(harness.state().state.project, reopened.project);
+}
+
+#[test]
+fn opening_with_unsaved_changes_asks_first_and_cancel_keeps_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let other = dir.path().join("other.hairloom");
+    let mut other_state = EditorState::sample();
+    other_state.edit("curl").styling.global.curl.radius_m = 0.006;
+    other_state.commit_edit();
+    other_state.save_as(&other).expect("save");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([
+            DialogAnswer::Chosen(other.clone()),
+            DialogAnswer::Chosen(other.clone()),
+        ]),
+    );
+    make_unsaved_change(&mut harness);
+    let edited = harness.state().state.document().clone();
+    file_menu(&mut harness, "Open…");
+    harness.get_by_label("Save changes?");
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.document(),
+        &edited,
+        "Cancel keeps the work"
+    );
+    assert!(harness.state().confirm.is_none());
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
+    harness.run();
+    harness.get_by_label("Don't Save").click();
+    harness.run();
+    assert_eq!(harness.state().state.project, other_state.project);
+    assert!(!harness.state().state.is_dirty());
+}
+
+#[test]
+fn quitting_with_unsaved_changes_asks_first() {
+    let recovery_dir = fresh_recovery_dir();
+    let mut harness = harness_with(&recovery_dir, ScriptedDialogs::default());
+    file_menu(&mut harness, "Quit");
+    assert!(
+        harness.state().wants_to_quit(),
+        "nothing unsaved: quits at once"
+    );
+
+    let mut harness = harness_with(&recovery_dir, ScriptedDialogs::default());
+    make_unsaved_change(&mut harness);
+    file_menu(&mut harness, "Quit");
+    assert!(!harness.state().wants_to_quit());
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert!(!harness.state().wants_to_quit(), "Cancel stays");
+    // The window's close button asks the same question.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Q);
+    harness.run();
+    harness.get_by_label("Don't Save").click();
+    harness.run();
+    assert!(harness.state().wants_to_quit());
+}
+
+/// Runs frames until the export worker is done (bounded, so a hang fails instead).
+fn wait_for_export(harness: &mut Harness<'static, HairloomApp>) {
+    for _ in 0..2000 {
+        if harness.state().export.is_none() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        harness.step();
+    }
+    panic!("the export did not finish");
+}
+
+#[test]
+fn exports_write_a_loadable_runtime_bundle_and_strand_files() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let runtime = dir.path().join("runtime");
+    let strands = dir.path().join("hair.usda");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([
+            DialogAnswer::Chosen(runtime.clone()),
+            DialogAnswer::Chosen(strands.clone()),
+            DialogAnswer::Chosen(dir.path().join("hair.obj")),
+        ]),
+    );
+    file_menu(&mut harness, "Export runtime bundle…");
+    wait_for_export(&mut harness);
+    let message = harness.state().state.message.clone();
+    assert!(message.starts_with("exported"), "{message}");
+    let bundle = hairloom_core::export::load_runtime_bundle(&runtime).expect("loads");
+    assert_eq!(
+        bundle.manifest.strands_per_bundle,
+        harness.state().viewport.settings.strands_per_bundle
+    );
+
+    file_menu(&mut harness, "Export strands…");
+    wait_for_export(&mut harness);
+    let text = std::fs::read_to_string(&strands).expect("usda written");
+    assert!(text.starts_with("#usda"), "{}", &text[..40.min(text.len())]);
+
+    file_menu(&mut harness, "Export strands…");
+    wait_for_export(&mut harness);
+    let message = harness.state().state.message.clone();
+    assert!(
+        message.contains("hair.obj") && message.contains("unknown strand format"),
+        "{message}"
+    );
+}
+
+#[test]
+fn importing_a_scalp_is_one_undo_step() {
+    let glb =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/head/LeePerrySmith.glb");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([
+            DialogAnswer::Chosen(dir.path().join("missing.glb")),
+            DialogAnswer::Chosen(glb),
+        ]),
+    );
+    let original = harness.state().state.document().clone();
+    file_menu(&mut harness, "Import scalp…");
+    let message = harness.state().state.message.clone();
+    assert!(message.contains("missing.glb"), "{message}");
+    assert_eq!(harness.state().state.document(), &original);
+
+    file_menu(&mut harness, "Import scalp…");
+    let imported = harness.state().state.document().clone();
+    assert_eq!(imported.name, "LeePerrySmith");
+    assert!(imported.hair_mesh.bundles.len() > original.hair_mesh.bundles.len());
+    assert!(imported.hair_mesh.bundles.iter().all(|b| b.layers == 0));
+    assert_eq!(imported.styling, original.styling, "the styling is kept");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original);
+}
+
+#[test]
+fn without_a_native_dialog_a_typed_path_is_asked_for() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("typed.hairloom");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Unavailable]),
+    );
+    file_menu(&mut harness, "Save As…");
+    // Replace the suggested name with the typed path.
+    harness.get_by_role(Role::TextInput).focus();
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness
+        .get_by_role(Role::TextInput)
+        .type_text(&path.display().to_string());
+    harness.run();
+    harness.get_by_label("OK").click();
+    harness.run();
+    assert!(path.exists(), "{}", harness.state().state.message);
+    assert_eq!(harness.state().state.path.as_deref(), Some(path.as_path()));
 }

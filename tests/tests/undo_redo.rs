@@ -432,3 +432,42 @@ fn a_styling_only_change_is_recorded_and_undone() {
     history.redo(&mut current).expect("redo");
     assert_eq!(current, after);
 }
+
+#[test]
+fn every_document_field_is_recorded_and_undone() {
+    // Regression: the source and body were outside the diff, so undoing an import kept the
+    // imported body and attribution. Change each whole-value field alone, then all at once.
+    let document = hairloom_core::project::load(&hairloom_tests::sample_paths()[0])
+        .expect("sample")
+        .document;
+    type Change = fn(&mut hairloom_core::Document);
+    let changes: [(&str, Change); 4] = [
+        ("name", |d| d.name.push_str(" copy")),
+        ("source", |d| {
+            d.source = "imported from elsewhere.glb".into()
+        }),
+        ("body", |d| {
+            d.body.positions.push([0.0, 0.0, 0.0]);
+        }),
+        ("all", |d| {
+            d.name = "other".into();
+            d.source.clear();
+            d.body = hairloom_core::document::BodyMesh::default();
+            d.styling.global.seed += 1;
+        }),
+    ];
+    for (what, change) in changes {
+        let mut after = document.clone();
+        change(&mut after);
+        assert_ne!(after, document, "{what}");
+        let command = Command::record(what, &document, &after)
+            .unwrap_or_else(|| panic!("a change of {what} was not recorded"));
+        let mut history = History::default();
+        history.push(command);
+        let mut current = after.clone();
+        history.undo(&mut current).expect("undo");
+        assert_eq!(current, document, "undo of {what}");
+        history.redo(&mut current).expect("redo");
+        assert_eq!(current, after, "redo of {what}");
+    }
+}

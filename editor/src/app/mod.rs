@@ -1,8 +1,10 @@
-//! The interactive editor (eframe on wgpu): a 3D viewport with live GPU strands, a styling
-//! panel, a history panel, menus and a status bar. `state` is the model; panels follow the
-//! egui demo pattern `fn ui(&mut self, ui, state)`.
+//! The interactive editor (eframe on wgpu): a 3D viewport with live GPU strands and dockable
+//! panels (egui_tiles: tools, outliner, history, styling), menus and a status bar. `state` is
+//! the model; panels follow the egui demo pattern `fn ui(&mut self, ui, state)`.
 
+pub mod files;
 pub mod history_panel;
+pub mod outliner_panel;
 pub mod recovery;
 pub mod state;
 pub mod styling_panel;
@@ -11,21 +13,95 @@ pub mod viewport;
 
 pub use state::EditorState;
 
+use std::path::PathBuf;
+
+use files::{
+    DialogAnswer, ExportJob, ExportTarget, FileDialogs, FileRequest, NativeDialogs, PathPrompt,
+    RecentFiles,
+};
 use history_panel::HistoryPanel;
+use outliner_panel::OutlinerPanel;
 use recovery::{AUTOSAVE_SECONDS, PendingRecovery, Recovery};
 use styling_panel::StylingPanel;
 use tools_panel::ToolsPanel;
 use viewport::Viewport;
+
+/// What runs after the artist answers "save changes?".
+#[derive(Clone, Debug, PartialEq)]
+pub enum AfterConfirm {
+    Quit,
+    New,
+    Open(PathBuf),
+}
+
+/// The dockable panes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pane {
+    Viewport,
+    Tools,
+    Outliner,
+    History,
+    Styling,
+}
+
+impl Pane {
+    pub fn title(self) -> &'static str {
+        match self {
+            Self::Viewport => "Viewport",
+            Self::Tools => "Tools",
+            Self::Outliner => "Outliner",
+            Self::History => "History",
+            Self::Styling => "Styling",
+        }
+    }
+}
+
+/// The default layout: tools / outliner / history on the left, the viewport in the middle,
+/// styling on the right. Panes can be dragged into tabs and splits.
+pub fn default_layout() -> egui_tiles::Tree<Pane> {
+    let mut tiles = egui_tiles::Tiles::default();
+    let tools = tiles.insert_pane(Pane::Tools);
+    let outliner = tiles.insert_pane(Pane::Outliner);
+    let history = tiles.insert_pane(Pane::History);
+    let left_top = tiles.insert_tab_tile(vec![tools]);
+    let left_middle = tiles.insert_tab_tile(vec![outliner]);
+    let left_bottom = tiles.insert_tab_tile(vec![history]);
+    let left = tiles.insert_vertical_tile(vec![left_top, left_middle, left_bottom]);
+    let viewport = tiles.insert_pane(Pane::Viewport);
+    let styling = tiles.insert_pane(Pane::Styling);
+    let right = tiles.insert_tab_tile(vec![styling]);
+    let root = tiles.insert_horizontal_tile(vec![left, viewport, right]);
+    if let Some(egui_tiles::Tile::Container(egui_tiles::Container::Linear(linear))) =
+        tiles.get_mut(root)
+    {
+        linear.shares.set_share(left, 1.0);
+        linear.shares.set_share(viewport, 3.2);
+        linear.shares.set_share(right, 1.3);
+    }
+    egui_tiles::Tree::new(egui::Id::unique("hairloom layout"), root, tiles)
+}
 
 pub struct HairloomApp {
     pub state: EditorState,
     pub styling: StylingPanel,
     pub history: HistoryPanel,
     pub tools: ToolsPanel,
+    pub outliner: OutlinerPanel,
     pub viewport: Viewport,
+    pub layout: egui_tiles::Tree<Pane>,
     pub recovery: Recovery,
     /// A recovery file from an earlier run, offered until recovered or discarded.
     pub offer: Option<PendingRecovery>,
+    pub dialogs: Box<dyn FileDialogs>,
+    pub recent: RecentFiles,
+    /// The typed-path prompt, where no native dialog exists.
+    pub prompt: Option<PathPrompt>,
+    pub export: Option<ExportJob>,
+    /// "Save changes?" is being asked before this action.
+    pub confirm: Option<AfterConfirm>,
+    /// The artist chose to quit; the next close request is let through.
+    quitting: bool,
+    close_sent: bool,
     /// Time (s) and document revision of the last autosave.
     autosaved: (f64, u64),
     title: String,
@@ -36,7 +112,8 @@ impl HairloomApp {
         Self::with_recovery(cc, state, Recovery::default_location())
     }
 
-    /// The app with its autosaves in `recovery` (tests use a temporary folder).
+    /// The app with its autosaves (and recent-files list) in `recovery` (tests use a
+    /// temporary folder) and native file dialogs.
     pub fn with_recovery(
         cc: &eframe::CreationContext<'_>,
         state: EditorState,
@@ -46,13 +123,28 @@ impl HairloomApp {
             viewport: Viewport::new(cc.wgpu_render_state.as_ref()),
             offer: recovery.pending(),
             autosaved: (0.0, state.revision),
+            recent: RecentFiles::load(recovery.dir().join("recent.txt")),
             recovery,
             state,
             styling: StylingPanel::default(),
             history: HistoryPanel,
             tools: ToolsPanel::default(),
+            outliner: OutlinerPanel,
+            layout: default_layout(),
+            dialogs: Box::new(NativeDialogs),
+            prompt: None,
+            export: None,
+            confirm: None,
+            quitting: false,
+            close_sent: false,
             title: String::new(),
         }
+    }
+
+    /// Replaces the file dialogs (tests script them).
+    pub fn with_dialogs(mut self, dialogs: impl FileDialogs + 'static) -> Self {
+        self.dialogs = Box::new(dialogs);
+        self
     }
 
     /// Writes the recovery file when there is unsaved work newer than the last autosave.
@@ -128,6 +220,10 @@ impl HairloomApp {
         let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
         let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
         let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
+        let save_as = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::S);
+        let open = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
+        let new = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
+        let quit = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
         // The most specific shortcut first: Ctrl+Shift+Z would also match Ctrl+Z.
         if ui.input_mut(|i| i.consume_shortcut(&redo_shift) || i.consume_shortcut(&redo_y)) {
             self.state.redo();
@@ -135,8 +231,20 @@ impl HairloomApp {
         if ui.input_mut(|i| i.consume_shortcut(&undo)) {
             self.state.undo();
         }
+        if ui.input_mut(|i| i.consume_shortcut(&save_as)) {
+            self.save_as();
+        }
         if ui.input_mut(|i| i.consume_shortcut(&save)) {
             self.save();
+        }
+        if ui.input_mut(|i| i.consume_shortcut(&open)) {
+            self.file_request(FileRequest::OpenProject);
+        }
+        if ui.input_mut(|i| i.consume_shortcut(&new)) {
+            self.request(AfterConfirm::New);
+        }
+        if ui.input_mut(|i| i.consume_shortcut(&quit)) {
+            self.request(AfterConfirm::Quit);
         }
         // Single-key tools only when no text field has the keyboard.
         if !ui.ctx().egui_wants_keyboard_input()
@@ -146,19 +254,221 @@ impl HairloomApp {
         }
     }
 
-    /// Saves; a saved project needs no recovery file.
-    pub fn save(&mut self) {
-        if self.state.save().is_ok() {
-            self.recovery.discard();
+    /// Saves (Save As when the project has no file yet); a saved project needs no
+    /// recovery file.
+    pub fn save(&mut self) -> bool {
+        if self.state.path.is_none() {
+            return self.save_as();
         }
+        match self.state.save() {
+            Ok(path) => {
+                self.saved_to(&path);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    pub fn save_as(&mut self) -> bool {
+        let suggested =
+            self.state.path.clone().unwrap_or_else(|| {
+                PathBuf::from(format!("{}.hairloom", self.state.document().name))
+            });
+        match self.ask(FileRequest::SaveProjectAs, Some(suggested)) {
+            Some(mut path) => {
+                if path.extension().is_none() {
+                    path.set_extension("hairloom");
+                }
+                match self.state.save_as(&path) {
+                    Ok(path) => {
+                        self.saved_to(&path);
+                        true
+                    }
+                    Err(_) => false,
+                }
+            }
+            None => false,
+        }
+    }
+
+    fn saved_to(&mut self, path: &std::path::Path) {
+        self.recovery.discard();
+        self.recent.push(path);
+    }
+
+    /// Asks a dialog for a path; `None` when cancelled or when the typed-path prompt was
+    /// opened instead (its OK continues the request).
+    fn ask(&mut self, request: FileRequest, suggested: Option<PathBuf>) -> Option<PathBuf> {
+        match self.dialogs.ask(request, suggested.as_deref()) {
+            DialogAnswer::Chosen(path) => Some(path),
+            DialogAnswer::Cancelled => None,
+            DialogAnswer::Unavailable => {
+                self.prompt = Some(PathPrompt {
+                    request,
+                    text: suggested.map_or(String::new(), |p| p.display().to_string()),
+                });
+                None
+            }
+        }
+    }
+
+    /// Runs a file request for a chosen path.
+    fn answered(&mut self, request: FileRequest, path: PathBuf) {
+        match request {
+            FileRequest::OpenProject => self.request(AfterConfirm::Open(path)),
+            FileRequest::SaveProjectAs => {
+                if let Ok(path) = self.state.save_as(&path) {
+                    self.saved_to(&path);
+                }
+            }
+            FileRequest::ImportScalp => self.import_scalp(&path),
+            FileRequest::ExportRuntime => self.start_export(ExportTarget::Runtime {
+                dir: path,
+                precision: self.viewport.settings.precision,
+            }),
+            FileRequest::ExportStrands => self.start_export(ExportTarget::Strands {
+                file: path,
+                vertices_log2: crate::files::EXPORT_VERTICES_LOG2,
+            }),
+        }
+    }
+
+    /// File ▸ Open, Import, Export: ask for the path, then do it.
+    pub fn file_request(&mut self, request: FileRequest) {
+        let suggested = match request {
+            FileRequest::ExportRuntime => Some(PathBuf::from(format!(
+                "{}_runtime",
+                self.state.document().name
+            ))),
+            FileRequest::ExportStrands => {
+                Some(PathBuf::from(format!("{}.glb", self.state.document().name)))
+            }
+            _ => self.state.path.clone(),
+        };
+        if let Some(path) = self.ask(request, suggested) {
+            self.answered(request, path);
+        }
+    }
+
+    /// New, Open or Quit: asks "save changes?" first when there is unsaved work.
+    pub fn request(&mut self, action: AfterConfirm) {
+        if self.state.is_dirty() {
+            self.confirm = Some(action);
+        } else {
+            self.run_action(action);
+        }
+    }
+
+    fn run_action(&mut self, action: AfterConfirm) {
+        match action {
+            AfterConfirm::Quit => {
+                self.quitting = true;
+                self.recovery.discard();
+            }
+            AfterConfirm::New => self.replace_state(EditorState::new_project()),
+            AfterConfirm::Open(path) => match EditorState::open(&path) {
+                Ok(state) => {
+                    self.recent.push(&path);
+                    self.replace_state(state);
+                }
+                // The open document stays as it was.
+                Err(error) => self.state.message = format!("open failed: {error}"),
+            },
+        }
+    }
+
+    fn replace_state(&mut self, state: EditorState) {
+        self.state = state;
+        self.recovery.discard();
+        self.autosaved.1 = self.state.revision;
+    }
+
+    fn import_scalp(&mut self, path: &std::path::Path) {
+        let options = hairloom_core::import::ImportOptions::default();
+        match crate::files::scalp_document(path, &options, false) {
+            Ok((document, summary)) => self.state.import_scalp(document, &summary),
+            Err(error) => self.state.message = format!("import failed: {error:#}"),
+        }
+    }
+
+    fn start_export(&mut self, target: ExportTarget) {
+        if let ExportTarget::Strands { file, .. } = &target
+            && !files::is_strand_file(file)
+        {
+            self.state.message = format!(
+                "export failed: {}: unknown strand format (use .hair, .usda or .glb)",
+                file.display()
+            );
+            return;
+        }
+        self.state.commit_edit();
+        self.export = Some(ExportJob::start(
+            self.state.document().clone(),
+            target,
+            self.viewport.settings.strands_per_bundle,
+        ));
+    }
+
+    /// Whether the artist asked to quit and nothing is left to ask (the window may close).
+    pub fn wants_to_quit(&self) -> bool {
+        self.quitting
     }
 
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if ui.button("Save").clicked() {
-                    self.save();
+                if ui.button("New").clicked() {
+                    self.request(AfterConfirm::New);
                     ui.close();
+                }
+                if ui.button("Open…").clicked() {
+                    ui.close();
+                    self.file_request(FileRequest::OpenProject);
+                }
+                ui.menu_button("Open Recent", |ui| {
+                    if self.recent.paths.is_empty() {
+                        ui.label("(none yet)");
+                    }
+                    for path in self.recent.paths.clone() {
+                        if ui.button(path.display().to_string()).clicked() {
+                            ui.close();
+                            self.request(AfterConfirm::Open(path));
+                        }
+                    }
+                });
+                ui.separator();
+                if ui.button("Save").clicked() {
+                    ui.close();
+                    self.save();
+                }
+                if ui.button("Save As…").clicked() {
+                    ui.close();
+                    self.save_as();
+                }
+                ui.separator();
+                if ui.button("Import scalp…").clicked() {
+                    ui.close();
+                    self.file_request(FileRequest::ImportScalp);
+                }
+                let exporting = self.export.is_some();
+                if ui
+                    .add_enabled(!exporting, egui::Button::new("Export runtime bundle…"))
+                    .clicked()
+                {
+                    ui.close();
+                    self.file_request(FileRequest::ExportRuntime);
+                }
+                if ui
+                    .add_enabled(!exporting, egui::Button::new("Export strands…"))
+                    .clicked()
+                {
+                    ui.close();
+                    self.file_request(FileRequest::ExportStrands);
+                }
+                ui.separator();
+                if ui.button("Quit").clicked() {
+                    ui.close();
+                    self.request(AfterConfirm::Quit);
                 }
             });
             ui.menu_button("Edit", |ui| {
@@ -211,8 +521,106 @@ impl HairloomApp {
                         "f16",
                     );
                 });
+                ui.separator();
+                if ui.button("Reset layout").clicked() {
+                    self.layout = default_layout();
+                    ui.close();
+                }
             });
         });
+    }
+
+    /// The modal windows: recovery offer, "save changes?", typed path, export progress.
+    fn modals(&mut self, ui: &mut egui::Ui) {
+        self.recovery_offer(ui);
+        if let Some(action) = self.confirm.clone() {
+            let mut choice = None;
+            egui::Modal::new(egui::Id::unique("hairloom save changes")).show(ui.ctx(), |ui| {
+                ui.heading("Save changes?");
+                ui.label(format!(
+                    "{} has unsaved changes. They are lost if you do not save them.",
+                    self.state.title().trim_end_matches(" — Hairloom")
+                ));
+                ui.horizontal(|ui| {
+                    if ui.button("Save").clicked() {
+                        choice = Some(Some(true));
+                    }
+                    if ui.button("Don't Save").clicked() {
+                        choice = Some(Some(false));
+                    }
+                    if ui.button("Cancel").clicked() {
+                        choice = Some(None);
+                    }
+                });
+            });
+            match choice {
+                Some(Some(save)) => {
+                    self.confirm = None;
+                    if !save || self.save() {
+                        self.run_action(action);
+                    }
+                }
+                Some(None) => self.confirm = None,
+                None => {}
+            }
+        }
+        if let Some(prompt) = self.prompt.as_mut() {
+            let mut answer = None;
+            egui::Modal::new(egui::Id::unique("hairloom path prompt")).show(ui.ctx(), |ui| {
+                ui.heading(prompt.request.title());
+                ui.label("No file dialog is available here: type the path.");
+                let field = ui.add(
+                    egui::TextEdit::singleline(&mut prompt.text)
+                        .desired_width(420.0)
+                        .hint_text("/path/to/file"),
+                );
+                let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                ui.horizontal(|ui| {
+                    if ui.button("OK").clicked() || entered {
+                        answer = Some(Some(PathBuf::from(prompt.text.trim())));
+                    }
+                    if ui.button("Cancel").clicked() {
+                        answer = Some(None);
+                    }
+                });
+            });
+            if let Some(answer) = answer {
+                let request = prompt.request;
+                self.prompt = None;
+                if let Some(path) = answer.filter(|p| !p.as_os_str().is_empty()) {
+                    self.answered(request, path);
+                }
+            }
+        }
+        if let Some(job) = &self.export {
+            match job.finished() {
+                Some(outcome) => {
+                    self.state.message = match outcome {
+                        Ok(summary) => format!("exported {summary}"),
+                        Err(error) => format!("export failed: {error}"),
+                    };
+                    self.export = None;
+                }
+                None => {
+                    egui::Modal::new(egui::Id::unique("hairloom export")).show(ui.ctx(), |ui| {
+                        ui.heading("Exporting");
+                        ui.label(match &job.target {
+                            ExportTarget::Runtime { dir, .. } => dir.display().to_string(),
+                            ExportTarget::Strands { file, .. } => file.display().to_string(),
+                        });
+                        ui.add(
+                            egui::ProgressBar::new(job.fraction())
+                                .show_percentage()
+                                .desired_width(360.0),
+                        );
+                        if ui.button("Cancel").clicked() {
+                            job.cancel();
+                        }
+                    });
+                    ui.ctx().request_repaint();
+                }
+            }
+        }
     }
 
     fn status_bar(&self, ui: &mut egui::Ui) {
@@ -234,10 +642,67 @@ impl HairloomApp {
     }
 }
 
+/// Draws each pane with the app's panels.
+struct PaneUi<'a> {
+    state: &'a mut EditorState,
+    tools: &'a mut ToolsPanel,
+    outliner: &'a mut OutlinerPanel,
+    history: &'a mut HistoryPanel,
+    styling: &'a mut StylingPanel,
+    viewport: &'a mut Viewport,
+}
+
+impl egui_tiles::Behavior<Pane> for PaneUi<'_> {
+    fn tab_title_for_pane(&mut self, pane: &Pane) -> egui::WidgetText {
+        pane.title().into()
+    }
+
+    fn pane_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        _tile_id: egui_tiles::TileId,
+        pane: &mut Pane,
+    ) -> egui_tiles::UiResponse {
+        if *pane == Pane::Viewport {
+            self.viewport.ui(ui, self.state);
+            return egui_tiles::UiResponse::None;
+        }
+        egui::Frame::central_panel(ui.style()).show(ui, |ui| {
+            egui::ScrollArea::vertical()
+                .id_salt(pane.title())
+                .auto_shrink([false, false])
+                .show(ui, |ui| match pane {
+                    Pane::Tools => self.tools.ui(ui, self.state),
+                    Pane::Outliner => self.outliner.ui(ui, self.state),
+                    Pane::History => self.history.ui(ui, self.state),
+                    Pane::Styling => self.styling.ui(ui, self.state),
+                    Pane::Viewport => {}
+                });
+        });
+        egui_tiles::UiResponse::None
+    }
+
+    fn simplification_options(&self) -> egui_tiles::SimplificationOptions {
+        egui_tiles::SimplificationOptions {
+            all_panes_must_have_tabs: true,
+            ..Default::default()
+        }
+    }
+
+    fn is_tab_bar_visible(&self, _tile_id: egui_tiles::TileId, tabs: &egui_tiles::Tabs) -> bool {
+        // The viewport alone in a tab group needs no tab bar; every other pane shows its title.
+        tabs.children.len() > 1 || tabs.active.is_none()
+    }
+}
+
 impl eframe::App for HairloomApp {
     fn on_exit(&mut self) {
+        if let Some(job) = &self.export {
+            // Let the export finish writing (each file is atomic either way).
+            let _ = job.wait();
+        }
         // Unsaved work survives a quit; nothing unsaved leaves no recovery file behind.
-        if self.state.is_dirty() {
+        if self.state.is_dirty() && !self.quitting {
             let _ = self.recovery.write(&self.state);
         } else if self.offer.is_none() {
             self.recovery.discard();
@@ -246,7 +711,17 @@ impl eframe::App for HairloomApp {
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.autosave(ui.input(|i| i.time));
-        self.recovery_offer(ui);
+        // The window's close button asks first, like File ▸ Quit.
+        if ui.input(|i| i.viewport().close_requested()) && !self.quitting {
+            ui.ctx()
+                .send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.request(AfterConfirm::Quit);
+        }
+        if self.quitting && !self.close_sent {
+            ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+            self.close_sent = true;
+        }
+        self.modals(ui);
         self.shortcuts(ui);
         let title = self.state.title();
         if title != self.title {
@@ -256,16 +731,16 @@ impl eframe::App for HairloomApp {
         }
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        egui::Panel::left("tools")
-            .default_size(240.0)
-            .show(ui, |ui| {
-                self.tools.ui(ui, &mut self.state);
-                ui.separator();
-                self.history.ui(ui, &mut self.state);
-            });
-        egui::Panel::right("styling")
-            .default_size(320.0)
-            .show(ui, |ui| self.styling.ui(ui, &mut self.state));
-        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport.ui(ui, &mut self.state));
+        egui::CentralPanel::no_frame().show(ui, |ui| {
+            let mut panes = PaneUi {
+                state: &mut self.state,
+                tools: &mut self.tools,
+                outliner: &mut self.outliner,
+                history: &mut self.history,
+                styling: &mut self.styling,
+                viewport: &mut self.viewport,
+            };
+            self.layout.ui(&mut panes, ui);
+        });
     }
 }

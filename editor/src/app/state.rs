@@ -63,6 +63,30 @@ impl EditorState {
         Self::with_project(project, None, format!("opened {SAMPLE_NAME}"))
     }
 
+    /// A new, empty project (import a scalp to start).
+    pub fn new_project() -> Self {
+        let document = Document::new("untitled", HairMesh::empty());
+        Self::with_project(
+            Project::new(document),
+            None,
+            "new project: import a scalp with File > Import scalp...".into(),
+        )
+    }
+
+    /// Replaces the scalp, body and name with an imported document's, keeping the styling:
+    /// one undo step.
+    pub fn import_scalp(&mut self, imported: Document, summary: &str) {
+        self.commit_edit();
+        let document = self.edit("Import scalp");
+        document.name = imported.name;
+        document.source = imported.source;
+        document.hair_mesh = imported.hair_mesh;
+        document.body = imported.body;
+        self.commit_edit();
+        self.selection.clear();
+        self.message = format!("imported {summary}");
+    }
+
     /// Opens a project file; the error names the file and the problem.
     pub fn open(path: &Path) -> Result<Self, project::ProjectError> {
         let project = project::load(path)?;
@@ -79,16 +103,14 @@ impl EditorState {
 
     /// Title for the window and the status bar.
     pub fn title(&self) -> String {
-        let name = self
-            .path
-            .as_deref()
-            .and_then(Path::file_name)
-            .map_or(SAMPLE_NAME.to_string(), |n| {
-                n.to_string_lossy().into_owned()
-            });
+        let name = match self.path.as_deref().and_then(Path::file_name) {
+            Some(name) => name.to_string_lossy().into_owned(),
+            None if self.project.document.name == "untitled" => "untitled".into(),
+            None => SAMPLE_NAME.to_string(),
+        };
         format!(
             "{}{name} — Hairloom",
-            if self.is_dirty() { "● " } else { "" }
+            if self.is_dirty() { "* " } else { "" }
         )
     }
 

@@ -1,5 +1,4 @@
-//! Tools and outliner: the bundle list (click selects, ctrl/shift-click adds), selection
-//! helpers, and the topology tools on the selection — extrude (E), insert and delete a layer,
+//! Tools: the topology tools on the selection — extrude (E), insert and delete a layer,
 //! remove / restore, subdivide. Each tool is one undo step; errors go to the status bar.
 
 use hairloom_core::edit::{self, ExtrudeDirection};
@@ -76,45 +75,5 @@ impl ToolsPanel {
                 state.edit_mesh("Subdivide", edit::subdivide);
             }
         });
-        ui.separator();
-        let count = state.document().hair_mesh.bundles.len();
-        ui.horizontal(|ui| {
-            ui.label(format!("Bundles ({} selected)", state.selection.len()));
-            if ui.small_button("All").clicked() {
-                state.selection = (0..count as u32).collect();
-            }
-            if ui.small_button("None").clicked() {
-                state.selection.clear();
-            }
-        });
-        let row_height = ui.text_style_height(&egui::TextStyle::Body) + 4.0;
-        egui::ScrollArea::vertical()
-            .id_salt("outliner")
-            .max_height(260.0)
-            .show_rows(ui, row_height, count, |ui, rows| {
-                for index in rows {
-                    let bundle = &state.document().hair_mesh.bundles[index];
-                    let text = format!(
-                        "Bundle {index} · {} layers{}",
-                        bundle.layers,
-                        if bundle.removed { " · removed" } else { "" }
-                    );
-                    let selected = state.selection.contains(&(index as u32));
-                    let response = ui.selectable_label(selected, text);
-                    if response.clicked() {
-                        let add = ui.input(|i| i.modifiers.command || i.modifiers.shift);
-                        if !add {
-                            state.selection.clear();
-                        }
-                        if selected && add {
-                            state.selection.remove(&(index as u32));
-                        } else {
-                            state.selection.insert(index as u32);
-                        }
-                    }
-                }
-            });
-        // Drop selections the document no longer has (after undoing a subdivide, say).
-        state.selection.retain(|&b| (b as usize) < count);
     }
 }

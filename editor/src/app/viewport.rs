@@ -19,6 +19,9 @@ use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
 use super::state::EditorState;
 use crate::render::{RenderableHair, default_scene};
 
+/// Storage buffers per shader stage the generation and preview pipelines bind.
+const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
+
 /// Where the camera looks from, around the hair's centre.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Orbit {
@@ -126,6 +129,8 @@ pub struct Viewport {
     pub drawn_vertices: usize,
     pub adapter: String,
     pub error: Option<String>,
+    /// Where the viewport was last drawn, in points (snapshot tests crop to it).
+    pub rect: Option<egui::Rect>,
     /// The box the camera frames (the drawn hair's), for picking with the same camera.
     camera_bounds: Option<(Vec3, Vec3)>,
     /// Per column and layer, whether the vertex is interior, for the document revision it
@@ -136,6 +141,22 @@ pub struct Viewport {
 impl Viewport {
     /// A viewport drawing through eframe's wgpu device, or a placeholder without one.
     pub fn new(render_state: Option<&egui_wgpu::RenderState>) -> Self {
+        // Generation needs storage buffers in compute and vertex stages (the WebGPU default
+        // of 8); a GL/WebGL2-limited device gets the placeholder and says why.
+        let unsupported = render_state.and_then(|state| {
+            let limits = state.device.limits();
+            (limits.max_storage_buffers_per_shader_stage < MIN_STORAGE_BUFFERS_PER_STAGE).then(
+                || {
+                    format!(
+                        "{}: {} storage buffers per shader stage, the viewport needs {}",
+                        describe(&state.adapter.get_info()),
+                        limits.max_storage_buffers_per_shader_stage,
+                        MIN_STORAGE_BUFFERS_PER_STAGE
+                    )
+                },
+            )
+        });
+        let render_state = render_state.filter(|_| unsupported.is_none());
         let gpu = render_state.map(|state| {
             let context = GpuContext::from_parts(
                 state.adapter.clone(),
@@ -152,9 +173,10 @@ impl Viewport {
             }
         });
         Self {
-            adapter: gpu.as_ref().map_or("no GPU device".into(), |g| {
-                describe(&g.context.adapter_info)
-            }),
+            adapter: gpu.as_ref().map_or_else(
+                || unsupported.clone().unwrap_or("no GPU device".into()),
+                |g| describe(&g.context.adapter_info),
+            ),
             gpu,
             orbit: Orbit::default(),
             settings: ViewSettings::default(),
@@ -163,6 +185,7 @@ impl Viewport {
             drawn_strands: 0,
             drawn_vertices: 0,
             error: None,
+            rect: None,
             camera_bounds: None,
             interior: None,
         }
@@ -171,6 +194,7 @@ impl Viewport {
     pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
         let (rect, response) =
             ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
+        self.rect = Some(rect);
         self.navigate(ui, &response);
         if response.clicked()
             && let Some(pointer) = response.interact_pointer_pos()

@@ -1,0 +1,210 @@
+//! File work shared by the command line and the editor: importing a glTF scalp as a
+//! document, and exporting the runtime bundle and strand files (each written atomically).
+//! Long work reports progress through a callback that may also cancel it.
+
+use std::io::{IsTerminal, Write};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use hairloom_core::Document;
+use hairloom_core::export::{
+    RuntimeExportOptions, glb_lines, hair_file, runtime_bundle, usda_file,
+};
+use hairloom_core::import::{ImportOptions, import_file};
+use hairloom_core::project::write_atomic;
+use hairloom_core::runtime::Precision;
+use hairloom_core::strands::{Strand, StrandContext, StrandOptions, StrandPlan};
+
+/// Strand width written to the strand files (80 µm, a typical human hair).
+const STRAND_WIDTH_M: f32 = 8e-5;
+
+/// Strands have 2^N + 1 vertices in exported strand files unless asked otherwise.
+pub const EXPORT_VERTICES_LOG2: u32 = 5;
+
+/// The strand file formats, by extension.
+pub const STRAND_EXTENSIONS: [&str; 3] = ["hair", "usda", "glb"];
+
+/// A document made from a glTF/GLB scalp (every face becomes a bare bundle, the whole mesh
+/// the body), and a one-line summary of what was read.
+pub fn scalp_document(
+    scalp: &Path,
+    options: &ImportOptions,
+    generate_uv: bool,
+) -> anyhow::Result<(Document, String)> {
+    if !(options.scale.is_finite() && options.scale > 0.0) {
+        bail!("the scale must be a positive number, got {}", options.scale);
+    }
+    let imported = import_file(scalp, options)?;
+    let mut hair_mesh = imported.to_hair_mesh(|_| true);
+    if generate_uv || !imported.has_uv {
+        hairloom_core::uv::generate_uv(&mut hair_mesh, None);
+    }
+    let name = scalp
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scalp".into());
+    let mut document = Document::new(name, hair_mesh);
+    document.source = format!("imported from {}", scalp.display());
+    document.body = imported.to_body();
+    document
+        .validate()
+        .with_context(|| format!("{} produced an invalid document", scalp.display()))?;
+    let summary = format!(
+        "{}: {} quads, {} triangles ({} source triangles, {} collapsed by welding){}",
+        scalp.display(),
+        imported.quad_count(),
+        imported.triangle_count(),
+        imported.source_triangles,
+        imported.degenerate_triangles,
+        if imported.has_uv {
+            ""
+        } else {
+            "; uv generated (the file has no TEXCOORD_0)"
+        }
+    );
+    Ok((document, summary))
+}
+
+/// Writes the runtime bundle of `document` into `dir` (created when missing); returns a
+/// one-line summary.
+pub fn write_runtime_bundle(
+    document: &Document,
+    dir: &Path,
+    precision: Precision,
+    strands_per_bundle: u32,
+) -> anyhow::Result<String> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let options = RuntimeExportOptions {
+        precision,
+        strands_per_bundle,
+        ..RuntimeExportOptions::default()
+    };
+    let files = runtime_bundle(document, &options)
+        .with_context(|| format!("exporting {}", document.name))?;
+    for (name, bytes) in &files {
+        let path = dir.join(name);
+        write_atomic(&path, bytes, |_| {})
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    let total: usize = files.iter().map(|(_, b)| b.len()).sum();
+    Ok(format!(
+        "{}: runtime bundle, {} files, {:.1} KiB",
+        dir.display(),
+        files.len(),
+        total as f64 / 1024.0
+    ))
+}
+
+/// Refuses a strand file whose extension names no format we write.
+pub fn check_strand_file(file: &Path) -> anyhow::Result<()> {
+    let extension = file.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !STRAND_EXTENSIONS.contains(&extension) {
+        bail!(
+            "{}: unknown strand format (use .hair, .usda or .glb)",
+            file.display()
+        );
+    }
+    Ok(())
+}
+
+/// Generates every strand; `progress` gets the fraction done after each bundle and may
+/// stop the work (`None` then).
+pub fn generate_strands(
+    document: &Document,
+    strands_per_bundle: u32,
+    vertices_log2: u32,
+    progress: &mut dyn FnMut(f32) -> ControlFlow<()>,
+) -> Option<Vec<Strand>> {
+    let options = StrandOptions {
+        strands_per_bundle,
+        vertices_log2,
+        ..StrandOptions::default()
+    };
+    let context = StrandContext::new(document);
+    let plan = StrandPlan::new(&options);
+    let bundle_count = document.hair_mesh.bundles.len();
+    let mut strands = Vec::new();
+    for index in 0..bundle_count {
+        strands.extend(plan.bundle_strands(&context, index));
+        if progress((index + 1) as f32 / bundle_count.max(1) as f32).is_break() {
+            return None;
+        }
+    }
+    Some(strands)
+}
+
+/// Writes `strands` in the format `file`'s extension names; returns a one-line summary.
+pub fn write_strand_file(strands: &[Strand], file: &Path) -> anyhow::Result<String> {
+    check_strand_file(file)?;
+    let bytes = match file.extension().and_then(|e| e.to_str()) {
+        Some("hair") => hair_file(strands, STRAND_WIDTH_M, [0.35, 0.22, 0.12]),
+        Some("usda") => usda_file(strands, STRAND_WIDTH_M).into_bytes(),
+        _ => glb_lines(strands),
+    };
+    write_atomic(file, &bytes, |_| {}).with_context(|| format!("writing {}", file.display()))?;
+    let points: usize = strands.iter().map(|s| s.points.len()).sum();
+    Ok(format!(
+        "{}: {} strands, {} points, {:.1} KiB",
+        file.display(),
+        strands.len(),
+        points,
+        bytes.len() as f64 / 1024.0
+    ))
+}
+
+/// `hairloom export`: the runtime bundle and/or strand files of a project, with a progress
+/// line on a terminal's standard error.
+pub fn run(
+    project_path: &Path,
+    runtime: Option<&Path>,
+    strand_files: &[PathBuf],
+    strands_per_bundle: u32,
+    vertices_log2: u32,
+    precision: Precision,
+) -> anyhow::Result<()> {
+    if runtime.is_none() && strand_files.is_empty() {
+        bail!("nothing to export: give --runtime DIR and/or --strands FILE.{{hair,usda,glb}}");
+    }
+    if vertices_log2 > 10 {
+        bail!("--vertices-log2 {vertices_log2} is more than 10 (1025 vertices per strand)");
+    }
+    for file in strand_files {
+        check_strand_file(file)?;
+    }
+    let project = hairloom_core::project::load(project_path)?;
+    let document = &project.document;
+    if let Some(dir) = runtime {
+        let summary = write_runtime_bundle(document, dir, precision, strands_per_bundle)
+            .with_context(|| format!("exporting {}", project_path.display()))?;
+        println!("{summary}");
+    }
+    if !strand_files.is_empty() {
+        let mut stderr = std::io::stderr();
+        // Redrawn in place on a terminal; logs and pipes get nothing.
+        let show_progress = stderr.is_terminal();
+        let mut last_percent = usize::MAX;
+        let strands = generate_strands(document, strands_per_bundle, vertices_log2, &mut |done| {
+            let percent = (done * 100.0) as usize;
+            if show_progress && percent != last_percent {
+                let filled = percent / 5;
+                let _ = write!(
+                    stderr,
+                    "\rgenerating strands [{}{}] {percent:>3}%",
+                    "#".repeat(filled),
+                    " ".repeat(20 - filled)
+                );
+                last_percent = percent;
+            }
+            ControlFlow::Continue(())
+        })
+        .unwrap_or_default();
+        if show_progress {
+            let _ = writeln!(stderr);
+        }
+        for file in strand_files {
+            println!("{}", write_strand_file(&strands, file)?);
+        }
+    }
+    Ok(())
+}

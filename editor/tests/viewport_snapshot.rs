@@ -1,0 +1,121 @@
+//! The editor's viewport rendered through wgpu (lavapipe in `make test`) by egui_kittest:
+//! the picture matches a golden image within a tolerance, and moving a styling slider
+//! changes what the viewport shows on the next frame.
+
+mod common;
+
+use egui::accesskit::Role;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use hairloom_editor::app::{EditorState, HairloomApp};
+
+/// Mean absolute channel difference allowed against the golden image (0-255 scale).
+const MEAN_ERROR_TOLERANCE: f64 = 2.0;
+
+fn root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The editor on the sample with a real wgpu renderer; `None` (skip) when no adapter exists
+/// (GL only) and `HAIRLOOM_REQUIRE_GPU` is not 1.
+fn wgpu_harness() -> Option<Harness<'static, HairloomApp>> {
+    let primary = hairloom_render::device::list_adapters()
+        .iter()
+        .any(|a| a.backend != wgpu::Backend::Gl);
+    if !primary {
+        assert!(
+            std::env::var("HAIRLOOM_REQUIRE_GPU").as_deref() != Ok("1"),
+            "no Vulkan/Metal/DX12 adapter (make test installs lavapipe)"
+        );
+        eprintln!("skipped: no Vulkan/Metal/DX12 adapter");
+        return None;
+    }
+    let recovery_dir = tempfile::tempdir().expect("temp dir").keep();
+    let recovery = hairloom_editor::app::recovery::Recovery::in_dir(recovery_dir);
+    // kittest's setup with the GL backend left out: its WebGL2 limits have no storage
+    // buffers, and the editor runs on Vulkan / Metal / DX12.
+    let mut setup = egui_kittest::wgpu::default_wgpu_setup();
+    if let eframe::egui_wgpu::WgpuSetup::CreateNew(create) = &mut setup {
+        create.instance_descriptor.backends = wgpu::Backends::PRIMARY;
+    }
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1100.0, 720.0))
+        .wgpu_setup(setup)
+        .build_eframe(move |cc| HairloomApp::with_recovery(cc, EditorState::sample(), recovery));
+    harness.run();
+    Some(harness)
+}
+
+/// The rendered window cropped to the viewport.
+fn viewport_image(harness: &mut Harness<'static, HairloomApp>) -> image::RgbaImage {
+    harness.run();
+    let rect = harness
+        .state()
+        .viewport
+        .rect
+        .expect("the viewport was drawn");
+    let scale = harness.ctx.pixels_per_point();
+    let image = harness.render().expect("wgpu render");
+    let x = (rect.left() * scale).round() as u32;
+    let y = (rect.top() * scale).round() as u32;
+    let width = ((rect.width() * scale).round() as u32).min(image.width() - x);
+    let height = ((rect.height() * scale).round() as u32).min(image.height() - y);
+    image::imageops::crop_imm(&image, x, y, width, height).to_image()
+}
+
+#[test]
+fn the_viewport_snapshot_matches_and_follows_the_styling() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    let adapter = harness.state().viewport.adapter.clone();
+    assert!(!adapter.contains("no GPU"), "{adapter}");
+    let image = viewport_image(&mut harness);
+    assert!(
+        harness.state().viewport.error.is_none(),
+        "{:?}",
+        harness.state().viewport.error
+    );
+    assert!(harness.state().viewport.drawn_strands > 1000);
+
+    // Hair and head cover a good part of the viewport.
+    let background = image.get_pixel(2, 2).0;
+    let drawn = common::drawn_pixels(&image, background);
+    let pixels = (image.width() * image.height()) as usize;
+    assert!(drawn > pixels / 10, "only {drawn} of {pixels} pixels drawn");
+
+    let golden_path = root().join("editor/tests/golden/editor_viewport.png");
+    if std::env::var("HAIRLOOM_UPDATE_GOLDEN").as_deref() == Ok("1") {
+        image.save(&golden_path).expect("write golden image");
+        eprintln!("updated {}", golden_path.display());
+    } else {
+        let golden = image::open(&golden_path).expect("golden image").to_rgba8();
+        let error = common::mean_error(&image, &golden);
+        eprintln!(
+            "viewport on {adapter}: mean error {error:.3} (tolerance {MEAN_ERROR_TOLERANCE})"
+        );
+        if error > MEAN_ERROR_TOLERANCE {
+            let failures = root().join("target/golden-failures");
+            std::fs::create_dir_all(&failures).expect("failure dir");
+            image
+                .save(failures.join("editor_viewport.png"))
+                .expect("write failed render");
+            panic!(
+                "viewport mean error {error:.3} > {MEAN_ERROR_TOLERANCE}; new image in {} \
+                 (HAIRLOOM_UPDATE_GOLDEN=1 regenerates)",
+                failures.display()
+            );
+        }
+    }
+
+    // A styling slider changes the picture on the next frame.
+    harness
+        .get_by_role_and_label(Role::Slider, "Curl radius")
+        .set_value_accesskit(0.01);
+    let curled = viewport_image(&mut harness);
+    let change = common::mean_error(&image, &curled);
+    assert!(
+        change > 1.0,
+        "curl changed the viewport by only {change:.3}"
+    );
+}
