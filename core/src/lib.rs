@@ -23,6 +23,7 @@ pub mod random;
 pub mod roots;
 pub mod runtime;
 pub mod samples;
+pub mod select;
 pub mod strands;
 pub mod styling;
 pub mod teapot;

@@ -455,3 +455,116 @@ fn without_a_native_dialog_a_typed_path_is_asked_for() {
     assert!(path.exists(), "{}", harness.state().state.message);
     assert_eq!(harness.state().state.path.as_deref(), Some(path.as_path()));
 }
+
+/// A left-button drag from `from` to `to` in steps (a region selection in the viewport).
+fn drag(harness: &mut Harness<'static, HairloomApp>, from: egui::Pos2, to: egui::Pos2) {
+    harness.hover_at(from);
+    harness.run();
+    harness.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run();
+    for step in 1..=8 {
+        harness.hover_at(from + (to - from) * (step as f32 / 8.0));
+        harness.run();
+    }
+    harness.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run();
+}
+
+fn viewport_rect(harness: &Harness<'static, HairloomApp>) -> egui::Rect {
+    harness.state().viewport.rect.expect("viewport drawn")
+}
+
+#[test]
+fn box_select_vertices_then_g_moves_them_as_one_undo_step() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    harness.get_by_label("Vertices").click();
+    harness.run();
+    let rect = viewport_rect(&harness);
+    drag(
+        &mut harness,
+        rect.left_top() + egui::vec2(5.0, 5.0),
+        rect.right_bottom() - egui::vec2(5.0, 5.0),
+    );
+    let selected = harness.state().state.vertex_selection.clone();
+    assert!(selected.len() > 100, "{}", harness.state().state.message);
+    let mesh = &original.hair_mesh;
+    let topology = hairloom_core::Topology::build(mesh);
+    assert!(
+        selected
+            .iter()
+            .all(|v| !mesh.is_interior(&topology, v.column as usize, v.layer as usize)),
+        "interior vertices are never selected"
+    );
+
+    // G, move the pointer, click: one "Move" step; the selected vertices moved.
+    let centre = rect.center();
+    harness.hover_at(centre);
+    harness.run();
+    harness.key_press(egui::Key::G);
+    harness.run();
+    harness.hover_at(centre + egui::vec2(60.0, -20.0));
+    harness.run();
+    click_at(&mut harness, centre + egui::vec2(60.0, -20.0));
+    let moved = harness.state().state.document().clone();
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+    assert_eq!(
+        harness.state().state.project.history.undo[0].label(),
+        "Move"
+    );
+    let v = *selected.iter().next().expect("a vertex");
+    let before = mesh.position(v).expect("position");
+    let after = moved.hair_mesh.position(v).expect("position");
+    assert!(before.distance(after) > 1e-4, "{before} → {after}");
+    assert!(moved.hair_mesh.validate().is_ok());
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original);
+}
+
+#[test]
+fn escape_cancels_a_scale_and_grow_shrink_keep_the_seed() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    let layers = original.hair_mesh.bundles[0].layers;
+    harness
+        .get_by_label(&format!("Bundle 0 · {layers} layers"))
+        .click();
+    harness.run();
+    harness.get_by_label("Grow").click();
+    harness.run();
+    let grown = harness.state().state.selection.clone();
+    assert!(grown.len() > 1 && grown.contains(&0));
+    harness.get_by_label("Shrink").click();
+    harness.run();
+    assert!(harness.state().state.selection.contains(&0));
+    assert!(harness.state().state.selection.len() < grown.len());
+
+    let centre = viewport_rect(&harness).center();
+    harness.hover_at(centre);
+    harness.run();
+    harness.key_press(egui::Key::S);
+    harness.run();
+    harness.hover_at(centre + egui::vec2(80.0, 80.0));
+    harness.run();
+    assert_ne!(
+        harness.state().state.document(),
+        &original,
+        "the scale previews live"
+    );
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original);
+    assert!(harness.state().state.project.history.undo.is_empty());
+}

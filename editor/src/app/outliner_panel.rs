@@ -47,6 +47,6 @@ impl OutlinerPanel {
             },
         );
         // Drop selections the document no longer has (after undoing a subdivide, say).
-        state.selection.retain(|&b| (b as usize) < count);
+        state.prune_selection();
     }
 }

@@ -8,11 +8,12 @@ use std::path::{Path, PathBuf};
 
 use std::collections::BTreeSet;
 
-use hairloom_core::HairMesh;
 use hairloom_core::document::Document;
 use hairloom_core::edit::{EditError, EditOutcome};
 use hairloom_core::history::Transaction;
 use hairloom_core::project::{self, Project};
+use hairloom_core::select;
+use hairloom_core::{HairMesh, Topology, VertexRef};
 
 /// The sample the editor opens with no file, embedded so it works from any folder.
 const SAMPLE_PROJECT: &[u8] = include_bytes!("../../../assets/samples/head_long_wavy.hairloom");
@@ -22,6 +23,43 @@ const SAMPLE_NAME: &str = "head_long_wavy.hairloom (sample)";
 fn next_revision() -> u64 {
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
     NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// What a click or a region selects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SelectMode {
+    Bundles,
+    /// Exterior vertices (interior ones place themselves).
+    Vertices,
+}
+
+/// What a left drag in the viewport does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DragTool {
+    Box,
+    Lasso,
+    Paint,
+}
+
+/// Selection and transform settings shared by the tools panel and the viewport (view state).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolSettings {
+    pub mode: SelectMode,
+    pub drag: DragTool,
+    pub paint_radius_px: f32,
+    /// Soft-selection radius for move / rotate / scale (0 = off).
+    pub soft_radius_m: f64,
+}
+
+impl Default for ToolSettings {
+    fn default() -> Self {
+        Self {
+            mode: SelectMode::Bundles,
+            drag: DragTool::Box,
+            paint_radius_px: 24.0,
+            soft_radius_m: 0.0,
+        }
+    }
 }
 
 pub struct EditorState {
@@ -38,6 +76,9 @@ pub struct EditorState {
     pub message: String,
     /// Selected bundles: view state, never saved and never in the history.
     pub selection: BTreeSet<u32>,
+    /// Selected exterior vertices (vertex mode).
+    pub vertex_selection: BTreeSet<VertexRef>,
+    pub tool: ToolSettings,
     /// Recovered work counts as unsaved even where it equals a file on disk.
     unsaved: bool,
 }
@@ -52,6 +93,8 @@ impl EditorState {
             revision: next_revision(),
             message,
             selection: BTreeSet::new(),
+            vertex_selection: BTreeSet::new(),
+            tool: ToolSettings::default(),
             unsaved: false,
         }
     }
@@ -138,6 +181,109 @@ impl EditorState {
         if let Some(edit) = self.edit.take() {
             edit.commit(&mut self.project.history, &self.project.document);
         }
+    }
+
+    /// Abandons the running edit and restores the document as it was before it.
+    pub fn cancel_edit(&mut self) {
+        if let Some(edit) = self.edit.take() {
+            edit.cancel(&mut self.project.document);
+            self.revision = next_revision();
+        }
+    }
+
+    /// The document as it was when the running edit began (the current one otherwise).
+    pub fn edit_start(&self) -> &Document {
+        self.edit
+            .as_ref()
+            .map_or(&self.project.document, |edit| edit.start())
+    }
+
+    /// Selects everything (mode-aware); `false` deselects everything.
+    pub fn select_all(&mut self, all: bool) {
+        self.selection.clear();
+        self.vertex_selection.clear();
+        if !all {
+            return;
+        }
+        let mesh = &self.project.document.hair_mesh;
+        match self.tool.mode {
+            SelectMode::Bundles => {
+                self.selection = (0..mesh.bundles.len() as u32)
+                    .filter(|&b| !mesh.bundles[b as usize].removed)
+                    .collect();
+            }
+            SelectMode::Vertices => {
+                let topology = Topology::build(mesh);
+                self.vertex_selection = select::exterior_vertices(mesh, &topology)
+                    .into_iter()
+                    .collect();
+            }
+        }
+    }
+
+    /// Grows (`true`) or shrinks the selection by one ring of neighbours.
+    pub fn grow_selection(&mut self, grow: bool) {
+        let mesh = &self.project.document.hair_mesh;
+        let topology = Topology::build(mesh);
+        match self.tool.mode {
+            SelectMode::Bundles => {
+                self.selection = if grow {
+                    select::grow_bundles(mesh, &topology, &self.selection)
+                } else {
+                    select::shrink_bundles(mesh, &topology, &self.selection)
+                };
+            }
+            SelectMode::Vertices => {
+                self.vertex_selection = if grow {
+                    select::grow_vertices(mesh, &topology, &self.vertex_selection)
+                } else {
+                    select::shrink_vertices(mesh, &topology, &self.vertex_selection)
+                };
+            }
+        }
+    }
+
+    /// Selects the exterior vertices of `layer` (of the selected bundles, or of all).
+    pub fn select_layer(&mut self, layer: u32) {
+        let mesh = &self.project.document.hair_mesh;
+        let topology = Topology::build(mesh);
+        let bundles = (!self.selection.is_empty()).then_some(&self.selection);
+        self.vertex_selection = select::layer_vertices(mesh, &topology, bundles, layer);
+        self.tool.mode = SelectMode::Vertices;
+        self.message = format!(
+            "layer {layer}: {} vertices selected",
+            self.vertex_selection.len()
+        );
+    }
+
+    /// What move / rotate / scale acts on: the selected vertices, or the selected bundles'
+    /// exterior vertices above the scalp.
+    pub fn transform_targets(&self) -> Vec<VertexRef> {
+        let mesh = &self.project.document.hair_mesh;
+        let topology = Topology::build(mesh);
+        match self.tool.mode {
+            SelectMode::Vertices => self
+                .vertex_selection
+                .iter()
+                .copied()
+                .filter(|v| {
+                    mesh.position(*v).is_some()
+                        && !mesh.is_interior(&topology, v.column as usize, v.layer as usize)
+                })
+                .collect(),
+            SelectMode::Bundles => {
+                select::bundle_transform_vertices(mesh, &topology, &self.selection)
+            }
+        }
+    }
+
+    /// Drops selected bundles and vertices the document no longer has (after an undo).
+    pub fn prune_selection(&mut self) {
+        let mesh = &self.project.document.hair_mesh;
+        let count = mesh.bundles.len() as u32;
+        self.selection.retain(|&b| b < count);
+        self.vertex_selection
+            .retain(|v| mesh.position(*v).is_some());
     }
 
     /// Applies a hair-mesh edit of the selected bundles as one undo step; an error (named in

@@ -3,12 +3,12 @@
 
 use hairloom_core::edit::{self, ExtrudeDirection};
 
-use super::state::EditorState;
+use super::state::{DragTool, EditorState, SelectMode};
 
 pub struct ToolsPanel {
     /// Extrusion distance along the top layer's normals (model units).
     pub extrude_distance_m: f64,
-    /// Layer index for insert (a new layer below it) and delete.
+    /// Layer index for insert (a new layer below it), delete and select.
     pub layer: u32,
 }
 
@@ -30,6 +30,64 @@ impl ToolsPanel {
     }
 
     pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
+        ui.heading("Select");
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut state.tool.mode, SelectMode::Bundles, "Bundles")
+                .on_hover_text("Tab switches");
+            ui.selectable_value(&mut state.tool.mode, SelectMode::Vertices, "Vertices")
+                .on_hover_text("Tab switches");
+        });
+        ui.horizontal(|ui| {
+            ui.label("Drag:");
+            ui.selectable_value(&mut state.tool.drag, DragTool::Box, "Box");
+            ui.selectable_value(&mut state.tool.drag, DragTool::Lasso, "Lasso");
+            ui.selectable_value(&mut state.tool.drag, DragTool::Paint, "Paint");
+        });
+        if state.tool.drag == DragTool::Paint {
+            ui.add(
+                egui::Slider::new(&mut state.tool.paint_radius_px, 4.0..=120.0)
+                    .text("Brush radius")
+                    .suffix(" px"),
+            );
+        }
+        ui.horizontal(|ui| {
+            if ui.button("Grow").on_hover_text("Ctrl +").clicked() {
+                state.grow_selection(true);
+            }
+            if ui.button("Shrink").on_hover_text("Ctrl -").clicked() {
+                state.grow_selection(false);
+            }
+            if ui.button("Select layer").clicked() {
+                state.select_layer(self.layer);
+            }
+        });
+        ui.label(format!(
+            "{} bundles, {} vertices selected",
+            state.selection.len(),
+            state.vertex_selection.len()
+        ));
+        ui.separator();
+        ui.heading("Transform");
+        ui.horizontal(|ui| {
+            let label = ui.label("Soft radius");
+            ui.add(
+                egui::DragValue::new(&mut state.tool.soft_radius_m)
+                    .speed(0.001)
+                    .range(0.0..=1.0)
+                    .suffix(" m"),
+            )
+            .labelled_by(label.id)
+            .on_hover_text("Unselected vertices this close follow with a smooth falloff (wheel while transforming)");
+        });
+        ui.label(
+            egui::RichText::new(
+                "G move · R rotate · S scale in the viewport; X / Y / Z lock an axis; \
+                 click or Enter confirms, Esc or right-click cancels",
+            )
+            .small()
+            .weak(),
+        );
+        ui.separator();
         ui.heading("Tools");
         ui.horizontal(|ui| {
             if ui.button("Extrude").on_hover_text("E").clicked() {

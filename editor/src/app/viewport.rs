@@ -2,21 +2,34 @@
 //! time the document or the view changes (the same path as `hairloom render` and a game),
 //! drawn offscreen by the render crate and shown as an egui image.
 //!
-//! Navigation: drag (left or middle button) orbits, shift+drag pans, the wheel zooms,
-//! F frames the hair, numpad 1 / 3 / 7 look from the front / side / top. A click selects the
-//! bundle under the pointer (ctrl/shift+click adds or removes it; a click on nothing clears).
+//! Navigation (Blender's): middle-drag orbits, shift+middle-drag pans, the wheel zooms; on a
+//! trackpad alt+left-drag orbits and shift+alt+left-drag pans. F frames the selection (the
+//! hair without one), 1 / 3 / 7 look from the front / side / top.
+//!
+//! Selection: a click selects the bundle (or, in vertex mode, the exterior vertex) under the
+//! pointer, shift/ctrl+click adds or removes it, a click on nothing clears; a left drag
+//! selects with the box, lasso or paint brush (shift adds, ctrl removes). A selects all,
+//! alt+A none, ctrl +/- grows / shrinks, Tab switches bundles / vertices.
+//!
+//! Transform (modal, like Blender): G moves, R rotates, S scales the selection following
+//! the pointer; X / Y / Z lock an axis, the wheel changes the soft-selection radius; a click
+//! or Enter confirms (one undo step), Esc or a right-click cancels. Interior vertices follow
+//! live.
 
 use std::sync::Arc;
 
 use eframe::egui_wgpu;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
+use hairloom_core::edit::{self, VertexTransform};
 use hairloom_core::lod::LodSettings;
 use hairloom_core::runtime::{Filtering, Precision};
+use hairloom_core::select::{self, Region};
+use hairloom_core::{Topology, VertexRef};
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
 use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
 
-use super::state::EditorState;
+use super::state::{DragTool, EditorState, SelectMode};
 use crate::render::{RenderableHair, default_scene};
 
 /// Storage buffers per shader stage the generation and preview pipelines bind.
@@ -93,6 +106,82 @@ impl Default for ViewSettings {
     }
 }
 
+/// Which modal transform runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransformKind {
+    Move,
+    Rotate,
+    Scale,
+}
+
+impl TransformKind {
+    fn label(self) -> &'static str {
+        match self {
+            Self::Move => "Move",
+            Self::Rotate => "Rotate",
+            Self::Scale => "Scale",
+        }
+    }
+}
+
+/// A G / R / S gesture in progress: edits preview from the mesh it started on.
+struct ActiveTransform {
+    kind: TransformKind,
+    /// Locked axis (0 = x, 1 = y, 2 = z).
+    axis: Option<usize>,
+    start_pointer: egui::Pos2,
+    vertices: Vec<VertexRef>,
+    pivot: DVec3,
+    /// The last pointer position applied (recomputed only when it or the settings change).
+    applied: Option<(egui::Pos2, Option<usize>, u64)>,
+}
+
+/// The camera of the last frame: what screen point a model point lands on, and back.
+#[derive(Clone, Copy)]
+struct Projector {
+    view_projection: glam::Mat4,
+    rect: egui::Rect,
+}
+
+impl Projector {
+    fn project(&self, p: DVec3) -> Option<egui::Pos2> {
+        let clip = self.view_projection * p.as_vec3().extend(1.0);
+        (clip.w > 1e-6).then(|| {
+            let ndc = clip.truncate() / clip.w;
+            egui::pos2(
+                self.rect.left() + (ndc.x + 1.0) * 0.5 * self.rect.width(),
+                self.rect.top() + (1.0 - ndc.y) * 0.5 * self.rect.height(),
+            )
+        })
+    }
+
+    fn project_xy(&self, p: DVec3) -> Option<[f64; 2]> {
+        self.project(p).map(|q| [q.x as f64, q.y as f64])
+    }
+
+    /// The model point at screen position `at`, at the depth (NDC z) of `depth_of`.
+    fn unproject(&self, at: egui::Pos2, depth_of: DVec3) -> DVec3 {
+        let clip = self.view_projection * depth_of.as_vec3().extend(1.0);
+        let z = clip.z / clip.w.max(1e-6);
+        let x = (at.x - self.rect.left()) / self.rect.width().max(1.0) * 2.0 - 1.0;
+        let y = 1.0 - (at.y - self.rect.top()) / self.rect.height().max(1.0) * 2.0;
+        self.view_projection
+            .inverse()
+            .project_point3(Vec3::new(x, y, z))
+            .as_dvec3()
+    }
+
+    /// The ray under screen position `at`: origin and direction.
+    fn ray(&self, at: egui::Pos2) -> (DVec3, DVec3) {
+        let inverse = self.view_projection.inverse();
+        let x = (at.x - self.rect.left()) / self.rect.width().max(1.0) * 2.0 - 1.0;
+        let y = 1.0 - (at.y - self.rect.top()) / self.rect.height().max(1.0) * 2.0;
+        let near = inverse.project_point3(Vec3::new(x, y, 0.0)).as_dvec3();
+        let far = inverse.project_point3(Vec3::new(x, y, 1.0)).as_dvec3();
+        (near, far - near)
+    }
+}
+
 struct UploadedHair {
     gpu: GpuHair,
     bounds: (Vec3, Vec3),
@@ -131,6 +220,9 @@ pub struct Viewport {
     pub error: Option<String>,
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
     pub rect: Option<egui::Rect>,
+    transform: Option<ActiveTransform>,
+    /// The pointer path of a region drag in progress.
+    drag_path: Vec<egui::Pos2>,
     /// The box the camera frames (the drawn hair's), for picking with the same camera.
     camera_bounds: Option<(Vec3, Vec3)>,
     /// Per column and layer, whether the vertex is interior, for the document revision it
@@ -186,6 +278,8 @@ impl Viewport {
             drawn_vertices: 0,
             error: None,
             rect: None,
+            transform: None,
+            drag_path: Vec::new(),
             camera_bounds: None,
             interior: None,
         }
@@ -195,12 +289,34 @@ impl Viewport {
         let (rect, response) =
             ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
         self.rect = Some(rect);
-        self.navigate(ui, &response);
-        if response.clicked()
-            && let Some(pointer) = response.interact_pointer_pos()
-        {
-            self.select_at(ui, state, rect, pointer);
+        if let Some(projector) = self.projector(state, rect) {
+            if self.transform.is_some() {
+                self.drive_transform(ui, state, &response, projector);
+            } else {
+                self.navigate(ui, &response);
+                self.select(ui, state, &response, projector);
+                self.keys(ui, state, &response);
+            }
         }
+        self.draw(ui, state, rect);
+        self.paint_overlay(ui, state, rect);
+    }
+
+    /// The camera the picture and overlay use (the mesh's box before the first picture).
+    fn projector(&self, state: &EditorState, rect: egui::Rect) -> Option<Projector> {
+        let (lo, hi) = self.camera_bounds.or_else(|| {
+            let (lo, hi) = state.document().hair_mesh.bounds()?;
+            Some((lo.as_vec3(), hi.as_vec3()))
+        })?;
+        let camera = self.orbit.camera(lo, hi);
+        Some(Projector {
+            view_projection: camera.view_projection(rect.width() / rect.height().max(1.0)),
+            rect,
+        })
+    }
+
+    /// Generates and draws the strands when the document, settings, view or size changed.
+    fn draw(&mut self, ui: &mut egui::Ui, state: &mut EditorState, rect: egui::Rect) {
         let Some(gpu) = self.gpu.as_mut() else {
             ui.painter().text(
                 rect.center(),
@@ -319,30 +435,16 @@ impl Viewport {
             }
             (None, None) => {}
         }
-        self.paint_overlay(ui, state, rect);
     }
 
     /// The hair-mesh wireframe (when on) and the selected bundles' outlines, drawn over the
     /// picture with the picture's camera (not depth-tested: an X-ray view).
     fn paint_overlay(&mut self, ui: &egui::Ui, state: &EditorState, rect: egui::Rect) {
         let mesh = &state.document().hair_mesh;
-        let Some((lo, hi)) = self.camera_bounds else {
+        let Some(projector) = self.projector(state, rect) else {
             return;
         };
-        let view_projection = self
-            .orbit
-            .camera(lo, hi)
-            .view_projection(rect.width() / rect.height().max(1.0));
-        let project = |p: glam::DVec3| -> Option<egui::Pos2> {
-            let clip = view_projection * p.as_vec3().extend(1.0);
-            (clip.w > 1e-6).then(|| {
-                let ndc = clip.truncate() / clip.w;
-                egui::pos2(
-                    rect.left() + (ndc.x + 1.0) * 0.5 * rect.width(),
-                    rect.top() + (1.0 - ndc.y) * 0.5 * rect.height(),
-                )
-            })
-        };
+        let project = |p: DVec3| projector.project(p);
         let painter = ui.painter_at(rect);
         let outline = |bundle: &hairloom_core::Bundle, stroke: egui::Stroke| {
             for layer in 0..=bundle.layers as usize {
@@ -367,7 +469,8 @@ impl Viewport {
                 painter.add(egui::Shape::line(points, stroke));
             }
         };
-        if self.settings.wireframe {
+        let vertex_mode = state.tool.mode == SelectMode::Vertices;
+        if self.settings.wireframe || vertex_mode {
             let stroke = egui::Stroke::new(
                 1.0,
                 egui::Color32::from_rgba_unmultiplied(120, 170, 230, 110),
@@ -412,51 +515,351 @@ impl Viewport {
                 outline(bundle, selected);
             }
         }
+        let orange = egui::Color32::from_rgb(255, 150, 40);
+        for v in &state.vertex_selection {
+            if let Some(at) = mesh.position(*v).and_then(project) {
+                painter.circle_filled(at, 3.5, orange);
+            }
+        }
+        // The region being dragged.
+        if self.drag_path.len() > 1 {
+            let stroke = egui::Stroke::new(1.0, egui::Color32::WHITE);
+            let (first, last) = (self.drag_path[0], self.drag_path[self.drag_path.len() - 1]);
+            match state.tool.drag {
+                DragTool::Box => {
+                    painter.rect_stroke(
+                        egui::Rect::from_two_pos(first, last),
+                        0.0,
+                        stroke,
+                        egui::StrokeKind::Middle,
+                    );
+                }
+                DragTool::Lasso => {
+                    painter.add(egui::Shape::closed_line(self.drag_path.clone(), stroke));
+                }
+                DragTool::Paint => {
+                    painter.circle_stroke(last, state.tool.paint_radius_px, stroke);
+                    painter.add(egui::Shape::line(
+                        self.drag_path.clone(),
+                        egui::Stroke::new(
+                            state.tool.paint_radius_px * 2.0,
+                            egui::Color32::from_rgba_unmultiplied(255, 255, 255, 24),
+                        ),
+                    ));
+                }
+            }
+        }
+        if let Some(active) = &self.transform {
+            if let Some(pivot) = project(active.pivot) {
+                painter.circle_stroke(pivot, 5.0, egui::Stroke::new(1.5, orange));
+                if let Some(pointer) = active.applied.map(|(p, _, _)| p) {
+                    painter.line_segment(
+                        [pivot, pointer],
+                        egui::Stroke::new(1.0, egui::Color32::from_white_alpha(120)),
+                    );
+                }
+            }
+            painter.text(
+                rect.left_top() + egui::vec2(10.0, 10.0),
+                egui::Align2::LEFT_TOP,
+                &state.message,
+                egui::FontId::proportional(14.0),
+                egui::Color32::WHITE,
+            );
+        }
     }
 
-    /// Selects the bundle under `pointer` (see the module documentation).
-    fn select_at(
-        &self,
+    /// Click and region selection (see the module documentation).
+    fn select(
+        &mut self,
         ui: &egui::Ui,
         state: &mut EditorState,
-        rect: egui::Rect,
-        pointer: egui::Pos2,
+        response: &egui::Response,
+        projector: Projector,
     ) {
-        let Some((lo, hi)) = self.camera_bounds.or_else(|| {
-            let (lo, hi) = state.document().hair_mesh.bounds()?;
-            Some((lo.as_vec3(), hi.as_vec3()))
-        }) else {
+        let modifiers = ui.input(|i| i.modifiers);
+        let mesh = &state.document().hair_mesh;
+        if response.clicked()
+            && let Some(pointer) = response.interact_pointer_pos()
+        {
+            let add = modifiers.command || modifiers.shift;
+            match state.tool.mode {
+                SelectMode::Bundles => {
+                    let (origin, direction) = projector.ray(pointer);
+                    let hit = hairloom_core::pick::pick_bundle(mesh, origin, direction);
+                    if !add {
+                        state.selection.clear();
+                    }
+                    if let Some((bundle, _)) = hit {
+                        if !state.selection.insert(bundle) {
+                            state.selection.remove(&bundle);
+                        }
+                        state.message = format!("bundle {bundle}");
+                    }
+                }
+                SelectMode::Vertices => {
+                    let topology = Topology::build(mesh);
+                    let hit = select::nearest_vertex(
+                        mesh,
+                        &topology,
+                        |p| projector.project_xy(p),
+                        [pointer.x as f64, pointer.y as f64],
+                        PICK_RADIUS_PX,
+                    );
+                    if !add {
+                        state.vertex_selection.clear();
+                    }
+                    if let Some(v) = hit {
+                        if !state.vertex_selection.insert(v) {
+                            state.vertex_selection.remove(&v);
+                        }
+                        state.message = format!("vertex: column {} layer {}", v.column, v.layer);
+                    }
+                }
+            }
+            return;
+        }
+        let selecting = response.dragged_by(egui::PointerButton::Primary) && !modifiers.alt;
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            self.drag_path.clear();
+        }
+        if selecting && let Some(pointer) = response.interact_pointer_pos() {
+            self.drag_path.push(pointer);
+        }
+        if response.drag_stopped() && self.drag_path.len() > 1 {
+            let points: Vec<[f64; 2]> = std::mem::take(&mut self.drag_path)
+                .iter()
+                .map(|p| [p.x as f64, p.y as f64])
+                .collect();
+            let region = match state.tool.drag {
+                DragTool::Box => Region::Box {
+                    a: points[0],
+                    b: points[points.len() - 1],
+                },
+                DragTool::Lasso => Region::Lasso(points),
+                DragTool::Paint => Region::Paint {
+                    points,
+                    radius_px: state.tool.paint_radius_px as f64,
+                },
+            };
+            let project = |p| projector.project_xy(p);
+            let replace = !modifiers.shift && !modifiers.command;
+            let count = match state.tool.mode {
+                SelectMode::Bundles => {
+                    let hits = select::bundles_in_region(mesh, project, &region);
+                    if replace {
+                        state.selection.clear();
+                    }
+                    for b in &hits {
+                        if modifiers.command {
+                            state.selection.remove(b);
+                        } else {
+                            state.selection.insert(*b);
+                        }
+                    }
+                    hits.len()
+                }
+                SelectMode::Vertices => {
+                    let topology = Topology::build(mesh);
+                    let hits = select::vertices_in_region(mesh, &topology, project, &region);
+                    if replace {
+                        state.vertex_selection.clear();
+                    }
+                    for v in &hits {
+                        if modifiers.command {
+                            state.vertex_selection.remove(v);
+                        } else {
+                            state.vertex_selection.insert(*v);
+                        }
+                    }
+                    hits.len()
+                }
+            };
+            state.message = format!("{count} in the region");
+        }
+    }
+
+    /// Single-key commands while the pointer is over the viewport.
+    fn keys(&mut self, ui: &egui::Ui, state: &mut EditorState, response: &egui::Response) {
+        if !response.hovered() || ui.ctx().egui_wants_keyboard_input() {
+            return;
+        }
+        use egui::{Key, Modifiers};
+        let pressed = |key| ui.input_mut(|i| i.consume_key(Modifiers::NONE, key));
+        for (key, kind) in [
+            (Key::G, TransformKind::Move),
+            (Key::R, TransformKind::Rotate),
+            (Key::S, TransformKind::Scale),
+        ] {
+            if pressed(key) {
+                self.begin_transform(ui, state, kind);
+                return;
+            }
+        }
+        if pressed(Key::A) {
+            state.select_all(true);
+        }
+        if ui.input_mut(|i| i.consume_key(Modifiers::ALT, Key::A)) {
+            state.select_all(false);
+        }
+        if pressed(Key::Tab) {
+            state.tool.mode = match state.tool.mode {
+                SelectMode::Bundles => SelectMode::Vertices,
+                SelectMode::Vertices => SelectMode::Bundles,
+            };
+        }
+        if ui.input_mut(|i| {
+            i.consume_key(Modifiers::COMMAND, Key::Plus)
+                || i.consume_key(Modifiers::COMMAND, Key::Equals)
+        }) {
+            state.grow_selection(true);
+        }
+        if ui.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::Minus)) {
+            state.grow_selection(false);
+        }
+        if pressed(Key::F) {
+            self.frame_selection(state);
+        }
+    }
+
+    /// Frames the selection (the whole hair without one).
+    fn frame_selection(&mut self, state: &EditorState) {
+        self.orbit.zoom = 1.0;
+        self.orbit.pan = [0.0, 0.0];
+        let targets = state.transform_targets();
+        let mesh = &state.document().hair_mesh;
+        let points: Vec<DVec3> = if targets.is_empty() {
+            state
+                .selection
+                .iter()
+                .filter_map(|&b| select::bundle_centre(mesh, b))
+                .collect()
+        } else {
+            targets.iter().filter_map(|v| mesh.position(*v)).collect()
+        };
+        let (Some((lo, hi)), false) = (self.camera_bounds, points.is_empty()) else {
             return;
         };
+        let centre = points.iter().sum::<DVec3>() / points.len() as f64;
+        let extent = points
+            .iter()
+            .map(|p| p.distance(centre))
+            .fold(0.0, f64::max);
         let camera = self.orbit.camera(lo, hi);
-        let inverse = camera
-            .view_projection(rect.width() / rect.height().max(1.0))
-            .inverse();
-        let x = (pointer.x - rect.left()) / rect.width().max(1.0) * 2.0 - 1.0;
-        let y = 1.0 - (pointer.y - rect.top()) / rect.height().max(1.0) * 2.0;
-        let near = inverse.project_point3(Vec3::new(x, y, 0.0)).as_dvec3();
-        let far = inverse.project_point3(Vec3::new(x, y, 1.0)).as_dvec3();
-        let hit = hairloom_core::pick::pick_bundle(&state.document().hair_mesh, near, far - near);
-        let add = ui.input(|i| i.modifiers.command || i.modifiers.shift);
-        match hit {
-            Some((bundle, _)) => {
-                if !add {
-                    state.selection.clear();
-                }
-                if !state.selection.insert(bundle) {
-                    state.selection.remove(&bundle);
-                }
-                state.message = format!("bundle {bundle}");
+        let forward = (camera.target - camera.eye).normalize_or(Vec3::NEG_Z);
+        let right = forward.cross(Vec3::Y).normalize_or(Vec3::X);
+        let up = right.cross(forward);
+        let size = (hi - lo).length().max(1e-6);
+        let offset = centre.as_vec3() - camera.target;
+        self.orbit.pan = [offset.dot(right) / size, offset.dot(up) / size];
+        self.orbit.zoom = ((extent as f32 * 2.5) / size).clamp(0.08, 1.0);
+    }
+
+    fn begin_transform(&mut self, ui: &egui::Ui, state: &mut EditorState, kind: TransformKind) {
+        state.commit_edit();
+        let vertices = state.transform_targets();
+        let mesh = &state.document().hair_mesh;
+        let positions: Vec<DVec3> = vertices.iter().filter_map(|v| mesh.position(*v)).collect();
+        if positions.is_empty() {
+            state.message = format!(
+                "{}: nothing selected (interior vertices place themselves)",
+                kind.label()
+            );
+            return;
+        }
+        let pivot = positions.iter().sum::<DVec3>() / positions.len() as f64;
+        let start_pointer = ui
+            .input(|i| i.pointer.hover_pos())
+            .unwrap_or(egui::Pos2::ZERO);
+        self.transform = Some(ActiveTransform {
+            kind,
+            axis: None,
+            start_pointer,
+            vertices,
+            pivot,
+            applied: None,
+        });
+        state.message = format!(
+            "{}: move the pointer; click confirms, Esc cancels",
+            kind.label()
+        );
+    }
+
+    /// Follows the pointer during G / R / S; confirms or cancels.
+    fn drive_transform(
+        &mut self,
+        ui: &egui::Ui,
+        state: &mut EditorState,
+        response: &egui::Response,
+        projector: Projector,
+    ) {
+        let Some(active) = self.transform.as_mut() else {
+            return;
+        };
+        use egui::{Key, Modifiers};
+        let cancel = ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Escape))
+            || response.secondary_clicked();
+        if cancel {
+            state.cancel_edit();
+            state.message = format!("{} cancelled", active.kind.label());
+            self.transform = None;
+            return;
+        }
+        for (key, axis) in [(Key::X, 0), (Key::Y, 1), (Key::Z, 2)] {
+            if ui.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
+                active.axis = if active.axis == Some(axis) {
+                    None
+                } else {
+                    Some(axis)
+                };
             }
-            None if !add => state.selection.clear(),
-            None => {}
+        }
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            let radius = &mut state.tool.soft_radius_m;
+            *radius = if *radius <= 0.0 && scroll > 0.0 {
+                0.005
+            } else {
+                (*radius * (scroll as f64 * 0.004).exp()).clamp(0.0, 1.0)
+            };
+        }
+        let pointer = ui
+            .input(|i| i.pointer.hover_pos())
+            .unwrap_or(active.start_pointer);
+        let radius_bits = state.tool.soft_radius_m.to_bits();
+        if active.applied != Some((pointer, active.axis, radius_bits)) {
+            active.applied = Some((pointer, active.axis, radius_bits));
+            let transform = transform_for(active, pointer, projector);
+            let start = state.edit_start().hair_mesh.clone();
+            match edit::transform_vertices(
+                &start,
+                &active.vertices,
+                transform,
+                state.tool.soft_radius_m,
+            ) {
+                Ok(outcome) => {
+                    state.edit(active.kind.label()).hair_mesh = outcome.mesh;
+                    state.message = describe_transform(active.kind, active.axis, transform)
+                        + &format!(", soft radius {:.3} m", state.tool.soft_radius_m);
+                }
+                Err(error) => state.message = format!("{}: {error}", active.kind.label()),
+            }
+        }
+        let confirm =
+            response.clicked() || ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Enter));
+        if confirm {
+            state.commit_edit();
+            self.transform = None;
         }
     }
 
     fn navigate(&mut self, ui: &egui::Ui, response: &egui::Response) {
         let delta = response.drag_delta();
-        if response.dragged() && delta != egui::Vec2::ZERO {
-            if ui.input(|i| i.modifiers.shift) {
+        let modifiers = ui.input(|i| i.modifiers);
+        let navigating = response.dragged_by(egui::PointerButton::Middle)
+            || (response.dragged_by(egui::PointerButton::Primary) && modifiers.alt);
+        if navigating && delta != egui::Vec2::ZERO {
+            if modifiers.shift {
                 let scale = 1.0 / response.rect.height().max(1.0);
                 self.orbit.pan[0] -= delta.x * scale * self.orbit.zoom;
                 self.orbit.pan[1] += delta.y * scale * self.orbit.zoom;
@@ -471,10 +874,6 @@ impl Viewport {
                 self.orbit.zoom = (self.orbit.zoom * (-scroll * 0.002).exp()).clamp(0.05, 20.0);
             }
             ui.input(|i| {
-                if i.key_pressed(egui::Key::F) {
-                    self.orbit.zoom = 1.0;
-                    self.orbit.pan = [0.0, 0.0];
-                }
                 let view = |yaw: f32, pitch: f32| Orbit {
                     yaw_rad: yaw,
                     pitch_rad: pitch,
@@ -491,5 +890,99 @@ impl Viewport {
                 }
             });
         }
+    }
+}
+
+/// Pick distance for vertices, in points.
+const PICK_RADIUS_PX: f64 = 10.0;
+
+/// The transform the pointer asks for: screen motion mapped at the pivot's depth.
+fn transform_for(
+    active: &ActiveTransform,
+    pointer: egui::Pos2,
+    projector: Projector,
+) -> VertexTransform {
+    let axis_vector = active.axis.map(|a| {
+        let mut v = DVec3::ZERO;
+        v[a] = 1.0;
+        v
+    });
+    let pivot_screen = projector
+        .project(active.pivot)
+        .unwrap_or(active.start_pointer);
+    match active.kind {
+        TransformKind::Move => {
+            let offset = projector.unproject(pointer, active.pivot)
+                - projector.unproject(active.start_pointer, active.pivot);
+            let offset = axis_vector.map_or(offset, |axis| axis * offset.dot(axis));
+            VertexTransform::Translate {
+                offset: offset.to_array(),
+            }
+        }
+        TransformKind::Rotate => {
+            let angle = |p: egui::Pos2| (p.y - pivot_screen.y).atan2(p.x - pivot_screen.x) as f64;
+            let turn = angle(pointer) - angle(active.start_pointer);
+            // Into the screen: a clockwise pointer turn (screen y points down) turns the
+            // model clockwise as seen.
+            let forward = projector.ray(pivot_screen).1.normalize_or(DVec3::NEG_Z);
+            let axis =
+                axis_vector.map_or(
+                    forward,
+                    |axis| {
+                        if axis.dot(forward) < 0.0 { -axis } else { axis }
+                    },
+                );
+            VertexTransform::Rotate {
+                axis: axis.to_array(),
+                angle_rad: turn,
+                pivot: active.pivot.to_array(),
+            }
+        }
+        TransformKind::Scale => {
+            let start = active.start_pointer.distance(pivot_screen).max(1.0);
+            let factor = (pointer.distance(pivot_screen) / start) as f64;
+            let mut factors = [factor; 3];
+            if let Some(axis) = active.axis {
+                factors = [1.0; 3];
+                factors[axis] = factor;
+            }
+            VertexTransform::Scale {
+                factors,
+                pivot: active.pivot.to_array(),
+            }
+        }
+    }
+}
+
+/// One line for the status bar.
+fn describe_transform(
+    kind: TransformKind,
+    axis: Option<usize>,
+    transform: VertexTransform,
+) -> String {
+    let axis = axis.map_or(String::new(), |a| format!(" along {}", ["x", "y", "z"][a]));
+    match transform {
+        VertexTransform::Translate { offset } => format!(
+            "{}{axis}: ({:.4}, {:.4}, {:.4}) m",
+            kind.label(),
+            offset[0],
+            offset[1],
+            offset[2]
+        ),
+        VertexTransform::Rotate { angle_rad, .. } => {
+            format!("{}{axis}: {:.1}°", kind.label(), angle_rad.to_degrees())
+        }
+        VertexTransform::Scale { factors, .. } => format!(
+            "{}{axis}: ×{:.3}",
+            kind.label(),
+            factors
+                .iter()
+                .copied()
+                .fold(1.0, |a: f64, f| if (f - 1.0).abs() > (a - 1.0).abs() {
+                    f
+                } else {
+                    a
+                })
+        ),
     }
 }

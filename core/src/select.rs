@@ -1,0 +1,415 @@
+//! Selection on the hair mesh: which bundles or exterior vertices fall in a screen region
+//! (box, lasso, paint stroke), growing and shrinking a selection, whole layers, and the
+//! vertices a move / rotate / scale of selected bundles acts on.
+//!
+//! Screen positions come from a `project` closure (the editor's camera), so everything here
+//! is pure and testable. Interior vertices are never selectable: they place themselves.
+
+use std::collections::BTreeSet;
+
+use glam::DVec3;
+
+use crate::mesh::{HairMesh, Topology, VertexRef};
+
+/// A region on the screen, in pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Region {
+    /// An axis-aligned box between two corners (any order).
+    Box { a: [f64; 2], b: [f64; 2] },
+    /// A closed polygon (even-odd rule).
+    Lasso(Vec<[f64; 2]>),
+    /// Every point within `radius_px` of a stroke's sample points.
+    Paint {
+        points: Vec<[f64; 2]>,
+        radius_px: f64,
+    },
+}
+
+impl Region {
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        match self {
+            Self::Box { a, b } => {
+                (a[0].min(b[0])..=a[0].max(b[0])).contains(&p[0])
+                    && (a[1].min(b[1])..=a[1].max(b[1])).contains(&p[1])
+            }
+            Self::Lasso(polygon) => point_in_polygon(p, polygon),
+            Self::Paint { points, radius_px } => points.iter().any(|q| {
+                let (dx, dy) = (p[0] - q[0], p[1] - q[1]);
+                dx * dx + dy * dy <= radius_px * radius_px
+            }),
+        }
+    }
+}
+
+/// Even-odd point-in-polygon; fewer than three points contain nothing.
+pub fn point_in_polygon(p: [f64; 2], polygon: &[[f64; 2]]) -> bool {
+    if polygon.len() < 3 {
+        return false;
+    }
+    let mut inside = false;
+    let mut j = polygon.len() - 1;
+    for i in 0..polygon.len() {
+        let (a, b) = (polygon[i], polygon[j]);
+        if (a[1] > p[1]) != (b[1] > p[1]) {
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if p[0] < x {
+                inside = !inside;
+            }
+        }
+        j = i;
+    }
+    inside
+}
+
+/// The mean of a bundle's vertices over all its layers (where a click or region "sees" it).
+pub fn bundle_centre(mesh: &HairMesh, bundle: u32) -> Option<DVec3> {
+    let bundle = mesh.bundles.get(bundle as usize)?;
+    let mut sum = DVec3::ZERO;
+    let mut count = 0.0;
+    for &c in &bundle.vertices {
+        let column = mesh.columns.get(c as usize)?;
+        for p in column.positions.iter().take(bundle.layers as usize + 1) {
+            sum += *p;
+            count += 1.0;
+        }
+    }
+    (count > 0.0).then(|| sum / count)
+}
+
+/// Visible bundles whose centre projects into `region`.
+pub fn bundles_in_region(
+    mesh: &HairMesh,
+    project: impl Fn(DVec3) -> Option<[f64; 2]>,
+    region: &Region,
+) -> Vec<u32> {
+    (0..mesh.bundles.len() as u32)
+        .filter(|&b| !mesh.bundles[b as usize].removed)
+        .filter(|&b| {
+            bundle_centre(mesh, b)
+                .and_then(&project)
+                .is_some_and(|p| region.contains(p))
+        })
+        .collect()
+}
+
+/// Every exterior (artist-shaped) vertex of the mesh.
+pub fn exterior_vertices(mesh: &HairMesh, topology: &Topology) -> Vec<VertexRef> {
+    let mut out = Vec::new();
+    for (c, column) in mesh.columns.iter().enumerate() {
+        if topology.bundles_of_column[c]
+            .iter()
+            .all(|&b| mesh.bundles[b as usize].removed)
+        {
+            continue;
+        }
+        for layer in 0..column.positions.len() {
+            if !mesh.is_interior(topology, c, layer) {
+                out.push(VertexRef {
+                    column: c as u32,
+                    layer: layer as u32,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Exterior vertices that project into `region`.
+pub fn vertices_in_region(
+    mesh: &HairMesh,
+    topology: &Topology,
+    project: impl Fn(DVec3) -> Option<[f64; 2]>,
+    region: &Region,
+) -> Vec<VertexRef> {
+    exterior_vertices(mesh, topology)
+        .into_iter()
+        .filter(|v| {
+            mesh.position(*v)
+                .and_then(&project)
+                .is_some_and(|p| region.contains(p))
+        })
+        .collect()
+}
+
+/// The exterior vertex projecting nearest to `point`, within `max_px`.
+pub fn nearest_vertex(
+    mesh: &HairMesh,
+    topology: &Topology,
+    project: impl Fn(DVec3) -> Option<[f64; 2]>,
+    point: [f64; 2],
+    max_px: f64,
+) -> Option<VertexRef> {
+    exterior_vertices(mesh, topology)
+        .into_iter()
+        .filter_map(|v| {
+            let p = project(mesh.position(v)?)?;
+            let d = ((p[0] - point[0]).powi(2) + (p[1] - point[1]).powi(2)).sqrt();
+            (d <= max_px).then_some((v, d))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(v, _)| v)
+}
+
+/// Bundles sharing a column with a selected bundle, added (visible ones only).
+pub fn grow_bundles(
+    mesh: &HairMesh,
+    topology: &Topology,
+    selected: &BTreeSet<u32>,
+) -> BTreeSet<u32> {
+    let mut out = selected.clone();
+    for &b in selected {
+        let Some(bundle) = mesh.bundles.get(b as usize) else {
+            continue;
+        };
+        for &c in &bundle.vertices {
+            out.extend(
+                topology.bundles_of_column[c as usize]
+                    .iter()
+                    .filter(|&&n| !mesh.bundles[n as usize].removed),
+            );
+        }
+    }
+    out
+}
+
+/// Selected bundles whose neighbours (bundles sharing a column) are all selected.
+pub fn shrink_bundles(
+    mesh: &HairMesh,
+    topology: &Topology,
+    selected: &BTreeSet<u32>,
+) -> BTreeSet<u32> {
+    selected
+        .iter()
+        .copied()
+        .filter(|&b| {
+            mesh.bundles.get(b as usize).is_some_and(|bundle| {
+                bundle.vertices.iter().all(|&c| {
+                    topology.bundles_of_column[c as usize]
+                        .iter()
+                        .all(|n| mesh.bundles[*n as usize].removed || selected.contains(n))
+                })
+            })
+        })
+        .collect()
+}
+
+/// Vertices joined to `v` by an edge: along its column and along its layer's face edges.
+fn vertex_neighbours(mesh: &HairMesh, topology: &Topology, v: VertexRef) -> Vec<VertexRef> {
+    let mut out = Vec::new();
+    if v.layer > 0 {
+        out.push(VertexRef {
+            layer: v.layer - 1,
+            ..v
+        });
+    }
+    out.push(VertexRef {
+        layer: v.layer + 1,
+        ..v
+    });
+    for &b in &topology.bundles_of_column[v.column as usize] {
+        let bundle = &mesh.bundles[b as usize];
+        if bundle.removed || bundle.layers < v.layer {
+            continue;
+        }
+        let n = bundle.vertices.len();
+        if let Some(i) = bundle.vertices.iter().position(|&c| c == v.column) {
+            for j in [(i + 1) % n, (i + n - 1) % n] {
+                out.push(VertexRef {
+                    column: bundle.vertices[j],
+                    layer: v.layer,
+                });
+            }
+        }
+    }
+    out.retain(|n| mesh.position(*n).is_some());
+    out
+}
+
+/// Exterior neighbours of the selection, added.
+pub fn grow_vertices(
+    mesh: &HairMesh,
+    topology: &Topology,
+    selected: &BTreeSet<VertexRef>,
+) -> BTreeSet<VertexRef> {
+    let mut out = selected.clone();
+    for &v in selected {
+        out.extend(
+            vertex_neighbours(mesh, topology, v)
+                .into_iter()
+                .filter(|n| !mesh.is_interior(topology, n.column as usize, n.layer as usize)),
+        );
+    }
+    out
+}
+
+/// Selected vertices whose exterior neighbours are all selected.
+pub fn shrink_vertices(
+    mesh: &HairMesh,
+    topology: &Topology,
+    selected: &BTreeSet<VertexRef>,
+) -> BTreeSet<VertexRef> {
+    selected
+        .iter()
+        .copied()
+        .filter(|&v| {
+            vertex_neighbours(mesh, topology, v)
+                .into_iter()
+                .filter(|n| !mesh.is_interior(topology, n.column as usize, n.layer as usize))
+                .all(|n| selected.contains(&n))
+        })
+        .collect()
+}
+
+/// The exterior vertices at `layer` of the given bundles (all visible bundles when `None`).
+pub fn layer_vertices(
+    mesh: &HairMesh,
+    topology: &Topology,
+    bundles: Option<&BTreeSet<u32>>,
+    layer: u32,
+) -> BTreeSet<VertexRef> {
+    mesh.bundles
+        .iter()
+        .enumerate()
+        .filter(|(b, bundle)| {
+            !bundle.removed
+                && bundle.layers >= layer
+                && bundles.is_none_or(|set| set.contains(&(*b as u32)))
+        })
+        .flat_map(|(_, bundle)| bundle.vertices.iter().copied())
+        .map(|column| VertexRef { column, layer })
+        .filter(|v| {
+            mesh.position(*v).is_some()
+                && !mesh.is_interior(topology, v.column as usize, v.layer as usize)
+        })
+        .collect()
+}
+
+/// What moving the selected bundles moves: their exterior vertices above the root (the
+/// scalp stays where the head is).
+pub fn bundle_transform_vertices(
+    mesh: &HairMesh,
+    topology: &Topology,
+    bundles: &BTreeSet<u32>,
+) -> Vec<VertexRef> {
+    let mut out = BTreeSet::new();
+    for &b in bundles {
+        let Some(bundle) = mesh.bundles.get(b as usize) else {
+            continue;
+        };
+        for &c in &bundle.vertices {
+            for layer in 1..=bundle.layers {
+                let v = VertexRef { column: c, layer };
+                if mesh.position(v).is_some()
+                    && !mesh.is_interior(topology, c as usize, layer as usize)
+                {
+                    out.insert(v);
+                }
+            }
+        }
+    }
+    out.into_iter().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::test_meshes::grid;
+
+    /// Looks down the z axis: x, y in model units become pixels ×100.
+    fn top_view(p: DVec3) -> Option<[f64; 2]> {
+        Some([p.x * 100.0, p.y * 100.0])
+    }
+
+    #[test]
+    fn regions_contain_what_they_enclose() {
+        let square = Region::Lasso(vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]);
+        assert!(square.contains([5.0, 5.0]));
+        assert!(!square.contains([15.0, 5.0]));
+        assert!(!Region::Lasso(vec![[0.0, 0.0], [1.0, 1.0]]).contains([0.5, 0.5]));
+        let boxed = Region::Box {
+            a: [10.0, 10.0],
+            b: [0.0, 0.0],
+        };
+        assert!(boxed.contains([0.0, 10.0]) && !boxed.contains([-0.1, 5.0]));
+        let paint = Region::Paint {
+            points: vec![[0.0, 0.0], [20.0, 0.0]],
+            radius_px: 3.0,
+        };
+        assert!(paint.contains([20.0, 2.9]) && !paint.contains([10.0, 3.1]));
+        // NaN never lands inside anything.
+        assert!(!square.contains([f64::NAN, 5.0]) && !boxed.contains([f64::NAN, 1.0]));
+    }
+
+    #[test]
+    fn a_box_selects_the_bundles_and_exterior_vertices_it_covers() {
+        // 3×3 bundles of 0.5 m with 2 layers; the centre column's layer 1 is interior.
+        let mesh = grid(3, 3, 2, 0.5);
+        let topology = Topology::build(&mesh);
+        let left_column = Region::Box {
+            a: [-1.0, -1.0],
+            b: [60.0, 400.0],
+        };
+        let bundles = bundles_in_region(&mesh, top_view, &left_column);
+        assert_eq!(bundles, vec![0, 3, 6]);
+        let all = Region::Box {
+            a: [-1.0, -1.0],
+            b: [400.0, 400.0],
+        };
+        let vertices = vertices_in_region(&mesh, &topology, top_view, &all);
+        assert_eq!(vertices.len(), exterior_vertices(&mesh, &topology).len());
+        assert!(vertices.iter().all(|v| !mesh.is_interior(
+            &topology,
+            v.column as usize,
+            v.layer as usize
+        )));
+        assert!(
+            vertices.len() < mesh.vertex_count(),
+            "interior ones are left out"
+        );
+    }
+
+    #[test]
+    fn grow_then_shrink_returns_to_the_selection() {
+        let mesh = grid(5, 5, 1, 0.5);
+        let topology = Topology::build(&mesh);
+        let centre: BTreeSet<u32> = [12].into();
+        let grown = grow_bundles(&mesh, &topology, &centre);
+        assert_eq!(grown.len(), 9, "the centre and its 8 neighbours");
+        assert_eq!(shrink_bundles(&mesh, &topology, &grown), centre);
+        assert!(shrink_bundles(&mesh, &topology, &centre).is_empty());
+
+        let corner = VertexRef {
+            column: 0,
+            layer: 1,
+        };
+        let v: BTreeSet<VertexRef> = [corner].into();
+        let grown = grow_vertices(&mesh, &topology, &v);
+        assert!(grown.len() > 1 && grown.contains(&corner));
+        assert!(shrink_vertices(&mesh, &topology, &grown).is_subset(&grown));
+    }
+
+    #[test]
+    fn a_layer_and_bundle_moves_leave_the_scalp_and_interior_alone() {
+        let mesh = grid(3, 3, 3, 0.5);
+        let topology = Topology::build(&mesh);
+        let layer = layer_vertices(&mesh, &topology, None, 3);
+        assert_eq!(layer.len(), 16, "the whole top layer is exterior");
+        let middle = layer_vertices(&mesh, &topology, None, 2);
+        assert_eq!(
+            middle.len(),
+            12,
+            "the 4 inner columns are interior below the top"
+        );
+        let moved = bundle_transform_vertices(&mesh, &topology, &[4].into());
+        assert!(moved.iter().all(|v| v.layer >= 1));
+        assert!(moved.iter().all(|v| !mesh.is_interior(
+            &topology,
+            v.column as usize,
+            v.layer as usize
+        )));
+        assert_eq!(moved.len(), 4, "the centre bundle's top-layer corners");
+        let nearest = nearest_vertex(&mesh, &topology, top_view, [0.0, 0.0], 5.0);
+        assert_eq!(nearest.map(|v| v.column), Some(0));
+        assert!(nearest_vertex(&mesh, &topology, top_view, [-50.0, 0.0], 5.0).is_none());
+    }
+}
