@@ -225,6 +225,46 @@ impl StylingSet {
             .rposition(|g| g.bundles.contains(&bundle))
     }
 
+    /// Moves `bundles` into group `group` (`None`: back to the global parameters), out of
+    /// every other group, so each bundle is listed at most once.
+    pub fn assign(&mut self, bundles: &[u32], group: Option<usize>) -> Result<(), String> {
+        if let Some(g) = group
+            && g >= self.groups.len()
+        {
+            return Err(format!(
+                "group {g} does not exist ({} groups)",
+                self.groups.len()
+            ));
+        }
+        for existing in &mut self.groups {
+            existing.bundles.retain(|b| !bundles.contains(b));
+        }
+        if let Some(g) = group {
+            let target = &mut self.groups[g].bundles;
+            target.extend_from_slice(bundles);
+            target.sort_unstable();
+            target.dedup();
+        }
+        Ok(())
+    }
+
+    /// A new group holding `bundles` (taken out of other groups), starting from the
+    /// parameters they use now; returns its index.
+    pub fn new_group(&mut self, name: impl Into<String>, bundles: &[u32]) -> usize {
+        let params = bundles
+            .first()
+            .map_or(&self.global, |&b| self.params_for(b))
+            .clone();
+        self.groups.push(StylingGroup {
+            name: name.into(),
+            bundles: Vec::new(),
+            params,
+        });
+        let index = self.groups.len() - 1;
+        let _ = self.assign(bundles, Some(index));
+        index
+    }
+
     /// Every number must be finite and every range respected; names the offending field.
     pub fn validate(&self) -> Result<(), String> {
         let check = |p: &StylingParams, at: &str| -> Result<(), String> {
@@ -461,6 +501,41 @@ pub fn apply_twist(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn assigning_moves_bundles_between_groups_and_back_to_global() {
+        let mut set = StylingSet::default();
+        set.global.curl.radius_m = 0.002;
+        let a = set.new_group("fringe", &[3, 1, 2]);
+        assert_eq!(set.groups[a].bundles, vec![1, 2, 3]);
+        assert_eq!(
+            set.params_for(1).curl.radius_m,
+            0.002,
+            "starts from what it used"
+        );
+        set.groups[a].params.curl.radius_m = 0.004;
+        let b = set.new_group("crown", &[2, 7]);
+        assert_eq!(
+            set.groups[b].params.curl.radius_m, 0.004,
+            "2 came from the fringe"
+        );
+        assert_eq!(
+            set.groups[a].bundles,
+            vec![1, 3],
+            "a bundle is in one group"
+        );
+        set.assign(&[3, 7], None).expect("to global");
+        assert_eq!(set.group_of(3), None);
+        assert_eq!(set.group_of(7), None);
+        assert_eq!(set.group_of(2), Some(b));
+        let error = set.assign(&[1], Some(5)).expect_err("no group 5");
+        assert!(error.contains("group 5"), "{error}");
+        assert_eq!(
+            set.group_of(1),
+            Some(a),
+            "a refused assignment changes nothing"
+        );
+    }
 
     fn all_ops() -> StylingParams {
         StylingParams {

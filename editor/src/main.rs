@@ -255,6 +255,10 @@ fn editor(file: Option<&Path>) -> ExitCode {
             .with_inner_size([1400.0, 900.0])
             .with_title(state.title()),
         renderer: eframe::Renderer::Wgpu,
+        wgpu_options: eframe::egui_wgpu::WgpuConfiguration {
+            wgpu_setup: hairloom_editor::app::wgpu_setup(),
+            ..Default::default()
+        },
         ..Default::default()
     };
     match eframe::run_native(

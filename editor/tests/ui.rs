@@ -568,3 +568,52 @@ fn escape_cancels_a_scale_and_grow_shrink_keep_the_seed() {
     assert_eq!(harness.state().state.document(), &original);
     assert!(harness.state().state.project.history.undo.is_empty());
 }
+
+#[test]
+fn a_group_from_the_selection_gets_its_own_parameters_and_paste() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    let layers = original.hair_mesh.bundles[0].layers;
+    harness
+        .get_by_label(&format!("Bundle 0 · {layers} layers"))
+        .click();
+    harness.run();
+    harness.get_by_label("New group from selection").click();
+    harness.run();
+    let styling = harness.state().state.document().styling.clone();
+    assert_eq!(styling.groups.len(), original.styling.groups.len() + 1);
+    let g = styling.groups.len() - 1;
+    assert_eq!(styling.group_of(0), Some(g));
+    assert_eq!(
+        harness.state().styling.group,
+        Some(g),
+        "the panel edits the new group"
+    );
+
+    // A slider now changes the group only.
+    harness
+        .get_by_role_and_label(Role::Slider, "Curl radius")
+        .set_value_accesskit(0.005);
+    harness.run();
+    let styling = harness.state().state.document().styling.clone();
+    assert_eq!(styling.groups[g].params.curl.radius_m, 0.005);
+    assert_eq!(styling.global, original.styling.global);
+
+    // Copy the group's parameters onto the global set.
+    harness.get_by_label("Copy parameters").click();
+    harness.run();
+    harness.state_mut().styling.group = None;
+    harness.run();
+    harness.get_by_label("Paste parameters").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().styling.global,
+        styling.groups[g].params
+    );
+    assert_eq!(harness.state().state.project.history.undo.len(), 3);
+    for _ in 0..3 {
+        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+        harness.run();
+    }
+    assert_eq!(harness.state().state.document(), &original);
+}

@@ -32,11 +32,15 @@ fn wgpu_harness() -> Option<Harness<'static, HairloomApp>> {
     }
     let recovery_dir = tempfile::tempdir().expect("temp dir").keep();
     let recovery = hairloom_editor::app::recovery::Recovery::in_dir(recovery_dir);
-    // kittest's setup with the GL backend left out: its WebGL2 limits have no storage
-    // buffers, and the editor runs on Vulkan / Metal / DX12.
-    let mut setup = egui_kittest::wgpu::default_wgpu_setup();
-    if let eframe::egui_wgpu::WgpuSetup::CreateNew(create) = &mut setup {
-        create.instance_descriptor.backends = wgpu::Backends::PRIMARY;
+    // The editor's own device setup (no GL; timestamps and f32 filtering when available),
+    // with kittest's preference for a CPU adapter so the picture is reproducible.
+    let mut setup = hairloom_editor::app::wgpu_setup();
+    if let (
+        eframe::egui_wgpu::WgpuSetup::CreateNew(create),
+        eframe::egui_wgpu::WgpuSetup::CreateNew(kittest),
+    ) = (&mut setup, egui_kittest::wgpu::default_wgpu_setup())
+    {
+        create.native_adapter_selector = kittest.native_adapter_selector;
     }
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1100.0, 720.0))
@@ -117,5 +121,63 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
     assert!(
         change > 1.0,
         "curl changed the viewport by only {change:.3}"
+    );
+}
+
+#[test]
+fn the_accuracy_switches_show_measured_error_and_time() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    harness.get_by_label("Strands & accuracy").click();
+    harness.run();
+    harness.get_by_label("Measure").click();
+    harness.run();
+    let revision = harness.state().state.revision;
+    let (measured_at, rows) = harness.state().viewport.accuracy.clone().expect("measured");
+    assert_eq!(measured_at, revision);
+    let rows = rows.expect("measurement ran");
+    assert_eq!(rows.len(), 4);
+    let size = harness.state().state.document().hair_mesh.size();
+    // lavapipe cannot filter f32 textures in hardware: that row says so instead.
+    let rows: Vec<_> = rows
+        .into_iter()
+        .filter(|row| {
+            if let Some(why) = &row.unavailable {
+                eprintln!("{:?} {:?}: {why}", row.precision, row.filtering);
+            }
+            row.unavailable.is_none()
+        })
+        .collect();
+    assert!(
+        rows.len() >= 3,
+        "f32 exact, f16 exact and f16 hardware run anywhere"
+    );
+    for row in &rows {
+        eprintln!(
+            "{:?} {:?}: max {:.3e} m, mean {:.3e} m, {:.2} ms (wall {:.1} ms)",
+            row.precision,
+            row.filtering,
+            row.max_error_m,
+            row.mean_error_m,
+            row.generation_ms,
+            row.wall_ms
+        );
+        assert!(row.generation_ms > 0.0 && row.generation_ms.is_finite());
+        assert!(row.wall_ms > 0.0 && row.wall_ms.is_finite());
+        assert!(row.mean_error_m <= row.max_error_m);
+        assert!(row.max_error_m < 1e-2 * size, "{row:?}");
+    }
+    assert_eq!(rows[0].max_error_m, 0.0, "f32 / exact is the reference");
+    assert!(
+        rows[1..].iter().all(|r| r.max_error_m > 0.0),
+        "every other setting differs measurably"
+    );
+    // The table shows them.
+    let last = rows.last().expect("rows");
+    let shown = format!("{:.4} mm", last.mean_error_m * 1e3);
+    assert!(
+        harness.get_all_by_label(&shown).count() >= 1,
+        "{shown} shown"
     );
 }

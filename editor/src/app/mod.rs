@@ -26,6 +26,25 @@ use styling_panel::StylingPanel;
 use tools_panel::ToolsPanel;
 use viewport::Viewport;
 
+/// The editor's wgpu setup: egui's defaults plus the optional features the generator uses
+/// when the adapter has them (timestamps for measured GPU time, f32 texture filtering for
+/// the hardware-filtering switch, f16), and without the GL backend, whose WebGL2 limits have
+/// no storage buffers. Shared by the binary and the wgpu snapshot tests.
+pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetup {
+    let mut setup = eframe::egui_wgpu::WgpuSetupCreateNew::without_display_handle();
+    setup.instance_descriptor.backends = wgpu::Backends::PRIMARY;
+    let egui_descriptor = setup.device_descriptor.clone();
+    setup.device_descriptor = std::sync::Arc::new(move |adapter| {
+        let optional = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::FLOAT32_FILTERABLE
+            | wgpu::Features::SHADER_F16;
+        let mut descriptor = egui_descriptor(adapter);
+        descriptor.required_features |= adapter.features() & optional;
+        descriptor
+    });
+    eframe::egui_wgpu::WgpuSetup::CreateNew(setup)
+}
+
 /// What runs after the artist answers "save changes?".
 #[derive(Clone, Debug, PartialEq)]
 pub enum AfterConfirm {
@@ -42,6 +61,7 @@ pub enum Pane {
     Outliner,
     History,
     Styling,
+    Strands,
 }
 
 impl Pane {
@@ -52,6 +72,7 @@ impl Pane {
             Self::Outliner => "Outliner",
             Self::History => "History",
             Self::Styling => "Styling",
+            Self::Strands => "Strands & accuracy",
         }
     }
 }
@@ -69,7 +90,8 @@ pub fn default_layout() -> egui_tiles::Tree<Pane> {
     let left = tiles.insert_vertical_tile(vec![left_top, left_middle, left_bottom]);
     let viewport = tiles.insert_pane(Pane::Viewport);
     let styling = tiles.insert_pane(Pane::Styling);
-    let right = tiles.insert_tab_tile(vec![styling]);
+    let strands = tiles.insert_pane(Pane::Strands);
+    let right = tiles.insert_tab_tile(vec![styling, strands]);
     let root = tiles.insert_horizontal_tile(vec![left, viewport, right]);
     if let Some(egui_tiles::Tile::Container(egui_tiles::Container::Linear(linear))) =
         tiles.get_mut(root)
@@ -490,37 +512,10 @@ impl HairloomApp {
             ui.menu_button("View", |ui| {
                 let settings = &mut self.viewport.settings;
                 ui.checkbox(&mut settings.wireframe, "Hair-mesh wireframe");
-                ui.checkbox(&mut settings.lod.enabled, "Level of detail");
-                ui.add(
-                    egui::Slider::new(&mut settings.strands_per_bundle, 1..=256)
-                        .text("Strands per bundle"),
+                ui.label(
+                    egui::RichText::new("Strands, LOD and accuracy: the Strands & accuracy panel")
+                        .weak(),
                 );
-                ui.horizontal(|ui| {
-                    ui.label("Filtering");
-                    ui.selectable_value(
-                        &mut settings.filtering,
-                        hairloom_core::runtime::Filtering::Exact,
-                        "exact",
-                    );
-                    ui.selectable_value(
-                        &mut settings.filtering,
-                        hairloom_core::runtime::Filtering::Hardware8Bit,
-                        "hardware",
-                    );
-                });
-                ui.horizontal(|ui| {
-                    ui.label("Textures");
-                    ui.selectable_value(
-                        &mut settings.precision,
-                        hairloom_core::runtime::Precision::F32,
-                        "f32",
-                    );
-                    ui.selectable_value(
-                        &mut settings.precision,
-                        hairloom_core::runtime::Precision::F16,
-                        "f16",
-                    );
-                });
                 ui.separator();
                 if ui.button("Reset layout").clicked() {
                     self.layout = default_layout();
@@ -676,6 +671,7 @@ impl egui_tiles::Behavior<Pane> for PaneUi<'_> {
                     Pane::Outliner => self.outliner.ui(ui, self.state),
                     Pane::History => self.history.ui(ui, self.state),
                     Pane::Styling => self.styling.ui(ui, self.state),
+                    Pane::Strands => self.viewport.settings_ui(ui, self.state),
                     Pane::Viewport => {}
                 });
         });

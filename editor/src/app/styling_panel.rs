@@ -148,6 +148,9 @@ const OPS: &[(&str, &[SliderSpec])] = &[
 pub struct StylingPanel {
     /// `None`: global parameters; `Some(g)`: styling group `g`.
     pub group: Option<usize>,
+    /// Parameters copied from one group (or the global set) to paste onto another: the
+    /// styling half of the wisp copy / paste of seed 004.
+    pub copied: Option<StylingParams>,
 }
 
 impl StylingPanel {
@@ -173,6 +176,7 @@ impl StylingPanel {
                     ui.selectable_value(&mut self.group, Some(g), format!("group {name}"));
                 }
             });
+        self.group_tools(ui, state);
         let group = self.group;
         egui::ScrollArea::vertical().show(ui, |ui| {
             for (op, fields) in OPS {
@@ -212,6 +216,70 @@ impl StylingPanel {
                 }
                 commit_when_done(state, &response);
             });
+        });
+    }
+}
+
+impl StylingPanel {
+    /// Groups from the selection, and copy / paste of whole parameter sets.
+    fn group_tools(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
+        let selection: Vec<u32> = state.selection.iter().copied().collect();
+        let has_selection = !selection.is_empty();
+        ui.horizontal_wrapped(|ui| {
+            if ui
+                .add_enabled(has_selection, egui::Button::new("New group from selection"))
+                .clicked()
+            {
+                let styling = &mut state.edit("New styling group").styling;
+                let name = format!("{}", styling.groups.len() + 1);
+                self.group = Some(styling.new_group(name, &selection));
+                state.commit_edit();
+            }
+            if let Some(g) = self.group
+                && ui
+                    .add_enabled(has_selection, egui::Button::new("Assign selection"))
+                    .clicked()
+            {
+                let result = state
+                    .edit("Assign to group")
+                    .styling
+                    .assign(&selection, Some(g));
+                state.commit_edit();
+                if let Err(error) = result {
+                    state.message = error;
+                }
+            }
+            if ui
+                .add_enabled(has_selection, egui::Button::new("Selection to global"))
+                .clicked()
+            {
+                let _ = state
+                    .edit("Back to global")
+                    .styling
+                    .assign(&selection, None);
+                state.commit_edit();
+            }
+            if let Some(g) = self.group
+                && ui.button("Select group").clicked()
+            {
+                state.selection = state.document().styling.groups[g]
+                    .bundles
+                    .iter()
+                    .copied()
+                    .collect();
+            }
+        });
+        ui.horizontal(|ui| {
+            if ui.button("Copy parameters").clicked() {
+                self.copied = Some(selected(state, self.group).clone());
+                state.message = "styling parameters copied".into();
+            }
+            if let Some(copied) = &self.copied
+                && ui.button("Paste parameters").clicked()
+            {
+                *params_mut(state.edit("Paste styling"), self.group) = copied.clone();
+                state.commit_edit();
+            }
         });
     }
 }

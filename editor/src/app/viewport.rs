@@ -30,7 +30,7 @@ use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
 use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
 
 use super::state::{DragTool, EditorState, SelectMode};
-use crate::render::{RenderableHair, default_scene};
+use crate::render::{AccuracyRow, RenderableHair, default_scene, measure_accuracy};
 
 /// Storage buffers per shader stage the generation and preview pipelines bind.
 const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
@@ -221,6 +221,9 @@ pub struct Viewport {
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
     pub rect: Option<egui::Rect>,
     transform: Option<ActiveTransform>,
+    /// The last accuracy measurement: the document revision it was made at, and the rows
+    /// (or why it failed).
+    pub accuracy: Option<(u64, Result<Vec<AccuracyRow>, String>)>,
     /// The pointer path of a region drag in progress.
     drag_path: Vec<egui::Pos2>,
     /// The box the camera frames (the drawn hair's), for picking with the same camera.
@@ -279,6 +282,7 @@ impl Viewport {
             error: None,
             rect: None,
             transform: None,
+            accuracy: None,
             drag_path: Vec::new(),
             camera_bounds: None,
             interior: None,
@@ -300,6 +304,143 @@ impl Viewport {
         }
         self.draw(ui, state, rect);
         self.paint_overlay(ui, state, rect);
+    }
+
+    /// Strand count, level of detail and the accuracy switches, each setting with its
+    /// measured error and generation time beside it (measured on demand: it generates the
+    /// whole document four times).
+    pub fn settings_ui(&mut self, ui: &mut egui::Ui, state: &EditorState) {
+        ui.heading("Strands");
+        let settings = &mut self.settings;
+        ui.add(
+            egui::Slider::new(&mut settings.strands_per_bundle, 1..=256).text("Strands per bundle"),
+        );
+        ui.checkbox(&mut settings.lod.enabled, "Level of detail");
+        ui.add_enabled_ui(settings.lod.enabled, |ui| {
+            ui.add(
+                egui::Slider::new(&mut settings.lod.alpha_strands, 0.005..=0.5)
+                    .logarithmic(true)
+                    .text("Strand LOD alpha"),
+            );
+            ui.add(
+                egui::Slider::new(&mut settings.lod.alpha_vertices, 0.005..=0.5)
+                    .logarithmic(true)
+                    .text("Vertex LOD alpha"),
+            );
+            ui.add(egui::Slider::new(&mut settings.lod.lambda, 0.0..=1.0).text("Morph lambda"));
+        });
+        ui.separator();
+        ui.heading("Accuracy");
+        let rows = match &self.accuracy {
+            Some((revision, Ok(rows))) if *revision == state.revision => Some(rows.clone()),
+            _ => None,
+        };
+        let row_for = |precision, filtering| {
+            rows.as_ref().and_then(|rows| {
+                rows.iter()
+                    .find(|r| r.precision == precision && r.filtering == filtering)
+                    .cloned()
+            })
+        };
+        let size_m = state.document().hair_mesh.size().max(1e-9);
+        egui::Grid::new("accuracy switches")
+            .num_columns(4)
+            .striped(true)
+            .show(ui, |ui| {
+                ui.label("Textures / filtering");
+                ui.label("max error");
+                ui.label("mean error");
+                ui.label("generation");
+                ui.end_row();
+                for precision in [Precision::F32, Precision::F16] {
+                    for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
+                        let name = format!(
+                            "{} / {}",
+                            match precision {
+                                Precision::F32 => "f32",
+                                Precision::F16 => "f16",
+                            },
+                            match filtering {
+                                Filtering::Exact => "exact",
+                                Filtering::Hardware8Bit => "hardware",
+                            }
+                        );
+                        let chosen = self.settings.precision == precision
+                            && self.settings.filtering == filtering;
+                        if ui.selectable_label(chosen, name).clicked() {
+                            self.settings.precision = precision;
+                            self.settings.filtering = filtering;
+                        }
+                        match row_for(precision, filtering) {
+                            Some(AccuracyRow {
+                                unavailable: Some(why),
+                                ..
+                            }) => {
+                                ui.label("not on this GPU").on_hover_text(why);
+                                ui.label("-");
+                                ui.label("-");
+                            }
+                            Some(row) => {
+                                ui.label(format!(
+                                    "{:.3} mm ({:.2e} × size)",
+                                    row.max_error_m * 1e3,
+                                    row.max_error_m / size_m
+                                ));
+                                ui.label(format!("{:.4} mm", row.mean_error_m * 1e3));
+                                ui.label(if row.timed_on_gpu {
+                                    format!(
+                                        "{:.2} ms GPU, {:.1} ms wall",
+                                        row.generation_ms, row.wall_ms
+                                    )
+                                } else {
+                                    format!("{:.1} ms wall", row.wall_ms)
+                                });
+                            }
+                            None => {
+                                ui.label("-");
+                                ui.label("-");
+                                ui.label("-");
+                            }
+                        }
+                        ui.end_row();
+                    }
+                }
+            });
+        ui.horizontal(|ui| {
+            let measure = ui
+                .add_enabled(self.gpu.is_some(), egui::Button::new("Measure"))
+                .on_hover_text(
+                    "Generates every strand of the document (full detail, 17 vertices) with \
+                     each setting on this GPU; errors against f32 / exact",
+                );
+            if measure.clicked()
+                && let Some(gpu) = &self.gpu
+            {
+                let result = measure_accuracy(
+                    &gpu.context,
+                    &gpu.generator,
+                    state.document(),
+                    self.settings.strands_per_bundle,
+                    17,
+                )
+                .map_err(|e| format!("{e:#}"));
+                self.accuracy = Some((state.revision, result));
+            }
+            match &self.accuracy {
+                Some((_, Err(error))) => {
+                    ui.colored_label(ui.visuals().error_fg_color, error);
+                }
+                Some((revision, Ok(_))) if *revision != state.revision => {
+                    ui.weak("the document changed since the last measurement");
+                }
+                None => {
+                    ui.weak("not measured yet");
+                }
+                _ => {
+                    ui.weak(format!("on {}", self.adapter));
+                }
+            }
+        });
     }
 
     /// The camera the picture and overlay use (the mesh's box before the first picture).
