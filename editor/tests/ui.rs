@@ -537,11 +537,7 @@ fn box_select_vertices_then_g_moves_them_as_one_undo_step() {
 fn escape_cancels_a_scale_and_grow_shrink_keep_the_seed() {
     let mut harness = harness();
     let original = harness.state().state.document().clone();
-    let layers = original.hair_mesh.bundles[0].layers;
-    harness
-        .get_by_label(&format!("Bundle 0 · {layers} layers"))
-        .click();
-    harness.run();
+    click_bundle_in_outliner(&mut harness, 0);
     harness.get_by_label("Grow").click();
     harness.run();
     let grown = harness.state().state.selection.clone();
@@ -573,11 +569,7 @@ fn escape_cancels_a_scale_and_grow_shrink_keep_the_seed() {
 fn a_group_from_the_selection_gets_its_own_parameters_and_paste() {
     let mut harness = harness();
     let original = harness.state().state.document().clone();
-    let layers = original.hair_mesh.bundles[0].layers;
-    harness
-        .get_by_label(&format!("Bundle 0 · {layers} layers"))
-        .click();
-    harness.run();
+    click_bundle_in_outliner(&mut harness, 0);
     harness.get_by_label("New group from selection").click();
     harness.run();
     let styling = harness.state().state.document().styling.clone();
@@ -612,6 +604,68 @@ fn a_group_from_the_selection_gets_its_own_parameters_and_paste() {
     );
     assert_eq!(harness.state().state.project.history.undo.len(), 3);
     for _ in 0..3 {
+        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+        harness.run();
+    }
+    assert_eq!(harness.state().state.document(), &original);
+}
+
+/// Clicks bundle `index` in the outliner (selects it alone).
+fn click_bundle_in_outliner(harness: &mut Harness<'static, HairloomApp>, index: usize) {
+    let layers = harness.state().state.document().hair_mesh.bundles[index].layers;
+    harness
+        .get_by_label(&format!("Bundle {index} · {layers} layers"))
+        .click();
+    harness.run();
+}
+
+#[test]
+fn dragging_a_uv_corner_moves_it_on_its_side_of_the_seam_as_one_step() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    harness.get_by_label("uv / w layout").click();
+    harness.run();
+    click_bundle_in_outliner(&mut harness, 0);
+    let rect = harness.state().layout_panel.uv_rect.expect("uv view drawn");
+    let bundle = &original.hair_mesh.bundles[0];
+    let (column, uv) = (bundle.vertices[0], bundle.uvs[0]);
+    let at = egui::pos2(
+        rect.left() + uv.x as f32 * rect.width(),
+        rect.bottom() - uv.y as f32 * rect.height(),
+    );
+    drag(&mut harness, at, at + egui::vec2(12.0, -8.0));
+    let moved = harness.state().state.document().clone();
+    let new_uv = moved.hair_mesh.bundles[0].uvs[0];
+    assert!(new_uv.x > uv.x && new_uv.y > uv.y, "{uv} → {new_uv}");
+    // Every corner of that column with the same uv moved along; other corners did not.
+    for (old, new) in original
+        .hair_mesh
+        .bundles
+        .iter()
+        .zip(&moved.hair_mesh.bundles)
+    {
+        for k in 0..old.vertices.len() {
+            if old.vertices[k] == column && old.uvs[k] == uv {
+                assert_eq!(new.uvs[k], new_uv);
+            } else {
+                assert_eq!(new.uvs[k], old.uvs[k]);
+            }
+        }
+    }
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+    assert_eq!(
+        harness.state().state.project.history.undo[0].label(),
+        "Move uv"
+    );
+
+    // w: switching to edited values is a step of its own; undo twice restores everything.
+    harness.get_by_label("edited").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().hair_mesh.w_mode,
+        hairloom_core::WMode::Manual
+    );
+    for _ in 0..2 {
         harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
         harness.run();
     }

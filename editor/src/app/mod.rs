@@ -4,6 +4,7 @@
 
 pub mod files;
 pub mod history_panel;
+pub mod layout_panel;
 pub mod outliner_panel;
 pub mod recovery;
 pub mod state;
@@ -20,6 +21,7 @@ use files::{
     RecentFiles,
 };
 use history_panel::HistoryPanel;
+use layout_panel::LayoutPanel;
 use outliner_panel::OutlinerPanel;
 use recovery::{AUTOSAVE_SECONDS, PendingRecovery, Recovery};
 use styling_panel::StylingPanel;
@@ -62,6 +64,7 @@ pub enum Pane {
     History,
     Styling,
     Strands,
+    Layout,
 }
 
 impl Pane {
@@ -73,6 +76,7 @@ impl Pane {
             Self::History => "History",
             Self::Styling => "Styling",
             Self::Strands => "Strands & accuracy",
+            Self::Layout => "uv / w layout",
         }
     }
 }
@@ -91,7 +95,8 @@ pub fn default_layout() -> egui_tiles::Tree<Pane> {
     let viewport = tiles.insert_pane(Pane::Viewport);
     let styling = tiles.insert_pane(Pane::Styling);
     let strands = tiles.insert_pane(Pane::Strands);
-    let right = tiles.insert_tab_tile(vec![styling, strands]);
+    let layout = tiles.insert_pane(Pane::Layout);
+    let right = tiles.insert_tab_tile(vec![styling, strands, layout]);
     let root = tiles.insert_horizontal_tile(vec![left, viewport, right]);
     if let Some(egui_tiles::Tile::Container(egui_tiles::Container::Linear(linear))) =
         tiles.get_mut(root)
@@ -109,6 +114,7 @@ pub struct HairloomApp {
     pub history: HistoryPanel,
     pub tools: ToolsPanel,
     pub outliner: OutlinerPanel,
+    pub layout_panel: LayoutPanel,
     pub viewport: Viewport,
     pub layout: egui_tiles::Tree<Pane>,
     pub recovery: Recovery,
@@ -152,6 +158,7 @@ impl HairloomApp {
             history: HistoryPanel,
             tools: ToolsPanel::default(),
             outliner: OutlinerPanel,
+            layout_panel: LayoutPanel::default(),
             layout: default_layout(),
             dialogs: Box::new(NativeDialogs),
             prompt: None,
@@ -644,6 +651,7 @@ struct PaneUi<'a> {
     outliner: &'a mut OutlinerPanel,
     history: &'a mut HistoryPanel,
     styling: &'a mut StylingPanel,
+    layout: &'a mut LayoutPanel,
     viewport: &'a mut Viewport,
 }
 
@@ -672,6 +680,7 @@ impl egui_tiles::Behavior<Pane> for PaneUi<'_> {
                     Pane::History => self.history.ui(ui, self.state),
                     Pane::Styling => self.styling.ui(ui, self.state),
                     Pane::Strands => self.viewport.settings_ui(ui, self.state),
+                    Pane::Layout => self.layout.ui(ui, self.state),
                     Pane::Viewport => {}
                 });
         });
@@ -734,6 +743,7 @@ impl eframe::App for HairloomApp {
                 outliner: &mut self.outliner,
                 history: &mut self.history,
                 styling: &mut self.styling,
+                layout: &mut self.layout_panel,
                 viewport: &mut self.viewport,
             };
             self.layout.ui(&mut panes, ui);
