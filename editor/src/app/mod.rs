@@ -92,6 +92,13 @@ pub fn default_layout() -> egui_tiles::Tree<Pane> {
     let left_middle = tiles.insert_tab_tile(vec![outliner]);
     let left_bottom = tiles.insert_tab_tile(vec![history]);
     let left = tiles.insert_vertical_tile(vec![left_top, left_middle, left_bottom]);
+    if let Some(egui_tiles::Tile::Container(egui_tiles::Container::Linear(linear))) =
+        tiles.get_mut(left)
+    {
+        linear.shares.set_share(left_top, 2.6);
+        linear.shares.set_share(left_middle, 1.2);
+        linear.shares.set_share(left_bottom, 0.9);
+    }
     let viewport = tiles.insert_pane(Pane::Viewport);
     let styling = tiles.insert_pane(Pane::Styling);
     let strands = tiles.insert_pane(Pane::Strands);
@@ -102,8 +109,8 @@ pub fn default_layout() -> egui_tiles::Tree<Pane> {
         tiles.get_mut(root)
     {
         linear.shares.set_share(left, 1.0);
-        linear.shares.set_share(viewport, 3.2);
-        linear.shares.set_share(right, 1.3);
+        linear.shares.set_share(viewport, 3.0);
+        linear.shares.set_share(right, 1.5);
     }
     egui_tiles::Tree::new(egui::Id::unique("hairloom layout"), root, tiles)
 }
