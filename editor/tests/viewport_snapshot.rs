@@ -181,3 +181,34 @@ fn the_accuracy_switches_show_measured_error_and_time() {
         "{shown} shown"
     );
 }
+
+#[test]
+fn a_gpu_error_is_shown_in_the_viewport_instead_of_panicking() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    let device = harness.state().viewport.device().expect("a device").clone();
+    // An invalid buffer (mappable for reading and writing at once) outside any error scope.
+    let _ = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("invalid on purpose"),
+        size: 16,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::MAP_WRITE,
+        mapped_at_creation: false,
+    });
+    harness.run();
+    let error = harness
+        .state()
+        .viewport
+        .error
+        .clone()
+        .expect("the error is shown");
+    assert!(error.contains("GPU error"), "{error}");
+    // The document is untouched and can still be saved.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("after-gpu-error.hairloom");
+    harness
+        .state_mut()
+        .state
+        .save_as(&path)
+        .expect("saving still works");
+}

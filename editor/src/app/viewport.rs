@@ -209,6 +209,9 @@ struct DrawnKey {
 
 pub struct Viewport {
     gpu: Option<GpuView>,
+    /// A lost device or a GPU error the device reported outside any error scope: shown in
+    /// the viewport instead of panicking (wgpu's default).
+    device_problem: Arc<std::sync::Mutex<Option<String>>>,
     pub orbit: Orbit,
     pub settings: ViewSettings,
     uploaded: Option<(u64, ViewSettings)>,
@@ -252,6 +255,23 @@ impl Viewport {
             )
         });
         let render_state = render_state.filter(|_| unsupported.is_none());
+        let device_problem = Arc::new(std::sync::Mutex::new(None::<String>));
+        if let Some(state) = render_state {
+            let lost = device_problem.clone();
+            state
+                .device
+                .set_device_lost_callback(move |reason, message| {
+                    if let Ok(mut problem) = lost.lock() {
+                        *problem = Some(format!("the GPU device was lost ({reason:?}): {message}"));
+                    }
+                });
+            let failed = device_problem.clone();
+            state.device.on_uncaptured_error(Arc::new(move |error| {
+                if let Ok(mut problem) = failed.lock() {
+                    problem.get_or_insert_with(|| format!("GPU error: {error}"));
+                }
+            }));
+        }
         let gpu = render_state.map(|state| {
             let context = GpuContext::from_parts(
                 state.adapter.clone(),
@@ -273,6 +293,7 @@ impl Viewport {
                 |g| describe(&g.context.adapter_info),
             ),
             gpu,
+            device_problem,
             orbit: Orbit::default(),
             settings: ViewSettings::default(),
             uploaded: None,
@@ -304,6 +325,11 @@ impl Viewport {
         }
         self.draw(ui, state, rect);
         self.paint_overlay(ui, state, rect);
+    }
+
+    /// The wgpu device the viewport draws with (tests provoke device errors on it).
+    pub fn device(&self) -> Option<&wgpu::Device> {
+        self.gpu.as_ref().map(|g| &g.context.device)
     }
 
     /// Strand count, level of detail and the accuracy switches, each setting with its
@@ -458,6 +484,20 @@ impl Viewport {
 
     /// Generates and draws the strands when the document, settings, view or size changed.
     fn draw(&mut self, ui: &mut egui::Ui, state: &mut EditorState, rect: egui::Rect) {
+        let problem = self.device_problem.lock().ok().and_then(|p| p.clone());
+        if let Some(problem) = problem {
+            // Nothing more is drawn on a device in this state; the document is untouched
+            // and can still be saved and exported.
+            ui.painter().text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                format!("{problem}\nSave your work and restart Hairloom to draw again."),
+                egui::FontId::proportional(14.0),
+                ui.visuals().error_fg_color,
+            );
+            self.error = Some(problem);
+            return;
+        }
         let Some(gpu) = self.gpu.as_mut() else {
             ui.painter().text(
                 rect.center(),
