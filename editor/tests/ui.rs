@@ -603,10 +603,7 @@ fn a_group_from_the_selection_gets_its_own_parameters_and_paste() {
         styling.groups[g].params
     );
     assert_eq!(harness.state().state.project.history.undo.len(), 3);
-    for _ in 0..3 {
-        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-        harness.run();
-    }
+    undo(&mut harness, 3);
     assert_eq!(harness.state().state.document(), &original);
 }
 
@@ -665,9 +662,57 @@ fn dragging_a_uv_corner_moves_it_on_its_side_of_the_seam_as_one_step() {
         harness.state().state.document().hair_mesh.w_mode,
         hairloom_core::WMode::Manual
     );
-    for _ in 0..2 {
+    undo(&mut harness, 2);
+    assert_eq!(harness.state().state.document(), &original);
+}
+
+#[test]
+fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    click_bundle_in_outliner(&mut harness, 0);
+    harness.get_by_label("Copy shape").click();
+    harness.run();
+    click_bundle_in_outliner(&mut harness, 5);
+    harness.get_by_label("Paste shape").click();
+    harness.run();
+    let pasted = harness.state().state.document().clone();
+    assert_ne!(
+        pasted.hair_mesh,
+        original.hair_mesh,
+        "{}",
+        harness.state().state.message
+    );
+    assert_eq!(
+        harness.state().state.project.history.undo[0].label(),
+        "Paste shape"
+    );
+    harness.get_by_label("Mirror shape").click();
+    harness.run();
+    let selection = harness.state().state.selection.clone();
+    assert_eq!(selection.len(), 1, "{}", harness.state().state.message);
+    assert!(
+        !selection.contains(&5),
+        "the mirror image is another bundle"
+    );
+    assert_eq!(harness.state().state.project.history.undo.len(), 2);
+    assert!(
+        harness
+            .state()
+            .state
+            .document()
+            .hair_mesh
+            .validate()
+            .is_ok()
+    );
+    undo(&mut harness, 2);
+    assert_eq!(harness.state().state.document(), &original);
+}
+
+/// Presses Ctrl+Z `times` times.
+fn undo(harness: &mut Harness<'static, HairloomApp>, times: usize) {
+    for _ in 0..times {
         harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
         harness.run();
     }
-    assert_eq!(harness.state().state.document(), &original);
 }

@@ -10,6 +10,8 @@ pub struct ToolsPanel {
     pub extrude_distance_m: f64,
     /// Layer index for insert (a new layer below it), delete and select.
     pub layer: u32,
+    /// The bundle whose shape Copy shape took (wisp copy / paste).
+    pub copied_shape: Option<u32>,
 }
 
 impl Default for ToolsPanel {
@@ -17,6 +19,7 @@ impl Default for ToolsPanel {
         Self {
             extrude_distance_m: 0.02,
             layer: 1,
+            copied_shape: None,
         }
     }
 }
@@ -131,6 +134,59 @@ impl ToolsPanel {
             }
             if ui.button("Subdivide").clicked() {
                 state.edit_mesh("Subdivide", edit::subdivide);
+            }
+        });
+        ui.separator();
+        ui.heading("Wisps");
+        ui.horizontal(|ui| {
+            if ui
+                .button("Copy shape")
+                .on_hover_text("The one selected bundle's shape")
+                .clicked()
+            {
+                match state.selection.iter().collect::<Vec<_>>()[..] {
+                    [&one] => {
+                        self.copied_shape = Some(one);
+                        state.message = format!("copied the shape of bundle {one}");
+                    }
+                    _ => state.message = "Copy shape: select exactly one bundle".into(),
+                }
+            }
+            if let Some(source) = self.copied_shape
+                && ui
+                    .button("Paste shape")
+                    .on_hover_text("Onto the selected bundles, turned into each one's frame")
+                    .clicked()
+            {
+                state.edit_mesh("Paste shape", |mesh, bundles| {
+                    edit::paste_shape(mesh, source, bundles)
+                });
+            }
+            if ui
+                .button("Mirror shape")
+                .on_hover_text("The selected bundles' shapes onto their mirror images across the model's centre (x)")
+                .clicked()
+            {
+                // The body's centre (a head is symmetric; its hair need not be yet).
+                let document = state.document();
+                let body_x = document.body.positions.iter().map(|p| p[0] as f64);
+                let plane_x = match (body_x.clone().reduce(f64::min), body_x.reduce(f64::max)) {
+                    (Some(lo), Some(hi)) => 0.5 * (lo + hi),
+                    _ => document
+                        .hair_mesh
+                        .bounds()
+                        .map_or(0.0, |(lo, hi)| 0.5 * (lo.x + hi.x)),
+                };
+                let mut mirrored = Vec::new();
+                state.edit_mesh("Mirror shape", |mesh, bundles| {
+                    edit::mirror_shape(mesh, bundles, plane_x).map(|(outcome, targets)| {
+                        mirrored = targets;
+                        outcome
+                    })
+                });
+                if !mirrored.is_empty() {
+                    state.selection = mirrored.into_iter().collect();
+                }
             }
         });
     }
