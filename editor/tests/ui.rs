@@ -716,3 +716,51 @@ fn undo(harness: &mut Harness<'static, HairloomApp>, times: usize) {
         harness.run();
     }
 }
+
+#[test]
+fn e_over_the_viewport_extrudes_by_the_dragged_distance() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    click_bundle_in_outliner(&mut harness, 0);
+    let layers = original.hair_mesh.bundles[0].layers;
+    let centre = viewport_rect(&harness).center();
+    harness.hover_at(centre);
+    harness.run();
+    harness.key_press(egui::Key::E);
+    harness.run();
+    let tip = |harness: &Harness<'static, HairloomApp>| {
+        let mesh = &harness.state().state.document().hair_mesh;
+        let column = mesh.bundles[0].vertices[0];
+        *mesh.columns[column as usize]
+            .positions
+            .last()
+            .expect("a tip")
+    };
+    assert_eq!(
+        harness.state().state.document().hair_mesh.bundles[0].layers,
+        layers + 1,
+        "the preview shows the new layer at once"
+    );
+    let first = tip(&harness);
+    harness.hover_at(centre + egui::vec2(0.0, -120.0));
+    harness.run();
+    let dragged = tip(&harness);
+    assert!(
+        first.distance(dragged) > 1e-4,
+        "the pointer changes the distance"
+    );
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original, "Esc cancels");
+
+    harness.key_press(egui::Key::E);
+    harness.run();
+    click_at(&mut harness, centre + egui::vec2(0.0, -60.0));
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+    assert_eq!(
+        harness.state().state.document().hair_mesh.bundles[0].layers,
+        layers + 1
+    );
+    undo(&mut harness, 1);
+    assert_eq!(harness.state().state.document(), &original);
+}

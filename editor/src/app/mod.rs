@@ -286,7 +286,14 @@ impl HairloomApp {
         if !ui.ctx().egui_wants_keyboard_input()
             && ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::E))
         {
-            self.tools.extrude(&mut self.state);
+            // Over the viewport E is interactive (the pointer sets the distance, a click
+            // confirms); elsewhere it extrudes by the Tools panel's distance at once.
+            if self.viewport.is_hovered(ui) {
+                let distance = self.tools.extrude_distance_m;
+                self.viewport.begin_extrude(ui, &mut self.state, distance);
+            } else {
+                self.tools.extrude(&mut self.state);
+            }
         }
     }
 

@@ -12,7 +12,7 @@
 //! alt+A none, ctrl +/- grows / shrinks, Tab switches bundles / vertices.
 //!
 //! Transform (modal, like Blender): G moves, R rotates, S scales the selection following
-//! the pointer; X / Y / Z lock an axis, the wheel changes the soft-selection radius; a click
+//! the pointer, E extrudes the selected bundles with the pointer setting the distance; X / Y / Z lock an axis, the wheel changes the soft-selection radius; a click
 //! or Enter confirms (one undo step), Esc or a right-click cancels. Interior vertices follow
 //! live.
 
@@ -112,6 +112,8 @@ pub enum TransformKind {
     Move,
     Rotate,
     Scale,
+    /// E: the selected bundles grow a layer whose distance follows the pointer.
+    Extrude,
 }
 
 impl TransformKind {
@@ -120,6 +122,7 @@ impl TransformKind {
             Self::Move => "Move",
             Self::Rotate => "Rotate",
             Self::Scale => "Scale",
+            Self::Extrude => "Extrude",
         }
     }
 }
@@ -132,6 +135,11 @@ struct ActiveTransform {
     start_pointer: egui::Pos2,
     vertices: Vec<VertexRef>,
     pivot: DVec3,
+    /// Extrude: the bundles, the direction pointer motion is measured along and the
+    /// distance at the start pointer.
+    bundles: Vec<u32>,
+    direction: DVec3,
+    base_distance_m: f64,
     /// The last pointer position applied (recomputed only when it or the settings change).
     applied: Option<(egui::Pos2, Option<usize>, u64)>,
 }
@@ -958,6 +966,9 @@ impl Viewport {
             start_pointer,
             vertices,
             pivot,
+            bundles: Vec::new(),
+            direction: DVec3::ZERO,
+            base_distance_m: 0.0,
             applied: None,
         });
         state.message = format!(
@@ -966,7 +977,77 @@ impl Viewport {
         );
     }
 
-    /// Follows the pointer during G / R / S; confirms or cancels.
+    /// Whether the pointer is over the viewport (the app routes E here then).
+    pub fn is_hovered(&self, ui: &egui::Ui) -> bool {
+        let pointer = ui.input(|i| i.pointer.hover_pos());
+        self.rect
+            .zip(pointer)
+            .is_some_and(|(rect, pointer)| rect.contains(pointer))
+    }
+
+    /// E over the viewport: extrude the selected bundles by `distance_m` at once, then let
+    /// the pointer change the distance until a click confirms (one undo step) or Esc cancels.
+    pub fn begin_extrude(&mut self, ui: &egui::Ui, state: &mut EditorState, distance_m: f64) {
+        state.commit_edit();
+        let bundles: Vec<u32> = state.selection.iter().copied().collect();
+        let mesh = &state.document().hair_mesh;
+        let mut tips = Vec::new();
+        let mut direction = DVec3::ZERO;
+        for &b in &bundles {
+            let Some(bundle) = mesh.bundles.get(b as usize) else {
+                continue;
+            };
+            let layer_centre = |layer: u32| {
+                let points: Option<Vec<DVec3>> = bundle
+                    .vertices
+                    .iter()
+                    .map(|&c| mesh.position(VertexRef { column: c, layer }))
+                    .collect();
+                points.map(|p| p.iter().sum::<DVec3>() / p.len().max(1) as f64)
+            };
+            let Some(tip) = layer_centre(bundle.layers) else {
+                continue;
+            };
+            tips.push(tip);
+            direction += match bundle.layers {
+                0 => {
+                    let p: Vec<DVec3> = bundle
+                        .vertices
+                        .iter()
+                        .filter_map(|&c| {
+                            mesh.position(VertexRef {
+                                column: c,
+                                layer: 0,
+                            })
+                        })
+                        .collect();
+                    (0..p.len()).fold(DVec3::ZERO, |n, i| n + p[i].cross(p[(i + 1) % p.len()]))
+                }
+                layers => tip - layer_centre(layers - 1).unwrap_or(tip),
+            }
+            .normalize_or_zero();
+        }
+        if tips.is_empty() {
+            state.message = "Extrude: nothing selected".into();
+            return;
+        }
+        let start_pointer = ui
+            .input(|i| i.pointer.hover_pos())
+            .unwrap_or(egui::Pos2::ZERO);
+        self.transform = Some(ActiveTransform {
+            kind: TransformKind::Extrude,
+            axis: None,
+            start_pointer,
+            vertices: Vec::new(),
+            pivot: tips.iter().sum::<DVec3>() / tips.len() as f64,
+            bundles,
+            direction: direction.normalize_or(DVec3::Z),
+            base_distance_m: distance_m,
+            applied: None,
+        });
+    }
+
+    /// Follows the pointer during G / R / S / E; confirms or cancels.
     fn drive_transform(
         &mut self,
         ui: &egui::Ui,
@@ -1010,18 +1091,35 @@ impl Viewport {
         let radius_bits = state.tool.soft_radius_m.to_bits();
         if active.applied != Some((pointer, active.axis, radius_bits)) {
             active.applied = Some((pointer, active.axis, radius_bits));
-            let transform = transform_for(active, pointer, projector);
             let start = state.edit_start().hair_mesh.clone();
-            match edit::transform_vertices(
-                &start,
-                &active.vertices,
-                transform,
-                state.tool.soft_radius_m,
-            ) {
-                Ok(outcome) => {
-                    state.edit(active.kind.label()).hair_mesh = outcome.mesh;
-                    state.message = describe_transform(active.kind, active.axis, transform)
+            let result = if active.kind == TransformKind::Extrude {
+                let moved = projector.unproject(pointer, active.pivot)
+                    - projector.unproject(active.start_pointer, active.pivot);
+                let distance = active.base_distance_m + moved.dot(active.direction);
+                edit::extrude(
+                    &start,
+                    &active.bundles,
+                    edit::ExtrudeDirection::AlongNormal { distance },
+                )
+                .map(|outcome| (outcome, format!("Extrude: {distance:.4} m")))
+            } else {
+                let transform = transform_for(active, pointer, projector);
+                edit::transform_vertices(
+                    &start,
+                    &active.vertices,
+                    transform,
+                    state.tool.soft_radius_m,
+                )
+                .map(|outcome| {
+                    let text = describe_transform(active.kind, active.axis, transform)
                         + &format!(", soft radius {:.3} m", state.tool.soft_radius_m);
+                    (outcome, text)
+                })
+            };
+            match result {
+                Ok((outcome, text)) => {
+                    state.edit(active.kind.label()).hair_mesh = outcome.mesh;
+                    state.message = text;
                 }
                 Err(error) => state.message = format!("{}: {error}", active.kind.label()),
             }
@@ -1119,6 +1217,7 @@ fn transform_for(
                 pivot: active.pivot.to_array(),
             }
         }
+        TransformKind::Extrude => VertexTransform::Translate { offset: [0.0; 3] },
         TransformKind::Scale => {
             let start = active.start_pointer.distance(pivot_screen).max(1.0);
             let factor = (pointer.distance(pivot_screen) / start) as f64;
