@@ -533,6 +533,10 @@ impl HairloomApp {
             ui.menu_button("View", |ui| {
                 let settings = &mut self.viewport.settings;
                 ui.checkbox(&mut settings.wireframe, "Hair-mesh wireframe");
+                ui.checkbox(
+                    &mut settings.frame_glyphs,
+                    "Styling frames (u red, v green, w blue)",
+                );
                 ui.label(
                     egui::RichText::new("Strands, LOD and accuracy: the Strands & accuracy panel")
                         .weak(),

@@ -88,6 +88,8 @@ impl Orbit {
 pub struct ViewSettings {
     /// Overlay the hair mesh: layer faces and columns, interior vertices in a second colour.
     pub wireframe: bool,
+    /// Overlay the styling frame (û red, v̂ green, ŵ blue) at every hair-mesh vertex.
+    pub frame_glyphs: bool,
     pub strands_per_bundle: u32,
     pub precision: Precision,
     pub filtering: Filtering,
@@ -98,6 +100,7 @@ impl Default for ViewSettings {
     fn default() -> Self {
         Self {
             wireframe: false,
+            frame_glyphs: false,
             strands_per_bundle: 32,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -242,6 +245,8 @@ pub struct Viewport {
     /// Per column and layer, whether the vertex is interior, for the document revision it
     /// was computed at (the wireframe marks them; recomputed only when the document changes).
     interior: Option<(u64, Vec<Vec<bool>>)>,
+    /// Styling frames per layer and column for the document revision they were computed at.
+    frames: Option<(u64, Vec<Vec<Option<hairloom_core::frames::Frame>>>)>,
 }
 
 impl Viewport {
@@ -315,6 +320,7 @@ impl Viewport {
             drag_path: Vec::new(),
             camera_bounds: None,
             interior: None,
+            frames: None,
         }
     }
 
@@ -519,6 +525,7 @@ impl Viewport {
         // The overlay does not change the picture: leave it out of what triggers GPU work.
         let settings = ViewSettings {
             wireframe: false,
+            frame_glyphs: false,
             ..self.settings
         };
         let key = (state.revision, settings);
@@ -702,6 +709,51 @@ impl Viewport {
         for &b in &state.selection {
             if let Some(bundle) = mesh.bundles.get(b as usize) {
                 outline(bundle, selected);
+            }
+        }
+        if self.settings.frame_glyphs {
+            if self
+                .frames
+                .as_ref()
+                .is_none_or(|(r, _)| *r != state.revision)
+            {
+                let frames = (0..=mesh.max_layers())
+                    .map(|layer| hairloom_core::frames::layer_frames(mesh, layer))
+                    .collect();
+                self.frames = Some((state.revision, frames));
+            }
+            let length = mesh.size() * 0.012;
+            if let Some((_, frames)) = &self.frames {
+                for (layer, frames) in frames.iter().enumerate() {
+                    for (c, frame) in frames.iter().enumerate() {
+                        let (Some(frame), Some(p)) = (
+                            frame,
+                            mesh.position(VertexRef {
+                                column: c as u32,
+                                layer: layer as u32,
+                            }),
+                        ) else {
+                            continue;
+                        };
+                        let Some(at) = project(p) else { continue };
+                        let alpha = if frame.fallback { 90 } else { 220 };
+                        for (axis, (r, g, b)) in [
+                            (frame.u, (235, 70, 60)),
+                            (frame.v, (90, 200, 90)),
+                            (frame.w, (80, 140, 255)),
+                        ] {
+                            if let Some(tip) = project(p + axis * length) {
+                                painter.line_segment(
+                                    [at, tip],
+                                    egui::Stroke::new(
+                                        1.2,
+                                        egui::Color32::from_rgba_unmultiplied(r, g, b, alpha),
+                                    ),
+                                );
+                            }
+                        }
+                    }
+                }
             }
         }
         let orange = egui::Color32::from_rgb(255, 150, 40);
