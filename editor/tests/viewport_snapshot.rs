@@ -81,6 +81,13 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
         harness.state().viewport.error
     );
     assert!(harness.state().viewport.drawn_strands > 1000);
+    let frame_ms = harness
+        .state()
+        .viewport
+        .frame_ms
+        .expect("the frame was timed");
+    assert!(frame_ms > 0.0 && frame_ms.is_finite());
+    eprintln!("viewport frame (generate + draw, wall): {frame_ms:.1} ms");
 
     // Hair and head cover a good part of the viewport.
     let background = image.get_pixel(2, 2).0;

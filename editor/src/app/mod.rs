@@ -651,6 +651,10 @@ impl HairloomApp {
                 "{} strands, {} vertices drawn",
                 self.viewport.drawn_strands, self.viewport.drawn_vertices
             ));
+            if let Some(ms) = self.viewport.frame_ms {
+                ui.separator();
+                ui.label(format!("GPU generate + draw {ms:.1} ms"));
+            }
             ui.separator();
             ui.label(format!(
                 "fps {:.0}",

@@ -230,6 +230,8 @@ pub struct Viewport {
     /// Strands and vertices of the last frame, after culling and LOD.
     pub drawn_strands: usize,
     pub drawn_vertices: usize,
+    /// Wall time of generating and drawing the last frame on the GPU (submit to idle).
+    pub frame_ms: Option<f64>,
     pub adapter: String,
     pub error: Option<String>,
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
@@ -313,6 +315,7 @@ impl Viewport {
             drawn: None,
             drawn_strands: 0,
             drawn_vertices: 0,
+            frame_ms: None,
             error: None,
             rect: None,
             transform: None,
@@ -575,10 +578,15 @@ impl Viewport {
                     let plan = gpu.preview.plan(&scene, size[0], size[1]);
                     self.drawn_strands = plan.strands;
                     self.drawn_vertices = plan.vertices;
-                    match gpu
-                        .preview
-                        .render_texture(&gpu.context, &scene, &plan, size[0], size[1])
-                    {
+                    let started = std::time::Instant::now();
+                    let rendered =
+                        gpu.preview
+                            .render_texture(&gpu.context, &scene, &plan, size[0], size[1]);
+                    // Wait for the GPU so the status bar can say what generating and drawing
+                    // this frame cost (the viewport only redraws when something changed).
+                    let _ = gpu.context.device.poll(wgpu::PollType::wait_indefinitely());
+                    self.frame_ms = Some(started.elapsed().as_secs_f64() * 1e3);
+                    match rendered {
                         Ok(texture) => {
                             // egui composites gamma-encoded bytes: sample the sRGB image raw.
                             let view = texture.create_view(&wgpu::TextureViewDescriptor {
