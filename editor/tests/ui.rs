@@ -764,3 +764,46 @@ fn e_over_the_viewport_extrudes_by_the_dragged_distance() {
     undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original);
 }
+
+#[test]
+fn dragging_the_gizmo_moves_the_selection_as_one_step() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    click_bundle_in_outliner(&mut harness, 0);
+    harness.run();
+    let centre = harness
+        .state()
+        .viewport
+        .gizmo_centre
+        .expect("the gizmo is shown at the selection");
+    drag(&mut harness, centre, centre + egui::vec2(40.0, 25.0));
+    let moved = harness.state().state.document().clone();
+    assert_ne!(
+        moved.hair_mesh,
+        original.hair_mesh,
+        "{}",
+        harness.state().state.message
+    );
+    assert!(moved.hair_mesh.validate().is_ok());
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+    assert_eq!(
+        harness.state().state.project.history.undo[0].label(),
+        "Move"
+    );
+    assert_eq!(
+        harness.state().state.selection.len(),
+        1,
+        "dragging the gizmo does not box-select"
+    );
+    // The scalp stays where the head is.
+    for (old, new) in original
+        .hair_mesh
+        .columns
+        .iter()
+        .zip(&moved.hair_mesh.columns)
+    {
+        assert_eq!(old.positions[0], new.positions[0]);
+    }
+    undo(&mut harness, 1);
+    assert_eq!(harness.state().state.document(), &original);
+}

@@ -219,3 +219,37 @@ fn a_gpu_error_is_shown_in_the_viewport_instead_of_panicking() {
         .save_as(&path)
         .expect("saving still works");
 }
+
+#[test]
+fn the_gizmo_is_drawn_at_the_selection() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    let before = viewport_image(&mut harness);
+    harness.state_mut().state.selection.insert(0);
+    let after = viewport_image(&mut harness);
+    let centre = harness.state().viewport.gizmo_centre.expect("gizmo shown");
+    let rect = harness.state().viewport.rect.expect("viewport");
+    let scale = harness.ctx.pixels_per_point();
+    after
+        .save(root().join("target/editor-gizmo.png"))
+        .expect("write picture");
+    // Pixels within the gizmo's reach of its centre changed (handles and outline drawn).
+    let reach = 90.0 * scale;
+    let (cx, cy) = (
+        (centre.x - rect.left()) * scale,
+        (centre.y - rect.top()) * scale,
+    );
+    let changed = before
+        .enumerate_pixels()
+        .zip(after.pixels())
+        .filter(|((x, y, a), b)| {
+            (*x as f32 - cx).hypot(*y as f32 - cy) < reach
+                && a.0.iter().zip(b.0).any(|(p, q)| p.abs_diff(q) > 40)
+        })
+        .count();
+    assert!(
+        changed > 300,
+        "only {changed} pixels changed near the gizmo"
+    );
+}

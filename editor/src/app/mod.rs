@@ -3,6 +3,7 @@
 //! the model; panels follow the egui demo pattern `fn ui(&mut self, ui, state)`.
 
 pub mod files;
+pub mod gizmo;
 pub mod history_panel;
 pub mod layout_panel;
 pub mod outliner_panel;
@@ -533,6 +534,7 @@ impl HairloomApp {
             ui.menu_button("View", |ui| {
                 let settings = &mut self.viewport.settings;
                 ui.checkbox(&mut settings.wireframe, "Hair-mesh wireframe");
+                ui.checkbox(&mut settings.gizmo, "Transform gizmo");
                 ui.checkbox(
                     &mut settings.frame_glyphs,
                     "Styling frames (u red, v green, w blue)",

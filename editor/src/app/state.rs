@@ -49,6 +49,8 @@ pub struct ToolSettings {
     pub paint_radius_px: f32,
     /// Soft-selection radius for move / rotate / scale (0 = off).
     pub soft_radius_m: f64,
+    /// The on-screen gizmo's handles.
+    pub gizmo: super::gizmo::GizmoKind,
 }
 
 impl Default for ToolSettings {
@@ -58,6 +60,7 @@ impl Default for ToolSettings {
             drag: DragTool::Box,
             paint_radius_px: 24.0,
             soft_radius_m: 0.0,
+            gizmo: super::gizmo::GizmoKind::Move,
         }
     }
 }

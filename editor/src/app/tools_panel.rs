@@ -3,6 +3,7 @@
 
 use hairloom_core::edit::{self, ExtrudeDirection};
 
+use super::gizmo::GizmoKind;
 use super::state::{DragTool, EditorState, SelectMode};
 
 pub struct ToolsPanel {
@@ -71,6 +72,12 @@ impl ToolsPanel {
         ));
         ui.separator();
         ui.heading("Transform");
+        ui.horizontal(|ui| {
+            ui.label("Gizmo:");
+            for kind in [GizmoKind::Move, GizmoKind::Rotate, GizmoKind::Scale] {
+                ui.selectable_value(&mut state.tool.gizmo, kind, kind.label());
+            }
+        });
         ui.horizontal(|ui| {
             let label = ui.label("Soft radius");
             ui.add(

@@ -29,6 +29,7 @@ use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
 use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
 
+use super::gizmo::{GizmoAdapter, GizmoStep};
 use super::state::{DragTool, EditorState, SelectMode};
 use crate::render::{AccuracyRow, RenderableHair, default_scene, measure_accuracy};
 
@@ -90,6 +91,8 @@ pub struct ViewSettings {
     pub wireframe: bool,
     /// Overlay the styling frame (û red, v̂ green, ŵ blue) at every hair-mesh vertex.
     pub frame_glyphs: bool,
+    /// Show the move / rotate / scale gizmo at the selection.
+    pub gizmo: bool,
     pub strands_per_bundle: u32,
     pub precision: Precision,
     pub filtering: Filtering,
@@ -101,6 +104,7 @@ impl Default for ViewSettings {
         Self {
             wireframe: false,
             frame_glyphs: false,
+            gizmo: true,
             strands_per_bundle: 32,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -150,6 +154,7 @@ struct ActiveTransform {
 /// The camera of the last frame: what screen point a model point lands on, and back.
 #[derive(Clone, Copy)]
 struct Projector {
+    view: glam::Mat4,
     view_projection: glam::Mat4,
     rect: egui::Rect,
 }
@@ -237,6 +242,14 @@ pub struct Viewport {
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
     pub rect: Option<egui::Rect>,
     transform: Option<ActiveTransform>,
+    /// The on-screen gizmo, at the selection when there is one.
+    gizmo: GizmoAdapter,
+    /// Whether the gizmo was shown last frame (its handles are drawn then).
+    gizmo_shown: bool,
+    /// Where the gizmo's centre was drawn last (tests drag it).
+    pub gizmo_centre: Option<egui::Pos2>,
+    /// The vertices the running gizmo drag moves (fixed when it began).
+    gizmo_vertices: Vec<VertexRef>,
     /// The last accuracy measurement: the document revision it was made at, and the rows
     /// (or why it failed).
     pub accuracy: Option<(u64, Result<Vec<AccuracyRow>, String>)>,
@@ -319,6 +332,10 @@ impl Viewport {
             error: None,
             rect: None,
             transform: None,
+            gizmo: GizmoAdapter::default(),
+            gizmo_shown: false,
+            gizmo_vertices: Vec::new(),
+            gizmo_centre: None,
             accuracy: None,
             drag_path: Vec::new(),
             camera_bounds: None,
@@ -336,7 +353,9 @@ impl Viewport {
                 self.drive_transform(ui, state, &response, projector);
             } else {
                 self.navigate(ui, &response);
-                self.select(ui, state, &response, projector);
+                if !self.drive_gizmo(ui, state, &response, projector) {
+                    self.select(ui, state, &response, projector);
+                }
                 self.keys(ui, state, &response);
             }
         }
@@ -494,6 +513,7 @@ impl Viewport {
         })?;
         let camera = self.orbit.camera(lo, hi);
         Some(Projector {
+            view: glam::Mat4::look_at_rh(camera.eye, camera.target, camera.up),
             view_projection: camera.view_projection(rect.width() / rect.height().max(1.0)),
             rect,
         })
@@ -529,6 +549,7 @@ impl Viewport {
         let settings = ViewSettings {
             wireframe: false,
             frame_glyphs: false,
+            gizmo: false,
             ..self.settings
         };
         let key = (state.revision, settings);
@@ -763,6 +784,9 @@ impl Viewport {
                     }
                 }
             }
+        }
+        if self.gizmo_shown && self.transform.is_none() {
+            self.gizmo.paint(&painter);
         }
         let orange = egui::Color32::from_rgb(255, 150, 40);
         for v in &state.vertex_selection {
@@ -1035,6 +1059,78 @@ impl Viewport {
             "{}: move the pointer; click confirms, Esc cancels",
             kind.label()
         );
+    }
+
+    /// The gizmo at the selection's centre; `true` when it has the pointer (a click or drag
+    /// there moves the selection instead of selecting). A drag is one undo step.
+    fn drive_gizmo(
+        &mut self,
+        ui: &egui::Ui,
+        state: &mut EditorState,
+        response: &egui::Response,
+        projector: Projector,
+    ) -> bool {
+        self.gizmo_shown = false;
+        self.gizmo_centre = None;
+        if !self.settings.gizmo || ui.input(|i| i.modifiers.alt) {
+            return false;
+        }
+        let vertices = if self.gizmo.is_dragging() {
+            self.gizmo_vertices.clone()
+        } else {
+            state.transform_targets()
+        };
+        let start = state.edit_start().hair_mesh.clone();
+        let positions: Vec<DVec3> = vertices.iter().filter_map(|v| start.position(*v)).collect();
+        if positions.is_empty() {
+            return false;
+        }
+        self.gizmo_shown = true;
+        let pivot = positions.iter().sum::<DVec3>() / positions.len() as f64;
+        self.gizmo_centre = projector.project(pivot);
+        let projection = projector.view_projection * projector.view.inverse();
+        let step = self.gizmo.update(
+            state.tool.gizmo,
+            ui,
+            response,
+            projector.rect,
+            projector.view,
+            projection,
+            pivot,
+        );
+        match step {
+            GizmoStep::Dragging(transform) => {
+                if self.gizmo_vertices.is_empty() {
+                    state.commit_edit();
+                    self.gizmo_vertices = vertices.clone();
+                }
+                let start = state.edit_start().hair_mesh.clone();
+                match edit::transform_vertices(
+                    &start,
+                    &self.gizmo_vertices,
+                    transform,
+                    state.tool.soft_radius_m,
+                ) {
+                    Ok(outcome) => {
+                        let kind = match transform {
+                            VertexTransform::Translate { .. } => TransformKind::Move,
+                            VertexTransform::Rotate { .. } => TransformKind::Rotate,
+                            VertexTransform::Scale { .. } => TransformKind::Scale,
+                        };
+                        state.edit(kind.label()).hair_mesh = outcome.mesh;
+                        state.message = describe_transform(kind, None, transform);
+                    }
+                    Err(error) => state.message = format!("gizmo: {error}"),
+                }
+                true
+            }
+            GizmoStep::Released => {
+                state.commit_edit();
+                self.gizmo_vertices.clear();
+                true
+            }
+            GizmoStep::Idle => self.gizmo.is_hovered(ui.input(|i| i.pointer.hover_pos())),
+        }
     }
 
     /// Whether the pointer is over the viewport (the app routes E here then).
