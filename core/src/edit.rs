@@ -653,7 +653,7 @@ pub fn set_corner_uvs(
 }
 
 /// The centre of a bundle's corners at `layer`.
-fn bundle_layer_centre(mesh: &HairMesh, bundle: &Bundle, layer: usize) -> Option<DVec3> {
+pub fn bundle_layer_centre(mesh: &HairMesh, bundle: &Bundle, layer: usize) -> Option<DVec3> {
     let points: Option<Vec<DVec3>> = bundle
         .vertices
         .iter()
@@ -680,6 +680,17 @@ fn root_frame(mesh: &HairMesh, bundle: &Bundle) -> Option<[DVec3; 3]> {
         .reject_from_normalized(normal)
         .try_normalize()?;
     Some([edge, normal.cross(edge), normal])
+}
+
+/// The unit direction a bundle grows in at its top: from the centre of the layer below to
+/// the top centre, or the root face's normal for a bare bundle.
+pub fn growth_direction(mesh: &HairMesh, bundle: &Bundle) -> Option<DVec3> {
+    match bundle.layers as usize {
+        0 => root_frame(mesh, bundle).map(|[_, _, normal]| normal),
+        top => (bundle_layer_centre(mesh, bundle, top)?
+            - bundle_layer_centre(mesh, bundle, top - 1)?)
+        .try_normalize(),
+    }
 }
 
 /// The path of a bundle's centre above its root, layer by layer (`offsets[k-1]` is layer k).

@@ -175,12 +175,19 @@ impl Projector {
         self.project(p).map(|q| [q.x as f64, q.y as f64])
     }
 
+    /// Normalised device x, y of screen position `at`.
+    fn ndc_xy(&self, at: egui::Pos2) -> (f32, f32) {
+        (
+            (at.x - self.rect.left()) / self.rect.width().max(1.0) * 2.0 - 1.0,
+            1.0 - (at.y - self.rect.top()) / self.rect.height().max(1.0) * 2.0,
+        )
+    }
+
     /// The model point at screen position `at`, at the depth (NDC z) of `depth_of`.
     fn unproject(&self, at: egui::Pos2, depth_of: DVec3) -> DVec3 {
         let clip = self.view_projection * depth_of.as_vec3().extend(1.0);
         let z = clip.z / clip.w.max(1e-6);
-        let x = (at.x - self.rect.left()) / self.rect.width().max(1.0) * 2.0 - 1.0;
-        let y = 1.0 - (at.y - self.rect.top()) / self.rect.height().max(1.0) * 2.0;
+        let (x, y) = self.ndc_xy(at);
         self.view_projection
             .inverse()
             .project_point3(Vec3::new(x, y, z))
@@ -190,8 +197,7 @@ impl Projector {
     /// The ray under screen position `at`: origin and direction.
     fn ray(&self, at: egui::Pos2) -> (DVec3, DVec3) {
         let inverse = self.view_projection.inverse();
-        let x = (at.x - self.rect.left()) / self.rect.width().max(1.0) * 2.0 - 1.0;
-        let y = 1.0 - (at.y - self.rect.top()) / self.rect.height().max(1.0) * 2.0;
+        let (x, y) = self.ndc_xy(at);
         let near = inverse.project_point3(Vec3::new(x, y, 0.0)).as_dvec3();
         let far = inverse.project_point3(Vec3::new(x, y, 1.0)).as_dvec3();
         (near, far - near)
@@ -248,8 +254,11 @@ pub struct Viewport {
     gizmo_shown: bool,
     /// Where the gizmo's centre was drawn last (tests drag it).
     pub gizmo_centre: Option<egui::Pos2>,
-    /// The vertices the running gizmo drag moves (fixed when it began).
-    gizmo_vertices: Vec<VertexRef>,
+    /// The vertices a running gizmo drag moves and its pivot (fixed when it began).
+    gizmo_drag: Option<(Vec<VertexRef>, Option<DVec3>)>,
+    /// What the selection transforms and its centre, for the selection key it was computed
+    /// at (the gizmo asks every frame; topology is rebuilt only when the key changes).
+    targets_cache: Option<(TargetsKey, Vec<VertexRef>, Option<DVec3>)>,
     /// The last accuracy measurement: the document revision it was made at, and the rows
     /// (or why it failed).
     pub accuracy: Option<(u64, Result<Vec<AccuracyRow>, String>)>,
@@ -334,7 +343,8 @@ impl Viewport {
             transform: None,
             gizmo: GizmoAdapter::default(),
             gizmo_shown: false,
-            gizmo_vertices: Vec::new(),
+            gizmo_drag: None,
+            targets_cache: None,
             gizmo_centre: None,
             accuracy: None,
             drag_path: Vec::new(),
@@ -917,35 +927,16 @@ impl Viewport {
             };
             let project = |p| projector.project_xy(p);
             let replace = !modifiers.shift && !modifiers.command;
+            let remove = modifiers.command;
             let count = match state.tool.mode {
                 SelectMode::Bundles => {
                     let hits = select::bundles_in_region(mesh, project, &region);
-                    if replace {
-                        state.selection.clear();
-                    }
-                    for b in &hits {
-                        if modifiers.command {
-                            state.selection.remove(b);
-                        } else {
-                            state.selection.insert(*b);
-                        }
-                    }
-                    hits.len()
+                    apply_hits(&mut state.selection, &hits, replace, remove)
                 }
                 SelectMode::Vertices => {
                     let topology = Topology::build(mesh);
                     let hits = select::vertices_in_region(mesh, &topology, project, &region);
-                    if replace {
-                        state.vertex_selection.clear();
-                    }
-                    for v in &hits {
-                        if modifiers.command {
-                            state.vertex_selection.remove(v);
-                        } else {
-                            state.vertex_selection.insert(*v);
-                        }
-                    }
-                    hits.len()
+                    apply_hits(&mut state.vertex_selection, &hits, replace, remove)
                 }
             };
             state.message = format!("{count} in the region");
@@ -1030,17 +1021,14 @@ impl Viewport {
 
     fn begin_transform(&mut self, ui: &egui::Ui, state: &mut EditorState, kind: TransformKind) {
         state.commit_edit();
-        let vertices = state.transform_targets();
-        let mesh = &state.document().hair_mesh;
-        let positions: Vec<DVec3> = vertices.iter().filter_map(|v| mesh.position(*v)).collect();
-        if positions.is_empty() {
+        let (vertices, pivot) = self.selection_targets(state);
+        let Some(pivot) = pivot else {
             state.message = format!(
                 "{}: nothing selected (interior vertices place themselves)",
                 kind.label()
             );
             return;
-        }
-        let pivot = positions.iter().sum::<DVec3>() / positions.len() as f64;
+        };
         let start_pointer = ui
             .input(|i| i.pointer.hover_pos())
             .unwrap_or(egui::Pos2::ZERO);
@@ -1075,18 +1063,16 @@ impl Viewport {
         if !self.settings.gizmo || ui.input(|i| i.modifiers.alt) {
             return false;
         }
-        let vertices = if self.gizmo.is_dragging() {
-            self.gizmo_vertices.clone()
-        } else {
-            state.transform_targets()
+        // The targets are fixed while a drag runs (the document changes under it);
+        // otherwise they follow the selection, recomputed only when it or the document changes.
+        let (vertices, pivot) = match &self.gizmo_drag {
+            Some(drag) => drag.clone(),
+            None => self.selection_targets(state),
         };
-        let start = state.edit_start().hair_mesh.clone();
-        let positions: Vec<DVec3> = vertices.iter().filter_map(|v| start.position(*v)).collect();
-        if positions.is_empty() {
+        let Some(pivot) = pivot else {
             return false;
-        }
+        };
         self.gizmo_shown = true;
-        let pivot = positions.iter().sum::<DVec3>() / positions.len() as f64;
         self.gizmo_centre = projector.project(pivot);
         let projection = projector.view_projection * projector.view.inverse();
         let step = self.gizmo.update(
@@ -1100,37 +1086,48 @@ impl Viewport {
         );
         match step {
             GizmoStep::Dragging(transform) => {
-                if self.gizmo_vertices.is_empty() {
+                if self.gizmo_drag.is_none() {
                     state.commit_edit();
-                    self.gizmo_vertices = vertices.clone();
+                    self.gizmo_drag = Some((vertices.clone(), Some(pivot)));
                 }
-                let start = state.edit_start().hair_mesh.clone();
-                match edit::transform_vertices(
-                    &start,
-                    &self.gizmo_vertices,
-                    transform,
-                    state.tool.soft_radius_m,
-                ) {
-                    Ok(outcome) => {
-                        let kind = match transform {
-                            VertexTransform::Translate { .. } => TransformKind::Move,
-                            VertexTransform::Rotate { .. } => TransformKind::Rotate,
-                            VertexTransform::Scale { .. } => TransformKind::Scale,
-                        };
-                        state.edit(kind.label()).hair_mesh = outcome.mesh;
-                        state.message = describe_transform(kind, None, transform);
-                    }
-                    Err(error) => state.message = format!("gizmo: {error}"),
-                }
+                let kind = match transform {
+                    VertexTransform::Translate { .. } => TransformKind::Move,
+                    VertexTransform::Rotate { .. } => TransformKind::Rotate,
+                    VertexTransform::Scale { .. } => TransformKind::Scale,
+                };
+                preview_transform(state, kind, None, &vertices, transform);
                 true
             }
             GizmoStep::Released => {
                 state.commit_edit();
-                self.gizmo_vertices.clear();
+                self.gizmo_drag = None;
                 true
             }
             GizmoStep::Idle => self.gizmo.is_hovered(ui.input(|i| i.pointer.hover_pos())),
         }
+    }
+
+    /// The selection's transform targets and their centre, cached per selection key.
+    fn selection_targets(&mut self, state: &EditorState) -> (Vec<VertexRef>, Option<DVec3>) {
+        let key = TargetsKey {
+            revision: state.revision,
+            mode: state.tool.mode,
+            bundles: state.selection.clone(),
+            vertices: state.vertex_selection.clone(),
+        };
+        if self
+            .targets_cache
+            .as_ref()
+            .is_none_or(|(k, _, _)| *k != key)
+        {
+            let targets = state.transform_targets();
+            let pivot = centre_of(&state.document().hair_mesh, &targets);
+            self.targets_cache = Some((key, targets, pivot));
+        }
+        self.targets_cache
+            .as_ref()
+            .map(|(_, targets, pivot)| (targets.clone(), *pivot))
+            .unwrap_or_default()
     }
 
     /// Whether the pointer is over the viewport (the app routes E here then).
@@ -1149,39 +1146,11 @@ impl Viewport {
         let mesh = &state.document().hair_mesh;
         let mut tips = Vec::new();
         let mut direction = DVec3::ZERO;
-        for &b in &bundles {
-            let Some(bundle) = mesh.bundles.get(b as usize) else {
-                continue;
-            };
-            let layer_centre = |layer: u32| {
-                let points: Option<Vec<DVec3>> = bundle
-                    .vertices
-                    .iter()
-                    .map(|&c| mesh.position(VertexRef { column: c, layer }))
-                    .collect();
-                points.map(|p| p.iter().sum::<DVec3>() / p.len().max(1) as f64)
-            };
-            let Some(tip) = layer_centre(bundle.layers) else {
-                continue;
-            };
-            tips.push(tip);
-            direction += match bundle.layers {
-                0 => {
-                    let p: Vec<DVec3> = bundle
-                        .vertices
-                        .iter()
-                        .filter_map(|&c| {
-                            mesh.position(VertexRef {
-                                column: c,
-                                layer: 0,
-                            })
-                        })
-                        .collect();
-                    (0..p.len()).fold(DVec3::ZERO, |n, i| n + p[i].cross(p[(i + 1) % p.len()]))
-                }
-                layers => tip - layer_centre(layers - 1).unwrap_or(tip),
+        for bundle in bundles.iter().filter_map(|&b| mesh.bundles.get(b as usize)) {
+            if let Some(tip) = edit::bundle_layer_centre(mesh, bundle, bundle.layers as usize) {
+                tips.push(tip);
+                direction += edit::growth_direction(mesh, bundle).unwrap_or(DVec3::ZERO);
             }
-            .normalize_or_zero();
         }
         if tips.is_empty() {
             state.message = "Extrude: nothing selected".into();
@@ -1247,37 +1216,25 @@ impl Viewport {
         let radius_bits = state.tool.soft_radius_m.to_bits();
         if active.applied != Some((pointer, active.axis, radius_bits)) {
             active.applied = Some((pointer, active.axis, radius_bits));
-            let start = state.edit_start().hair_mesh.clone();
-            let result = if active.kind == TransformKind::Extrude {
+            if active.kind == TransformKind::Extrude {
                 let moved = projector.unproject(pointer, active.pivot)
                     - projector.unproject(active.start_pointer, active.pivot);
                 let distance = active.base_distance_m + moved.dot(active.direction);
-                edit::extrude(
-                    &start,
+                let extruded = edit::extrude(
+                    &state.edit_start().hair_mesh,
                     &active.bundles,
                     edit::ExtrudeDirection::AlongNormal { distance },
-                )
-                .map(|outcome| (outcome, format!("Extrude: {distance:.4} m")))
+                );
+                match extruded {
+                    Ok(outcome) => {
+                        state.edit(active.kind.label()).hair_mesh = outcome.mesh;
+                        state.message = format!("Extrude: {distance:.4} m");
+                    }
+                    Err(error) => state.message = format!("Extrude: {error}"),
+                }
             } else {
                 let transform = transform_for(active, pointer, projector);
-                edit::transform_vertices(
-                    &start,
-                    &active.vertices,
-                    transform,
-                    state.tool.soft_radius_m,
-                )
-                .map(|outcome| {
-                    let text = describe_transform(active.kind, active.axis, transform)
-                        + &format!(", soft radius {:.3} m", state.tool.soft_radius_m);
-                    (outcome, text)
-                })
-            };
-            match result {
-                Ok((outcome, text)) => {
-                    state.edit(active.kind.label()).hair_mesh = outcome.mesh;
-                    state.message = text;
-                }
-                Err(error) => state.message = format!("{}: {error}", active.kind.label()),
+                preview_transform(state, active.kind, active.axis, &active.vertices, transform);
             }
         }
         let confirm =
@@ -1326,6 +1283,67 @@ impl Viewport {
             });
         }
     }
+}
+
+/// What the selection's transform targets depend on.
+#[derive(Clone, PartialEq)]
+struct TargetsKey {
+    revision: u64,
+    mode: SelectMode,
+    bundles: std::collections::BTreeSet<u32>,
+    vertices: std::collections::BTreeSet<VertexRef>,
+}
+
+/// The mean position of `vertices` (`None` when none exists).
+fn centre_of(mesh: &hairloom_core::HairMesh, vertices: &[VertexRef]) -> Option<DVec3> {
+    let positions: Vec<DVec3> = vertices.iter().filter_map(|v| mesh.position(*v)).collect();
+    (!positions.is_empty()).then(|| positions.iter().sum::<DVec3>() / positions.len() as f64)
+}
+
+/// Previews `transform` of `vertices` from the document as the running edit began (soft
+/// selection and interior placement included) and says what it did in the status bar.
+fn preview_transform(
+    state: &mut EditorState,
+    kind: TransformKind,
+    axis: Option<usize>,
+    vertices: &[VertexRef],
+    transform: VertexTransform,
+) {
+    let moved = edit::transform_vertices(
+        &state.edit_start().hair_mesh,
+        vertices,
+        transform,
+        state.tool.soft_radius_m,
+    );
+    match moved {
+        Ok(outcome) => {
+            state.edit(kind.label()).hair_mesh = outcome.mesh;
+            state.message = describe_transform(kind, axis, transform)
+                + &format!(", soft radius {:.3} m", state.tool.soft_radius_m);
+        }
+        Err(error) => state.message = format!("{}: {error}", kind.label()),
+    }
+}
+
+/// Applies region hits to a selection: replace it, add to it, or (`remove`) take them out.
+/// Returns how many were hit.
+fn apply_hits<T: Ord + Copy>(
+    selection: &mut std::collections::BTreeSet<T>,
+    hits: &[T],
+    replace: bool,
+    remove: bool,
+) -> usize {
+    if replace {
+        selection.clear();
+    }
+    for hit in hits {
+        if remove {
+            selection.remove(hit);
+        } else {
+            selection.insert(*hit);
+        }
+    }
+    hits.len()
 }
 
 /// Pick distance for vertices, in points.
