@@ -18,7 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ));
     for (name, project) in projects {
         let path = out.join(format!("{name}.hairloom"));
-        hairloom_core::project::save(&path, &project)?;
+        hairloom_core::io::project::save(&path, &project)?;
         let stats = project.document.hair_mesh.stats();
         println!(
             "{}: {} bundles ({} quads, {} triangles), {} vertices ({} interior), {} layers, {} KiB",

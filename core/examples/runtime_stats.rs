@@ -1,6 +1,6 @@
 //! Prints runtime-texture sizes of each sample: atlas, texture dimensions, bytes per
 //! hair-mesh vertex. `cargo run --release -p hairloom-core --example runtime_stats`
-use hairloom_core::runtime::{Precision, RuntimeTextures};
+use hairloom_core::runtime::textures::{Precision, RuntimeTextures};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
@@ -9,7 +9,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     for entry in std::fs::read_dir("assets/samples")? {
         let path = entry?.path();
-        let project = hairloom_core::project::load(&path)?;
+        let project = hairloom_core::io::project::load(&path)?;
         let mesh = &project.document.hair_mesh;
         let full = RuntimeTextures::build(mesh, Precision::F32);
         let half = RuntimeTextures::build(mesh, Precision::F16);

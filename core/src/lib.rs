@@ -1,35 +1,29 @@
 //! Hairloom core: the hair-mesh document and everything computed from it on the CPU.
 //!
-//! Data flows one way: [`document::Document`] (edited only through [`edit`] functions
-//! recorded as [`history::Command`]s) → derived geometry ([`interior`], [`frames`],
-//! [`curve`]) → runtime data. This crate has no GPU or UI dependency; the f64 code here is
-//! the reference every faster path is measured against.
+//! The folders follow the pipeline, and data flows one way through them:
+//!
+//! | folder | stage |
+//! |---|---|
+//! | [`model`] | the document (hair mesh, body, styling parameters) and its undo history |
+//! | [`edit`] | edits as pure functions (topology, transforms, coordinates, wisps), selection and picking |
+//! | [`geometry`] | derived f64 geometry: interior vertices, styling frames, column curves, uv |
+//! | [`strands`] | root samples, random numbers, styling ops, LOD formulas, the f64 reference strands |
+//! | [`runtime`] | the runtime asset ([`runtime::hair::RuntimeHair`]: textures, samples, placements, styling) and the CPU mirror of every shader |
+//! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) and strand exports |
+//! | [`samples`] | the bundled sample projects, built by code |
+//!
+//! This crate has no GPU or UI dependency; the f64 code here is the reference every faster
+//! path is measured against.
 
-pub mod atlas;
-pub mod curve;
-pub mod document;
 pub mod edit;
-pub mod export;
-pub mod frames;
-pub mod gpu_types;
-pub mod history;
-pub mod import;
-pub mod interior;
-pub mod lod;
-pub mod mesh;
-pub mod pick;
-pub mod project;
-pub mod random;
-pub mod roots;
+pub mod geometry;
+pub mod io;
+pub mod model;
 pub mod runtime;
 pub mod samples;
-pub mod select;
 pub mod strands;
-pub mod styling;
-pub mod teapot;
-pub mod uv;
 
-pub use document::{BodyMesh, Document};
-pub use history::{Command, History, Transaction};
-pub use mesh::{Bundle, Column, HairMesh, Topology, VertexRef, WMode};
-pub use project::Project;
+pub use io::project::Project;
+pub use model::document::{BodyMesh, Document};
+pub use model::history::{Command, History, Transaction};
+pub use model::mesh::{Bundle, Column, HairMesh, Topology, VertexRef, WMode};

@@ -11,11 +11,12 @@ use std::time::Instant;
 
 use anyhow::Context;
 use glam::{DVec2, DVec3};
-use hairloom_core::atlas::Atlas;
-use hairloom_core::curve::{CurveDefinition, ReferenceStrand, SegmentForm};
-use hairloom_core::roots::{SampleDomain, progressive_samples};
-use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures, TexturePath};
-use hairloom_core::strands::{StrandOptions, generate, generate_parallel};
+use hairloom_core::geometry::curve::{CurveDefinition, ReferenceStrand, SegmentForm};
+use hairloom_core::runtime::atlas::Atlas;
+use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
+use hairloom_core::runtime::textures::{Precision, RuntimeTextures};
+use hairloom_core::strands::reference::{StrandOptions, generate, generate_parallel};
+use hairloom_core::strands::roots::{SampleDomain, progressive_samples};
 
 /// Vertices per strand used for the curve switches.
 const CURVE_VERTICES: usize = 33;
@@ -26,7 +27,7 @@ fn default_project() -> PathBuf {
 
 fn load(project: Option<PathBuf>) -> anyhow::Result<(PathBuf, hairloom_core::Project)> {
     let path = project.unwrap_or_else(default_project);
-    let loaded = hairloom_core::project::load(&path)
+    let loaded = hairloom_core::io::project::load(&path)
         .with_context(|| "the accuracy benchmark needs a project (--project FILE)")?;
     Ok((path, loaded))
 }
@@ -168,7 +169,7 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
             Filtering::Hardware8Bit,
         ),
     ] {
-        let path = TexturePath {
+        let path = StrandGen {
             textures,
             filtering,
         };

@@ -6,7 +6,7 @@ use std::time::Instant;
 use clap::Subcommand;
 use glam::DVec3;
 use hairloom_core::edit::{ExtrudeDirection, VertexTransform, extrude, transform_vertices};
-use hairloom_core::interior::place_interior;
+use hairloom_core::geometry::interior::place_interior;
 use hairloom_core::{HairMesh, Topology, VertexRef};
 
 #[derive(Subcommand)]
@@ -79,8 +79,8 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             let precisions = textures
                 .iter()
                 .map(|t| match t.as_str() {
-                    "f16" => Ok(hairloom_core::runtime::Precision::F16),
-                    "f32" => Ok(hairloom_core::runtime::Precision::F32),
+                    "f16" => Ok(hairloom_core::runtime::textures::Precision::F16),
+                    "f32" => Ok(hairloom_core::runtime::textures::Precision::F32),
                     other => Err(anyhow::anyhow!(
                         "--textures takes f16 and f32, not {other:?}"
                     )),
@@ -222,11 +222,11 @@ fn gpu(
     vertices_log2: u32,
     counts: &[usize],
     size: &str,
-    precisions: &[hairloom_core::runtime::Precision],
+    precisions: &[hairloom_core::runtime::textures::Precision],
     runs: usize,
 ) -> anyhow::Result<()> {
-    use hairloom_core::lod::LodSettings;
-    use hairloom_core::runtime::Filtering;
+    use hairloom_core::runtime::frame_plan::LodSettings;
+    use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
     use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
@@ -235,7 +235,7 @@ fn gpu(
             .join("../assets/samples/head_long_wavy.hairloom")
     });
     let (width, height) = hairloom_editor::render::parse_size(size)?;
-    let document = hairloom_core::project::load(&path)?.document;
+    let document = hairloom_core::io::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
     let generator = StrandGenRenderer::new(&context);
     let preview = PreviewRenderer::new(&context);
@@ -266,8 +266,14 @@ fn gpu(
         "mem ratio"
     );
     for &precision in precisions {
-        let mut renderable =
-            hairloom_editor::render::RenderableHair::from_document(&document, precision, 1);
+        let mut renderable = hairloom_core::runtime::hair::RuntimeHair::from_document(
+            &document,
+            &hairloom_core::runtime::hair::RuntimeOptions {
+                precision,
+                strands_per_bundle: 1,
+                ..Default::default()
+            },
+        );
         let bundles = renderable.textures.atlas.blocks.len().max(1);
         let (lo, hi) = renderable
             .textures
@@ -282,8 +288,8 @@ fn gpu(
             ..near
         };
         for &target in counts {
-            renderable.set_strands_per_bundle(target.div_ceil(bundles) as u32);
-            let hair = renderable.upload(&context, &generator);
+            renderable.set_strands_per_bundle(target.div_ceil(bundles) as u32)?;
+            let hair = generator.upload(&context, &renderable);
             let full = full_detail_plan(hair.root_count, vertex_count);
             let stored_bytes = full.vertices as u64 * 16;
             let hair_mb = hair.bytes as f64 / 1e6;

@@ -8,13 +8,13 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use hairloom_core::Document;
-use hairloom_core::export::{
-    RuntimeExportOptions, glb_lines, hair_file, runtime_bundle, usda_file,
-};
-use hairloom_core::import::{ImportOptions, import_file};
-use hairloom_core::project::write_atomic;
-use hairloom_core::runtime::Precision;
-use hairloom_core::strands::{Strand, StrandContext, StrandOptions, StrandPlan};
+use hairloom_core::io::import::{ImportOptions, import_file};
+use hairloom_core::io::project::write_atomic;
+use hairloom_core::io::runtime_bundle::runtime_bundle;
+use hairloom_core::io::strand_files::{glb_lines, hair_file, usda_file};
+use hairloom_core::runtime::hair::RuntimeOptions;
+use hairloom_core::runtime::textures::Precision;
+use hairloom_core::strands::reference::{Strand, StrandContext, StrandOptions, StrandPlan};
 
 /// Strand width written to the strand files (80 µm, a typical human hair).
 const STRAND_WIDTH_M: f32 = 8e-5;
@@ -38,7 +38,7 @@ pub fn scalp_document(
     let imported = import_file(scalp, options)?;
     let mut hair_mesh = imported.to_hair_mesh(|_| true);
     if generate_uv || !imported.has_uv {
-        hairloom_core::uv::generate_uv(&mut hair_mesh, None);
+        hairloom_core::geometry::uv::generate_uv(&mut hair_mesh, None);
     }
     let name = scalp
         .file_stem()
@@ -75,10 +75,10 @@ pub fn write_runtime_bundle(
     strands_per_bundle: u32,
 ) -> anyhow::Result<String> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let options = RuntimeExportOptions {
+    let options = RuntimeOptions {
         precision,
         strands_per_bundle,
-        ..RuntimeExportOptions::default()
+        ..RuntimeOptions::default()
     };
     let files = runtime_bundle(document, &options)
         .with_context(|| format!("exporting {}", document.name))?;
@@ -172,7 +172,7 @@ pub fn run(
     for file in strand_files {
         check_strand_file(file)?;
     }
-    let project = hairloom_core::project::load(project_path)?;
+    let project = hairloom_core::io::project::load(project_path)?;
     let document = &project.document;
     if let Some(dir) = runtime {
         let summary = write_runtime_bundle(document, dir, precision, strands_per_bundle)

@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use hairloom_core::project;
-use hairloom_core::runtime::{Filtering, Precision};
+use hairloom_core::io::project;
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::textures::Precision;
 
 mod accuracy;
 mod bench;
@@ -105,13 +106,13 @@ enum Command {
         #[arg(long)]
         no_lod: bool,
         /// Strand LOD α (eq. 7): larger keeps more strands at a distance.
-        #[arg(long, default_value_t = hairloom_core::lod::DEFAULT_ALPHA_STRANDS)]
+        #[arg(long, default_value_t = hairloom_core::runtime::frame_plan::DEFAULT_ALPHA_STRANDS)]
         alpha_strands: f64,
         /// Vertex LOD α (eq. 7): larger keeps more vertices at a distance.
-        #[arg(long, default_value_t = hairloom_core::lod::DEFAULT_ALPHA_VERTICES)]
+        #[arg(long, default_value_t = hairloom_core::runtime::frame_plan::DEFAULT_ALPHA_VERTICES)]
         alpha_vertices: f64,
         /// Vertex LOD morph window λ in [0, 1] (eq. 10-12); 0 switches levels abruptly.
-        #[arg(long, default_value_t = hairloom_core::lod::DEFAULT_LAMBDA)]
+        #[arg(long, default_value_t = hairloom_core::runtime::frame_plan::DEFAULT_LAMBDA)]
         lambda: f64,
     },
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
@@ -215,7 +216,7 @@ fn main() -> ExitCode {
                 vertices_log2,
                 precision: precision.into(),
                 filtering: filtering.into(),
-                lod: hairloom_core::lod::LodSettings {
+                lod: hairloom_core::runtime::frame_plan::LodSettings {
                     enabled: !no_lod,
                     cull: true,
                     alpha_strands,
@@ -347,10 +348,10 @@ fn import(
     scale: f64,
     generate_uv: bool,
 ) -> anyhow::Result<()> {
-    let options = hairloom_core::import::ImportOptions {
+    let options = hairloom_core::io::import::ImportOptions {
         mesh_name: mesh,
         scale,
-        ..hairloom_core::import::ImportOptions::default()
+        ..hairloom_core::io::import::ImportOptions::default()
     };
     let (document, summary) = files::scalp_document(scalp, &options, generate_uv)?;
     project::save(out, &hairloom_core::Project::new(document))?;

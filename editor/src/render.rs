@@ -8,21 +8,18 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 use glam::Vec3;
-use hairloom_core::document::BodyMesh;
-use hairloom_core::gpu_types::{StylingGpu, styling_array};
-use hairloom_core::lod::LodSettings;
-use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures};
-use hairloom_core::strands::sample_set_size;
+use hairloom_core::io::runtime_bundle::load_runtime_bundle;
+use hairloom_core::model::document::BodyMesh;
+use hairloom_core::runtime::frame_plan::LodSettings;
+use hairloom_core::runtime::hair::{DEFAULT_STRANDS_PER_BUNDLE, RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::textures::Precision;
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, PreviewScene};
-use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
+use hairloom_render::strand_gen::StrandGenRenderer;
 
 /// Vertices per strand in previews by default: 2^4 + 1.
 pub const PREVIEW_VERTICES_LOG2: u32 = 4;
-/// Strands per bundle of a project render when none is given (an export's default).
-pub const DEFAULT_STRANDS_PER_BUNDLE: u32 = 64;
-/// Root-sample seed of project renders: the one runtime exports use by default.
-const SAMPLE_SEED: u64 = 1;
 
 /// Settings of a headless render.
 #[derive(Clone, Debug)]
@@ -87,93 +84,28 @@ pub fn parse_view(view: &str) -> anyhow::Result<Vec3> {
     })
 }
 
-/// What the GPU needs to draw a head of hair: the runtime textures, root samples, each
-/// bundle's styling index, the styling array and the opaque body. Built from a project or
-/// read from a runtime bundle.
-pub struct RenderableHair {
-    pub textures: RuntimeTextures,
-    pub samples: RootSamples,
-    pub per_bundle: usize,
-    /// Per atlas block: 0 = global styling, `g + 1` = group `g`.
-    pub block_styling: Vec<u32>,
-    pub styling: Vec<StylingGpu>,
-    pub body: BodyMesh,
-}
-
-impl RenderableHair {
-    /// What exporting `document` with these settings would produce.
-    pub fn from_document(
-        document: &hairloom_core::document::Document,
-        precision: Precision,
-        strands_per_bundle: u32,
-    ) -> Self {
-        let textures = RuntimeTextures::build(&document.hair_mesh, precision);
-        let mut hair = Self {
-            samples: RootSamples {
-                quad: Vec::new(),
-                triangle: Vec::new(),
-            },
-            per_bundle: 0,
-            block_styling: textures.block_styling(&document.styling),
-            textures,
-            styling: styling_array(&document.styling),
-            body: document.body.clone(),
-        };
-        hair.set_strands_per_bundle(strands_per_bundle);
-        hair
-    }
-
-    /// Draws `strands_per_bundle` strands per bundle from the sample set an export of that
-    /// count would write.
-    pub fn set_strands_per_bundle(&mut self, strands_per_bundle: u32) {
-        self.samples = RootSamples::progressive(sample_set_size(strands_per_bundle), SAMPLE_SEED);
-        self.per_bundle = strands_per_bundle as usize;
-    }
-
-    /// Uploads everything generation reads (once per change of the hair, not per frame).
-    pub fn upload(&self, context: &GpuContext, generator: &StrandGenRenderer) -> GpuHair {
-        generator.upload(
-            context,
-            &self.textures,
-            &self.samples,
-            self.per_bundle,
-            &self.block_styling,
-            &self.styling,
-        )
-    }
-
-    /// A project file, or a runtime bundle folder (the game's input).
-    pub fn load(path: &Path, settings: &RenderSettings) -> anyhow::Result<Self> {
-        if path.is_dir() {
-            let bundle = hairloom_core::export::load_runtime_bundle(path)?;
-            let per_bundle = settings
-                .strands_per_bundle
-                .unwrap_or(bundle.manifest.strands_per_bundle);
-            if per_bundle as usize > bundle.manifest.quad_samples.len() {
-                bail!(
-                    "{}: --strands-per-bundle {per_bundle} is more than the bundle's {} samples",
-                    path.display(),
-                    bundle.manifest.quad_samples.len()
-                );
-            }
-            Ok(Self {
-                samples: bundle.root_samples(),
-                per_bundle: per_bundle as usize,
-                block_styling: bundle.block_styling(),
-                styling: styling_array(&bundle.manifest.styling),
-                textures: bundle.textures,
-                body: bundle.body,
-            })
-        } else {
-            let project = hairloom_core::project::load(path)?;
-            Ok(Self::from_document(
-                &project.document,
-                settings.precision,
-                settings
+/// The runtime asset a render draws: a runtime bundle folder (the game's input) as stored,
+/// or a project turned into what an export with `settings` would write.
+pub fn load_hair(path: &Path, settings: &RenderSettings) -> anyhow::Result<RuntimeHair> {
+    if path.is_dir() {
+        let mut hair = load_runtime_bundle(path)?;
+        if let Some(per_bundle) = settings.strands_per_bundle {
+            hair.set_strands_per_bundle(per_bundle)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        }
+        Ok(hair)
+    } else {
+        let project = hairloom_core::io::project::load(path)?;
+        Ok(RuntimeHair::from_document(
+            &project.document,
+            &RuntimeOptions {
+                precision: settings.precision,
+                strands_per_bundle: settings
                     .strands_per_bundle
                     .unwrap_or(DEFAULT_STRANDS_PER_BUNDLE),
-            ))
-        }
+                ..RuntimeOptions::default()
+            },
+        ))
     }
 }
 
@@ -203,7 +135,7 @@ pub fn default_scene<'a>(
 /// Draws `hair` seen from `direction`; returns RGBA8 pixels and a one-line description.
 pub fn render_pixels(
     context: &GpuContext,
-    hair: &RenderableHair,
+    hair: &RuntimeHair,
     width: u32,
     height: u32,
     direction: Vec3,
@@ -211,7 +143,7 @@ pub fn render_pixels(
 ) -> anyhow::Result<(Vec<u8>, String)> {
     let (vertices_log2, filtering) = (settings.vertices_log2, settings.filtering);
     let generator = StrandGenRenderer::new(context);
-    let gpu_hair = hair.upload(context, &generator);
+    let gpu_hair = generator.upload(context, hair);
     let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
     // Frame the hair (the head scan's shoulders would make it tiny), padded by a margin.
     let (lo, hi) = hair
@@ -264,14 +196,14 @@ pub fn write_png(out: &Path, pixels: &[u8], width: u32, height: u32) -> anyhow::
         std::fs::create_dir_all(parent)
             .with_context(|| format!("creating {}", parent.display()))?;
     }
-    hairloom_core::project::write_atomic(out, &png, |_| {})
+    hairloom_core::io::project::write_atomic(out, &png, |_| {})
         .with_context(|| format!("writing {}", out.display()))
 }
 
 pub fn run(input: &Path, out: &Path, settings: &RenderSettings) -> anyhow::Result<()> {
     let (width, height) = parse_size(&settings.size)?;
     let direction = parse_view(&settings.view)?;
-    let hair = RenderableHair::load(input, settings)?;
+    let hair = load_hair(input, settings)?;
     let context = GpuContext::new_headless()?;
     let (pixels, summary) = render_pixels(&context, &hair, width, height, direction, settings)?;
     write_png(out, &pixels, width, height)?;
@@ -314,8 +246,15 @@ pub fn measure_accuracy(
     let mut reference: Option<Vec<[f32; 4]>> = None;
     let mut rows = Vec::new();
     for (precision, filtering) in settings {
-        let hair = RenderableHair::from_document(document, precision, strands_per_bundle);
-        let gpu = hair.upload(context, generator);
+        let hair = RuntimeHair::from_document(
+            document,
+            &RuntimeOptions {
+                precision,
+                strands_per_bundle,
+                ..RuntimeOptions::default()
+            },
+        );
+        let gpu = generator.upload(context, &hair);
         let plan = hairloom_render::strand_gen::full_detail_plan(gpu.root_count, vertex_count);
         let generated = generator
             .generate_positions(context, &gpu, &plan, filtering)

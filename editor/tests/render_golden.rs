@@ -49,9 +49,8 @@ fn render(args: &[&std::ffi::OsStr], out: &Path) -> Option<image::RgbaImage> {
     let stderr = String::from_utf8_lossy(&output.stderr);
     if !output.status.success()
         && stderr.contains("no GPU adapter")
-        && std::env::var("HAIRLOOM_REQUIRE_GPU").as_deref() != Ok("1")
+        && hairloom_render::device::skip_test_without_gpu("render", &stderr)
     {
-        eprintln!("skipped: {stderr}");
         return None;
     }
     assert!(output.status.success(), "render {args:?}: {stderr}");

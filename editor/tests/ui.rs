@@ -384,9 +384,9 @@ fn exports_write_a_loadable_runtime_bundle_and_strand_files() {
     wait_for_export(&mut harness);
     let message = harness.state().state.message.clone();
     assert!(message.starts_with("exported"), "{message}");
-    let bundle = hairloom_core::export::load_runtime_bundle(&runtime).expect("loads");
+    let bundle = hairloom_core::io::runtime_bundle::load_runtime_bundle(&runtime).expect("loads");
     assert_eq!(
-        bundle.manifest.strands_per_bundle,
+        bundle.strands_per_bundle,
         harness.state().viewport.settings.strands_per_bundle
     );
 

@@ -9,12 +9,12 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
-use hairloom_core::runtime::Filtering;
+use hairloom_core::runtime::strand_gen::Filtering;
 use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, PassTimer, read_buffer, submit_timed};
 use crate::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
-use hairloom_core::lod::{FramePlan, LodCamera, LodSettings, plan_frame};
+use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
 
 pub const HAIR_SHADER: &str = include_str!("../../shaders/preview_hair.wgsl");
 pub const BODY_SHADER: &str = include_str!("../../shaders/preview_body.wgsl");
@@ -173,7 +173,7 @@ impl PreviewRenderer {
                         ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: false,
                         min_binding_size: wgpu::BufferSize::new(size_of::<
-                            hairloom_core::gpu_types::StrandRun,
+                            hairloom_core::runtime::gpu_types::StrandRun,
                         >() as u64),
                     },
                     count: None,
@@ -717,7 +717,7 @@ pub struct FrameTiming {
 
 /// Stored vertices: one run over every strand, one batch.
 fn stored_plan(strand_count: usize, vertex_count: u32) -> FramePlan {
-    let runs = hairloom_core::runtime::full_detail_runs(strand_count, vertex_count);
+    let runs = hairloom_core::runtime::strand_gen::full_detail_runs(strand_count, vertex_count);
     FramePlan {
         strands: strand_count,
         vertices: strand_count * vertex_count as usize,

@@ -3,14 +3,17 @@
 //! of [`BATCH_STRANDS`] into one bounded scratch buffer, which the preview draws from right
 //! away; tests and benchmarks read it back or time it.
 //!
-//! CPU mirror: `hairloom_core::runtime::TexturePath::strand_gen`.
+//! CPU mirror: `hairloom_core::runtime::strand_gen` (`StrandGen::main` for one batch).
 
-use hairloom_core::export::TexelFormat;
-use hairloom_core::gpu_types::{
+use hairloom_core::io::ktx2::TexelFormat;
+use hairloom_core::runtime::frame_plan::{BundleBounds, FramePlan};
+use hairloom_core::runtime::gpu_types::{
     BundleGpu, FILTERING_EXACT, FILTERING_HARDWARE, StrandGenParams, StrandRun, StylingGpu,
+    styling_array,
 };
-use hairloom_core::lod::{BundleBounds, FramePlan};
-use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures, Texture3d};
+use hairloom_core::runtime::hair::RuntimeHair;
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::textures::{Precision, Texture3d};
 use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, read_buffer};
@@ -68,7 +71,7 @@ pub fn full_detail_plan(root_count: usize, vertex_count: u32) -> FramePlan {
     let mut plan = FramePlan::default();
     for start in (0..root_count).step_by(BATCH_STRANDS) {
         let strands = BATCH_STRANDS.min(root_count - start);
-        let mut runs = hairloom_core::runtime::full_detail_runs(strands, vertex_count);
+        let mut runs = hairloom_core::runtime::strand_gen::full_detail_runs(strands, vertex_count);
         for run in &mut runs {
             run.first_root += start as u32;
         }
@@ -132,7 +135,7 @@ fn upload_texture(
         TexelFormat::Rg16Float => wgpu::TextureFormat::Rg16Float,
         TexelFormat::R16Float => wgpu::TextureFormat::R16Float,
     };
-    let bytes = hairloom_core::export::texel_bytes(&texture.texels, export_format);
+    let bytes = hairloom_core::io::ktx2::texel_bytes(&texture.texels, export_format);
     let size = wgpu::Extent3d {
         width: texture.width,
         height: texture.height,
@@ -268,20 +271,17 @@ impl StrandGenRenderer {
         }
     }
 
-    /// Uploads the five textures of `textures` (f32 or f16 as built), every bundle's block
-    /// placement with its styling index (`block_styling[i]` for block `i`: 0 = global,
-    /// `g + 1` = group `g`), the first `per_bundle` root samples of each domain and the
-    /// styling array. Root `i` is then sample `i % per_bundle` of block `i / per_bundle`, as
-    /// `RuntimeTextures::strand_roots` lays roots out on the CPU.
-    pub fn upload(
-        &self,
-        context: &GpuContext,
-        textures: &RuntimeTextures,
-        samples: &RootSamples,
-        per_bundle: usize,
-        block_styling: &[u32],
-        styling: &[StylingGpu],
-    ) -> GpuHair {
+    /// Uploads a runtime asset: the five textures (f32 or f16 as built), every bundle's block
+    /// placement with its styling index, the first `strands_per_bundle` root samples of each
+    /// domain and the styling array. Root `i` is then sample `i % strands_per_bundle` of
+    /// block `i / strands_per_bundle`, as [`RuntimeHair::strand_roots`] lays roots out on the
+    /// CPU.
+    pub fn upload(&self, context: &GpuContext, hair: &RuntimeHair) -> GpuHair {
+        let (textures, samples) = (&hair.textures, &hair.samples);
+        let per_bundle = hair.strands_per_bundle as usize;
+        let block_styling = &hair.block_styling;
+        let styling = styling_array(&hair.styling);
+        let styling = &styling[..];
         let precision = textures.precision;
         let (hair_mesh, a) =
             upload_texture(context, "hair_mesh", &textures.hair_mesh, precision, 4);
@@ -322,7 +322,7 @@ impl StrandGenRenderer {
             );
         }
         let default_styling = [StylingGpu::from(
-            &hairloom_core::styling::StylingParams::default(),
+            &hairloom_core::model::styling::StylingParams::default(),
         )];
         let styling_bytes: &[u8] = bytemuck::cast_slice(if styling.is_empty() {
             &default_styling

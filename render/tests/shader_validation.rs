@@ -60,7 +60,9 @@ fn wgsl_struct_size(module: &naga::Module, name: &str) -> Option<u32> {
 
 #[test]
 fn gpu_structs_match_their_wgsl() {
-    use hairloom_core::gpu_types::{BundleGpu, StrandGenParams, StrandRoot, StrandRun, StylingGpu};
+    use hairloom_core::runtime::gpu_types::{
+        BundleGpu, StrandGenParams, StrandRoot, StrandRun, StylingGpu,
+    };
     use hairloom_render::preview::{BODY_SHADER, BodyUniforms, HAIR_SHADER, HairUniforms};
     use hairloom_render::strand_gen::SHADER_SOURCE;
     for (source, name, rust_size) in [

@@ -1,40 +1,28 @@
 //! GPU strand generation (`strand_gen.wgsl`) against its CPU mirror
-//! (`TexturePath::strand_gen`) on the bundled samples, every styling op on, with a styling
+//! (`StrandGen::main`) on the bundled samples, every styling op on, with a styling
 //! group: exact filtering within 1e-5 × model size; hardware filtering within the bound the
 //! CPU emulation of 8-bit weights documents. Runs on lavapipe in CI.
 
-use hairloom_core::gpu_types::styling_array;
-use hairloom_core::runtime::{Filtering, Precision, RootSamples, RuntimeTextures, TexturePath};
-use hairloom_core::styling::{StylingGroup, StylingParams, Twist};
-use hairloom_render::device::GpuContext;
+use hairloom_core::model::styling::{StylingGroup, StylingParams, Twist};
+use hairloom_core::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
+use hairloom_core::runtime::textures::Precision;
+use hairloom_render::device::headless_for_test;
 use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
 
-fn context() -> Option<GpuContext> {
-    match GpuContext::new_headless() {
-        Ok(context) => Some(context),
-        Err(error) if std::env::var("HAIRLOOM_REQUIRE_GPU").as_deref() != Ok("1") => {
-            eprintln!("skipped: {error} (set HAIRLOOM_REQUIRE_GPU=1 to make this a failure)");
-            None
-        }
-        Err(error) => panic!("{error}"),
-    }
-}
-
-fn sample(name: &str) -> hairloom_core::document::Document {
+fn sample(name: &str) -> hairloom_core::model::document::Document {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join(format!("../assets/samples/{name}.hairloom"));
-    hairloom_core::project::load(&path)
+    hairloom_core::io::project::load(&path)
         .expect("sample")
         .document
 }
 
 #[test]
 fn gpu_strands_match_the_cpu_mirror() {
-    let Some(context) = context() else { return };
-    eprintln!(
-        "adapter: {}",
-        hairloom_render::device::describe(&context.adapter_info)
-    );
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
     let renderer = StrandGenRenderer::new(&context);
     for name in ["head_curly", "head_long_wavy", "teapot_fur"] {
         let mut document = sample(name);
@@ -61,14 +49,20 @@ fn gpu_strands_match_the_cpu_mirror() {
         let params: Vec<&StylingParams> = std::iter::once(&document.styling.global)
             .chain(document.styling.groups.iter().map(|g| &g.params))
             .collect();
-        let styling = styling_array(&document.styling);
-        let samples = RootSamples::progressive(256, 5);
         for precision in [Precision::F32, Precision::F16] {
-            let textures = RuntimeTextures::build(mesh, precision);
-            let roots = textures.document_roots(&document.styling, &samples, 6);
+            let runtime = RuntimeHair::from_document(
+                &document,
+                &RuntimeOptions {
+                    precision,
+                    strands_per_bundle: 6,
+                    sample_seed: 5,
+                    ..RuntimeOptions::default()
+                },
+            );
+            let textures = &runtime.textures;
+            let roots = runtime.strand_roots();
             assert!(roots.iter().any(|r| r.styling == 1) && roots.iter().any(|r| r.styling == 0));
-            let block_styling = textures.block_styling(&document.styling);
-            let hair = renderer.upload(&context, &textures, &samples, 6, &block_styling, &styling);
+            let hair = renderer.upload(&context, &runtime);
             assert_eq!(hair.root_count, roots.len());
             let vertex_count = 17u32;
             let plan = full_detail_plan(roots.len(), vertex_count);
@@ -79,11 +73,11 @@ fn gpu_strands_match_the_cpu_mirror() {
                     Err(error) => panic!("{name} {precision:?} {filtering:?}: {error}"),
                 };
                 assert_eq!(positions.len(), roots.len() * vertex_count as usize);
-                let mirror = TexturePath {
-                    textures: &textures,
+                let mirror = StrandGen {
+                    textures,
                     filtering,
                 };
-                let expected = mirror.strand_gen(&roots, &plan.batches[0], &params);
+                let expected = mirror.main(&roots, &plan.batches[0], &params);
                 let mut worst = 0.0f32;
                 for (got, expected) in positions.iter().zip(&expected) {
                     let got = glam::Vec3::new(got[0], got[1], got[2]);
@@ -114,20 +108,34 @@ fn gpu_strands_match_the_cpu_mirror() {
 #[test]
 fn generation_runs_in_batches_with_bounded_scratch() {
     use hairloom_render::strand_gen::BATCH_STRANDS;
-    let Some(context) = context() else { return };
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
     let renderer = StrandGenRenderer::new(&context);
     let document = sample("teapot_fur");
-    let textures = RuntimeTextures::build(&document.hair_mesh, Precision::F16);
-    let styling = styling_array(&document.styling);
-    let samples = RootSamples::progressive(256, 1);
-    let small = textures.document_roots(&document.styling, &samples, 4);
+    let mut runtime = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            precision: Precision::F16,
+            strands_per_bundle: 160,
+            ..RuntimeOptions::default()
+        },
+    );
     // 288 bundles × 160 = 46,080 strands: 2 batches.
-    let large = textures.document_roots(&document.styling, &samples, 160);
+    let large = runtime.strand_roots();
     assert!(large.len() > BATCH_STRANDS);
+    let large_hair = renderer.upload(&context, &runtime);
+    // A prefix of the same sample set: 4 per bundle.
+    runtime.samples = RootSamples {
+        quad: runtime.samples.quad[..4].to_vec(),
+        triangle: runtime.samples.triangle[..4].to_vec(),
+    };
+    runtime.sample_seed = None;
+    runtime.set_strands_per_bundle(4).expect("4 of the samples");
+    let small = runtime.strand_roots();
+    let small_hair = renderer.upload(&context, &runtime);
+    let textures = &runtime.textures;
     let vertex_count = 5;
-    let block_styling = textures.block_styling(&document.styling);
-    let small_hair = renderer.upload(&context, &textures, &samples, 4, &block_styling, &styling);
-    let large_hair = renderer.upload(&context, &textures, &samples, 160, &block_styling, &styling);
     let small_plan = full_detail_plan(small.len(), vertex_count);
     let large_plan = full_detail_plan(large.len(), vertex_count);
     let a = renderer
@@ -149,15 +157,15 @@ fn generation_runs_in_batches_with_bounded_scratch() {
         .generate_positions(&context, &large_hair, &large_plan, Filtering::Exact)
         .expect("positions");
     assert_eq!(positions.len(), large.len() * vertex_count as usize);
-    let mirror = TexturePath {
-        textures: &textures,
+    let mirror = StrandGen {
+        textures,
         filtering: Filtering::Exact,
     };
     let params = [&document.styling.global];
     let boundary = &large_plan.batches[1][..1];
     assert_eq!(boundary[0].first_root as usize, BATCH_STRANDS);
     let expected: Vec<_> = mirror
-        .strand_gen(&large, boundary, &params)
+        .main(&large, boundary, &params)
         .into_iter()
         .take(vertex_count as usize)
         .collect();
@@ -183,16 +191,22 @@ fn generation_runs_in_batches_with_bounded_scratch() {
 
 #[test]
 fn lod_runs_match_the_cpu_mirror_with_morphing() {
-    use hairloom_core::lod::{LodCamera, LodSettings, plan_frame};
-    let Some(context) = context() else { return };
+    use hairloom_core::runtime::frame_plan::{LodCamera, LodSettings, plan_frame};
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
     let renderer = StrandGenRenderer::new(&context);
     let document = sample("head_long_wavy");
-    let textures = RuntimeTextures::build(&document.hair_mesh, Precision::F32);
-    let styling = styling_array(&document.styling);
-    let samples = RootSamples::progressive(256, 1);
-    let roots = textures.document_roots(&document.styling, &samples, 32);
-    let block_styling = textures.block_styling(&document.styling);
-    let hair = renderer.upload(&context, &textures, &samples, 32, &block_styling, &styling);
+    let runtime = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 32,
+            ..RuntimeOptions::default()
+        },
+    );
+    let textures = &runtime.textures;
+    let roots = runtime.strand_roots();
+    let hair = renderer.upload(&context, &runtime);
     // A camera far enough for partial strand counts, several vertex levels and morphing.
     let (lo, hi) = textures.hair_bounds().expect("hair");
     let centre = (lo + hi) * 0.5;
@@ -227,15 +241,15 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
         .generate_positions(&context, &hair, &plan, Filtering::Exact)
         .expect("positions");
     assert_eq!(positions.len(), plan.vertices);
-    let mirror = TexturePath {
-        textures: &textures,
+    let mirror = StrandGen {
+        textures,
         filtering: Filtering::Exact,
     };
     let params = [&document.styling.global];
     let expected: Vec<_> = plan
         .batches
         .iter()
-        .flat_map(|batch| mirror.strand_gen(&roots, batch, &params))
+        .flat_map(|batch| mirror.main(&roots, batch, &params))
         .collect();
     let size = document.hair_mesh.size() as f32;
     let worst = positions

@@ -122,6 +122,6 @@ impl GltfBuilder {
 
     /// A GLB file from `json` and this builder's binary chunk.
     pub fn glb(&self, json: &serde_json::Value) -> Vec<u8> {
-        hairloom_core::export::glb_container(json, self.bin.clone())
+        hairloom_core::io::strand_files::glb_container(json, self.bin.clone())
     }
 }

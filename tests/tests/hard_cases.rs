@@ -4,15 +4,18 @@
 //! and parameters counts non-finite outputs (there must be none).
 
 use glam::{DVec2, DVec3};
-use hairloom_core::curve::CurveDefinition;
-use hairloom_core::frames::layer_frames;
-use hairloom_core::interior::place_interior;
-use hairloom_core::lod::{morphed_tangents, strand_count, tangents, thickness_factor, vertex_lod};
-use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures, TexturePath};
-use hairloom_core::strands::{StrandOptions, generate};
-use hairloom_core::styling::{
+use hairloom_core::geometry::curve::CurveDefinition;
+use hairloom_core::geometry::frames::layer_frames;
+use hairloom_core::geometry::interior::place_interior;
+use hairloom_core::model::styling::{
     Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Twist, Wave,
 };
+use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
+use hairloom_core::runtime::textures::{Precision, RuntimeTextures};
+use hairloom_core::strands::lod::{
+    morphed_tangents, strand_count, tangents, thickness_factor, vertex_lod,
+};
+use hairloom_core::strands::reference::{StrandOptions, generate};
 use hairloom_core::{Document, HairMesh};
 use hairloom_tests::grid_mesh;
 use proptest::prelude::*;
@@ -101,7 +104,7 @@ fn run_pipeline(mesh: HairMesh, styling: StylingParams) -> f64 {
     for precision in [Precision::F32, Precision::F16] {
         let textures = RuntimeTextures::build(&document.hair_mesh, precision);
         for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
-            let path = TexturePath {
+            let path = StrandGen {
                 textures: &textures,
                 filtering,
             };

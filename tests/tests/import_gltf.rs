@@ -2,13 +2,13 @@
 //! malformed input. Malformed input must give an error naming the file, mesh and accessor,
 //! never a panic.
 
-use hairloom_core::import::{ImportError, ImportOptions, import_file, import_slice};
+use hairloom_core::io::import::{ImportError, ImportOptions, import_file, import_slice};
 use hairloom_tests::{GltfBuilder, assets_dir};
 
 fn import(
     bytes: &[u8],
     options: &ImportOptions,
-) -> Result<hairloom_core::import::ImportedMesh, ImportError> {
+) -> Result<hairloom_core::io::import::ImportedMesh, ImportError> {
     import_slice(bytes, None, "crafted.glb", options)
 }
 

@@ -5,7 +5,7 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-use hairloom_core::project::{self, ProjectError};
+use hairloom_core::io::project::{self, ProjectError};
 use hairloom_core::{Document, History, Project};
 use hairloom_tests::{grid_mesh, sample_paths};
 

@@ -2,17 +2,18 @@
 //! alone, in f32) against the f64 reference generator, strand for strand, on the bundled
 //! samples with every styling op switched on.
 
-use hairloom_core::curve::{FaceCoord, SegmentForm};
-use hairloom_core::roots::{SampleDomain, progressive_samples};
-use hairloom_core::runtime::{Filtering, Precision, RuntimeTextures, TexturePath};
-use hairloom_core::strands::{StrandContext, StrandOptions};
-use hairloom_core::styling::Twist;
+use hairloom_core::geometry::curve::{FaceCoord, SegmentForm};
+use hairloom_core::model::styling::Twist;
+use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
+use hairloom_core::runtime::textures::{Precision, RuntimeTextures};
+use hairloom_core::strands::reference::{StrandContext, StrandOptions};
+use hairloom_core::strands::roots::{SampleDomain, progressive_samples};
 use hairloom_tests::sample_paths;
 
 #[test]
 fn styled_texture_path_matches_the_reference_generator() {
     for path in sample_paths() {
-        let mut document = hairloom_core::project::load(&path)
+        let mut document = hairloom_core::io::project::load(&path)
             .expect("sample")
             .document;
         // Every op the sample has, plus twist (the one that needs the centre strand).
@@ -27,7 +28,7 @@ fn styled_texture_path_matches_the_reference_generator() {
         let triangle = progressive_samples(8, SampleDomain::Triangle, 3);
         let size = document.hair_mesh.size();
         for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
-            let mirror = TexturePath {
+            let mirror = StrandGen {
                 textures: &textures,
                 filtering,
             };
@@ -41,7 +42,7 @@ fn styled_texture_path_matches_the_reference_generator() {
                     &quad
                 };
                 for sample in samples {
-                    let gpu_like = mirror.styled_strand(index, *sample, 17, params);
+                    let gpu_like = mirror.styled_strand_of_sample(index, *sample, 17, params);
                     let coord = FaceCoord {
                         s: sample.x,
                         t: sample.y,

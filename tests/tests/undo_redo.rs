@@ -4,8 +4,9 @@
 
 use glam::{DVec2, DVec3};
 use hairloom_core::edit::{self, ExtrudeDirection, VertexTransform};
-use hairloom_core::history::{Command, History, Transaction};
-use hairloom_core::{Document, Project, Topology, VertexRef, WMode, project};
+use hairloom_core::io::project;
+use hairloom_core::model::history::{Command, History, Transaction};
+use hairloom_core::{Document, Project, Topology, VertexRef, WMode};
 use hairloom_tests::grid_mesh;
 use proptest::prelude::*;
 
@@ -418,7 +419,7 @@ fn mismatched_history_is_an_error_not_corruption() {
 fn a_styling_only_change_is_recorded_and_undone() {
     // Regression: a diff that changed only the styling counted as empty, so styling edits
     // were silently left out of the history.
-    let document = hairloom_core::project::load(&hairloom_tests::sample_paths()[0])
+    let document = hairloom_core::io::project::load(&hairloom_tests::sample_paths()[0])
         .expect("sample")
         .document;
     let mut after = document.clone();
@@ -437,7 +438,7 @@ fn a_styling_only_change_is_recorded_and_undone() {
 fn every_document_field_is_recorded_and_undone() {
     // Regression: the source and body were outside the diff, so undoing an import kept the
     // imported body and attribution. Change each whole-value field alone, then all at once.
-    let document = hairloom_core::project::load(&hairloom_tests::sample_paths()[0])
+    let document = hairloom_core::io::project::load(&hairloom_tests::sample_paths()[0])
         .expect("sample")
         .document;
     type Change = fn(&mut hairloom_core::Document);
@@ -452,7 +453,7 @@ fn every_document_field_is_recorded_and_undone() {
         ("all", |d| {
             d.name = "other".into();
             d.source.clear();
-            d.body = hairloom_core::document::BodyMesh::default();
+            d.body = hairloom_core::model::document::BodyMesh::default();
             d.styling.global.seed += 1;
         }),
     ];

@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc;
 
 use hairloom_core::Document;
-use hairloom_core::runtime::Precision;
+use hairloom_core::runtime::textures::Precision;
 
 use crate::files::{STRAND_EXTENSIONS, generate_strands, write_runtime_bundle, write_strand_file};
 
@@ -178,7 +178,7 @@ impl RecentFiles {
         if let Some(dir) = self.file.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        let _ = hairloom_core::project::write_atomic(&self.file, text.as_bytes(), |_| {});
+        let _ = hairloom_core::io::project::write_atomic(&self.file, text.as_bytes(), |_| {});
     }
 }
 

@@ -6,10 +6,10 @@
 use std::collections::BTreeMap;
 
 use glam::DVec2;
-use hairloom_core::atlas::{Atlas, build_atlas};
 use hairloom_core::edit;
-use hairloom_core::mesh::WMode;
-use hairloom_core::runtime::MAX_REGION_SIDE;
+use hairloom_core::model::mesh::WMode;
+use hairloom_core::runtime::atlas::{Atlas, build_atlas};
+use hairloom_core::runtime::textures::MAX_REGION_SIDE;
 use hairloom_core::{HairMesh, VertexRef};
 
 use super::state::EditorState;
@@ -157,7 +157,7 @@ impl LayoutPanel {
                 .filter(|(_, b)| !b.removed)
                 .find(|(_, b)| {
                     let polygon: Vec<[f64; 2]> = b.uvs.iter().map(|p| [p.x, p.y]).collect();
-                    hairloom_core::select::point_in_polygon([uv.x, uv.y], &polygon)
+                    hairloom_core::edit::select::point_in_polygon([uv.x, uv.y], &polygon)
                 })
                 .map(|(i, _)| i as u32);
             let add = ui.input(|i| i.modifiers.shift || i.modifiers.command);

@@ -428,7 +428,7 @@ impl HairloomApp {
     }
 
     fn import_scalp(&mut self, path: &std::path::Path) {
-        let options = hairloom_core::import::ImportOptions::default();
+        let options = hairloom_core::io::import::ImportOptions::default();
         match crate::files::scalp_document(path, &options, false) {
             Ok((document, summary)) => self.state.import_scalp(document, &summary),
             Err(error) => self.state.message = format!("import failed: {error:#}"),

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-use hairloom_core::project;
+use hairloom_core::io::project;
 
 use super::state::EditorState;
 

@@ -8,11 +8,11 @@ use std::path::{Path, PathBuf};
 
 use std::collections::BTreeSet;
 
-use hairloom_core::document::Document;
+use hairloom_core::edit::select;
 use hairloom_core::edit::{EditError, EditOutcome};
-use hairloom_core::history::Transaction;
-use hairloom_core::project::{self, Project};
-use hairloom_core::select;
+use hairloom_core::io::project::{self, Project};
+use hairloom_core::model::document::Document;
+use hairloom_core::model::history::Transaction;
 use hairloom_core::{HairMesh, Topology, VertexRef};
 
 /// The sample the editor opens with no file, embedded so it works from any folder.

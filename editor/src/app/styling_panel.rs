@@ -2,7 +2,7 @@
 //! double-click), for the global parameters or one styling group. A slider drag is one undo
 //! step; keyboard and typed changes commit at once.
 
-use hairloom_core::styling::StylingParams;
+use hairloom_core::model::styling::StylingParams;
 
 use super::state::EditorState;
 
@@ -293,7 +293,7 @@ fn commit_when_done(state: &mut EditorState, response: &egui::Response) {
 }
 
 fn params_mut(
-    document: &mut hairloom_core::document::Document,
+    document: &mut hairloom_core::model::document::Document,
     group: Option<usize>,
 ) -> &mut StylingParams {
     match group {

@@ -20,10 +20,11 @@ use std::sync::Arc;
 
 use eframe::egui_wgpu;
 use glam::{DVec3, Vec3};
+use hairloom_core::edit::select::{self, Region};
 use hairloom_core::edit::{self, VertexTransform};
-use hairloom_core::lod::LodSettings;
-use hairloom_core::runtime::{Filtering, Precision};
-use hairloom_core::select::{self, Region};
+use hairloom_core::runtime::frame_plan::LodSettings;
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::textures::Precision;
 use hairloom_core::{Topology, VertexRef};
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
@@ -31,7 +32,8 @@ use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
 
 use super::gizmo::{GizmoAdapter, GizmoStep};
 use super::state::{DragTool, EditorState, SelectMode};
-use crate::render::{AccuracyRow, RenderableHair, default_scene, measure_accuracy};
+use crate::render::{AccuracyRow, default_scene, measure_accuracy};
+use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 
 /// Storage buffers per shader stage the generation and preview pipelines bind.
 const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
@@ -207,7 +209,7 @@ impl Projector {
 struct UploadedHair {
     gpu: GpuHair,
     bounds: (Vec3, Vec3),
-    body: hairloom_core::document::BodyMesh,
+    body: hairloom_core::model::document::BodyMesh,
 }
 
 /// GPU resources of the viewport (absent without a wgpu device).
@@ -270,7 +272,10 @@ pub struct Viewport {
     /// was computed at (the wireframe marks them; recomputed only when the document changes).
     interior: Option<(u64, Vec<Vec<bool>>)>,
     /// Styling frames per layer and column for the document revision they were computed at.
-    frames: Option<(u64, Vec<Vec<Option<hairloom_core::frames::Frame>>>)>,
+    frames: Option<(
+        u64,
+        Vec<Vec<Option<hairloom_core::geometry::frames::Frame>>>,
+    )>,
 }
 
 impl Viewport {
@@ -564,13 +569,16 @@ impl Viewport {
         };
         let key = (state.revision, settings);
         if self.uploaded != Some(key) {
-            let hair = RenderableHair::from_document(
+            let hair = RuntimeHair::from_document(
                 state.document(),
-                self.settings.precision,
-                self.settings.strands_per_bundle,
+                &RuntimeOptions {
+                    precision: self.settings.precision,
+                    strands_per_bundle: self.settings.strands_per_bundle,
+                    ..RuntimeOptions::default()
+                },
             );
             gpu.hair = hair.textures.hair_bounds().map(|bounds| UploadedHair {
-                gpu: hair.upload(&gpu.context, &gpu.generator),
+                gpu: gpu.generator.upload(&gpu.context, &hair),
                 bounds,
                 body: hair.body,
             });
@@ -757,7 +765,7 @@ impl Viewport {
                 .is_none_or(|(r, _)| *r != state.revision)
             {
                 let frames = (0..=mesh.max_layers())
-                    .map(|layer| hairloom_core::frames::layer_frames(mesh, layer))
+                    .map(|layer| hairloom_core::geometry::frames::layer_frames(mesh, layer))
                     .collect();
                 self.frames = Some((state.revision, frames));
             }
@@ -869,7 +877,7 @@ impl Viewport {
             match state.tool.mode {
                 SelectMode::Bundles => {
                     let (origin, direction) = projector.ray(pointer);
-                    let hit = hairloom_core::pick::pick_bundle(mesh, origin, direction);
+                    let hit = hairloom_core::edit::pick::pick_bundle(mesh, origin, direction);
                     if !add {
                         state.selection.clear();
                     }

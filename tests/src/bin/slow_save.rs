@@ -14,9 +14,9 @@ fn main() {
     let pause_ms: u64 = pause.parse().unwrap_or(50);
     let mesh = hairloom_tests::grid_mesh(60, 60, 4, 0.1);
     let project = hairloom_core::Project::new(hairloom_core::Document::new("slow", mesh));
-    let bytes = hairloom_core::project::to_bytes(&project);
+    let bytes = hairloom_core::io::project::to_bytes(&project);
     let result =
-        hairloom_core::project::write_atomic(std::path::Path::new(&path), &bytes, |written| {
+        hairloom_core::io::project::write_atomic(std::path::Path::new(&path), &bytes, |written| {
             println!("wrote {written} of {}", bytes.len());
             let _ = std::io::stdout().flush();
             std::thread::sleep(std::time::Duration::from_millis(pause_ms));

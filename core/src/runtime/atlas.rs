@@ -15,7 +15,7 @@ use std::collections::HashMap;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::mesh::HairMesh;
+use crate::model::mesh::HairMesh;
 
 /// Where one bundle sits on the root slice.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,10 +77,10 @@ impl Atlas {
 
     /// Block coordinates of a root sample as the manifest's sample sets give it: bundle-corner
     /// coordinates for quads ([`Atlas::block_coords`]), barycentric for triangles
-    /// ([`crate::roots::triangle_to_block`]).
+    /// ([`crate::strands::roots::triangle_to_block`]).
     pub fn sample_block_coords(block: &BundleBlock, sample: DVec2) -> (f64, f64) {
         if Self::is_triangle(block) {
-            let q = crate::roots::triangle_to_block(sample);
+            let q = crate::strands::roots::triangle_to_block(sample);
             (q.x, q.y)
         } else {
             Self::block_coords(block, sample.x, sample.y)
@@ -278,7 +278,7 @@ pub fn build_atlas(mesh: &HairMesh, max_region_side: usize) -> Atlas {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
+    use crate::model::mesh::test_meshes::grid;
 
     #[test]
     fn a_grid_shares_texels_and_every_block_sees_its_own_corners() {
@@ -343,7 +343,7 @@ mod tests {
             for (s, t) in [(0.2, 0.7), (0.0, 1.0), (0.9, 0.1)] {
                 let (bs, bt) = Atlas::block_coords(&block, s, t);
                 let weights = Atlas::corner_weights(&block, bs, bt);
-                let expected = crate::curve::FaceCoord { s, t }.weights(4);
+                let expected = crate::geometry::curve::FaceCoord { s, t }.weights(4);
                 for k in 0..4 {
                     assert!(
                         (weights[k] - expected[k]).abs() < 1e-15,

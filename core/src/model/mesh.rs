@@ -2,7 +2,7 @@
 //! bundle of layers, each root vertex owning a column of vertices (seed 000 §2.2).
 //!
 //! This module holds the data and the structural invariants (`validate`). Edits live in
-//! [`crate::edit`], interior-vertex placement in [`crate::interior`].
+//! [`crate::edit`], interior-vertex placement in [`crate::geometry::interior`].
 //!
 //! # Vocabulary
 //! - *layer* `k`: `0` is the root layer (the scalp); layer `k ≥ 1` is the k-th extrusion.
@@ -262,7 +262,7 @@ impl HairMesh {
     /// same bundles, so it lies on no side wall and no tip cap. Every other vertex is
     /// *exterior*: root-layer vertices (the scalp), vertices on the side walls of the volume
     /// (next to a removed or shorter bundle, or on the scalp's rim) and tip-cap vertices.
-    /// Exterior vertices are placed by the user; interior ones by [`crate::interior`].
+    /// Exterior vertices are placed by the user; interior ones by [`crate::geometry::interior`].
     pub fn is_interior(&self, topology: &Topology, column: usize, layer: usize) -> bool {
         if layer == 0 || topology.root_boundary[column] {
             return false;

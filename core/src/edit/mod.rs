@@ -2,7 +2,7 @@
 //!
 //! Every edit is a pure function from a mesh to a new mesh (or an error that leaves the
 //! input untouched). Each one keeps the invariants of [`HairMesh::validate`], re-places
-//! interior vertices of the layers it affected and refreshes w. [`crate::history`] turns the
+//! interior vertices of the layers it affected and refreshes w. [`crate::model::history`] turns the
 //! before/after pair into an undoable command.
 //!
 //! Column vertices are shared by every bundle around the column, so layer insertion and
@@ -10,14 +10,17 @@
 //! the edited layer ([`layer_closure`]); the returned [`EditOutcome`] says which bundles were
 //! affected.
 
+pub mod pick;
+pub mod select;
+
 use std::collections::{BTreeSet, HashMap};
 
 use glam::{DQuat, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::curve::{cubic_point, curve_segments};
-use crate::interior::place_interior;
-use crate::mesh::{Bundle, Column, HairMesh, Topology, VertexRef, WMode};
+use crate::geometry::curve::{cubic_point, curve_segments};
+use crate::geometry::interior::place_interior;
+use crate::model::mesh::{Bundle, Column, HairMesh, Topology, VertexRef, WMode};
 
 /// Why an edit was refused. The mesh is unchanged.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -41,7 +44,7 @@ pub enum EditError {
     #[error("{what} must be finite, got {value}")]
     NotFinite { what: &'static str, value: String },
     #[error("the edit would leave an invalid mesh: {0}")]
-    Invalid(#[from] crate::mesh::InvalidMesh),
+    Invalid(#[from] crate::model::mesh::InvalidMesh),
 }
 
 /// Result of a successful edit.
@@ -836,7 +839,7 @@ pub fn mirror_shape(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
+    use crate::model::mesh::test_meshes::grid;
 
     #[test]
     fn pasting_a_shape_copies_the_centre_path_and_keeps_the_width() {

@@ -9,7 +9,7 @@ use std::collections::BTreeSet;
 
 use glam::DVec3;
 
-use crate::mesh::{HairMesh, Topology, VertexRef};
+use crate::model::mesh::{HairMesh, Topology, VertexRef};
 
 /// A region on the screen, in pixels.
 #[derive(Clone, Debug, PartialEq)]
@@ -313,7 +313,7 @@ pub fn bundle_transform_vertices(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
+    use crate::model::mesh::test_meshes::grid;
 
     /// Looks down the z axis: x, y in model units become pixels ×100.
     fn top_view(p: DVec3) -> Option<[f64; 2]> {

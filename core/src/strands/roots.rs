@@ -16,7 +16,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::random::SplitMix64;
+use crate::strands::random::SplitMix64;
 
 /// Where samples live.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

@@ -15,9 +15,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::document::{BodyMesh, Document};
-use crate::mesh::{Bundle, Column, WMode};
-use crate::styling::StylingSet;
+use crate::model::document::{BodyMesh, Document};
+use crate::model::mesh::{Bundle, Column, WMode};
+use crate::model::styling::StylingSet;
 
 /// Default number of undo steps kept.
 pub const DEFAULT_HISTORY_LIMIT: usize = 200;

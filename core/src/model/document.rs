@@ -5,8 +5,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::mesh::{HairMesh, InvalidMesh};
-use crate::styling::StylingSet;
+use crate::model::mesh::{HairMesh, InvalidMesh};
+use crate::model::styling::StylingSet;
 
 /// A triangle mesh drawn under the hair (the head, the teapot) and used for depth testing.
 /// Positions are `f32` because the body is display-only; the hair mesh is `f64`.

@@ -1,7 +1,7 @@
 //! The f64 reference strand generator: the CPU definition of every strand the GPU draws.
 //!
 //! For each bundle that grows hair, strand `j` takes root sample `j` of the bundle's
-//! progressive sample set ([`crate::roots`]), so fewer strands (LOD) are a prefix of more. A
+//! progressive sample set ([`crate::strands::roots`]), so fewer strands (LOD) are a prefix of more. A
 //! strand of `2^e + 1` vertices samples its curve at evenly spaced `τ ∈ [0, τ_max]` (layer
 //! units), `τ_max = layers · length_fraction`. At each vertex after the root:
 //! 1. the unstyled point comes from [`ReferenceStrand`];
@@ -12,13 +12,12 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::curve::{CurveDefinition, FaceCoord, ReferenceStrand, SegmentForm};
-use crate::document::Document;
-use crate::frames::{Frame, fallback_frame, layer_frames};
-use crate::roots::{SampleDomain, progressive_samples};
-use crate::styling::{
-    StylingInput, StylingParams, apply_twist, strand_length_fraction, styling_offset,
-};
+use crate::geometry::curve::{CurveDefinition, FaceCoord, ReferenceStrand, SegmentForm};
+use crate::geometry::frames::{Frame, fallback_frame, layer_frames};
+use crate::model::document::Document;
+use crate::model::styling::StylingParams;
+use crate::strands::roots::{SampleDomain, progressive_samples};
+use crate::strands::styling::{StylingInput, strand_length_fraction, styling_offset, twist};
 
 /// What to generate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -139,7 +138,7 @@ impl<'a> StrandContext<'a> {
                 let (u, v, w_axis, w) = self.frame_at(bundle, &weights, tau);
                 if let Some(centre) = &centre {
                     let axis_point = centre.point(tau, options.definition, options.form);
-                    p = apply_twist(params, p, axis_point, w_axis, w);
+                    p = twist(params, p, axis_point, w_axis, w);
                 }
                 let input = StylingInput {
                     u,
@@ -264,8 +263,8 @@ pub fn generate_parallel(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
-    use crate::styling::{Clump, Curl, Frizz, LengthVariation, Noise, Twist, Wave};
+    use crate::model::mesh::test_meshes::grid;
+    use crate::model::styling::{Clump, Curl, Frizz, LengthVariation, Noise, Twist, Wave};
 
     fn styled(params: StylingParams) -> Document {
         // Hair-sized: 1 cm quads, three 1 cm layers.

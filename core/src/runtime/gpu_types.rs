@@ -44,8 +44,8 @@ pub struct BundleGpu {
 }
 
 impl BundleGpu {
-    pub fn new(block: &crate::atlas::BundleBlock, styling: u32) -> Self {
-        let triangle = crate::atlas::Atlas::is_triangle(block);
+    pub fn new(block: &crate::runtime::atlas::BundleBlock, styling: u32) -> Self {
+        let triangle = crate::runtime::atlas::Atlas::is_triangle(block);
         Self {
             origin_texel: [block.origin[0] as f32 + 0.5, block.origin[1] as f32 + 0.5],
             layers: block.layers,
@@ -99,7 +99,7 @@ pub struct StrandRoot {
     pub _padding: [u32; 2],
 }
 
-/// One set of styling parameters in f32 (`crate::styling::StylingParams`), flattened.
+/// One set of styling parameters in f32 (`crate::model::styling::StylingParams`), flattened.
 /// Keep in sync with `shaders/strand_gen.wgsl` (`Styling`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -130,8 +130,8 @@ pub struct StylingGpu {
     pub _padding: u32,
 }
 
-impl From<&crate::styling::StylingParams> for StylingGpu {
-    fn from(p: &crate::styling::StylingParams) -> Self {
+impl From<&crate::model::styling::StylingParams> for StylingGpu {
+    fn from(p: &crate::model::styling::StylingParams) -> Self {
         Self {
             curl_radius_m: p.curl.radius_m as f32,
             curl_turns_per_m: p.curl.turns_per_m as f32,
@@ -163,7 +163,7 @@ impl From<&crate::styling::StylingParams> for StylingGpu {
 
 /// The styling array the shader indexes with [`StrandRoot::styling`]: the global
 /// parameters, then every group in order.
-pub fn styling_array(set: &crate::styling::StylingSet) -> Vec<StylingGpu> {
+pub fn styling_array(set: &crate::model::styling::StylingSet) -> Vec<StylingGpu> {
     std::iter::once(&set.global)
         .chain(set.groups.iter().map(|g| &g.params))
         .map(StylingGpu::from)

@@ -15,8 +15,8 @@ use std::path::Path;
 
 use glam::{DMat4, DVec2, DVec3};
 
-use crate::document::BodyMesh;
-use crate::mesh::HairMesh;
+use crate::model::document::BodyMesh;
+use crate::model::mesh::HairMesh;
 
 /// Import settings.
 #[derive(Clone, Debug)]
@@ -89,7 +89,7 @@ pub struct ImportedMesh {
     pub faces: Vec<Vec<u32>>,
     /// uv per face corner.
     pub uvs: Vec<Vec<DVec2>>,
-    /// Whether the file had TEXCOORD_0 (otherwise every uv is zero; see [`crate::uv`]).
+    /// Whether the file had TEXCOORD_0 (otherwise every uv is zero; see [`crate::geometry::uv`]).
     pub has_uv: bool,
     /// Triangles read from the file, before welding and pairing.
     pub source_triangles: usize,

@@ -23,7 +23,7 @@
 
 use glam::{DMat3, DVec3};
 
-use crate::mesh::{HairMesh, Topology};
+use crate::model::mesh::{HairMesh, Topology};
 
 /// Relative strength of the regularisation of the affine fit: directions along which the
 /// exterior's root positions spread less than about `sqrt(FIT_REGULARISATION)` of their
@@ -404,7 +404,7 @@ fn column_interpolation(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
+    use crate::model::mesh::test_meshes::grid;
 
     fn random_affine(seed: u64) -> AffineMap {
         let mut state = seed;

@@ -27,7 +27,7 @@
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::mesh::HairMesh;
+use crate::model::mesh::HairMesh;
 
 /// Which curve a strand follows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -266,7 +266,7 @@ impl ReferenceStrand {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
+    use crate::model::mesh::test_meshes::grid;
 
     #[test]
     fn curve_interpolates_its_points() {

@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::document::Document;
-use crate::history::History;
+use crate::model::document::Document;
+use crate::model::history::History;
 
 /// The project file format this build writes and the newest it reads.
 pub const FORMAT_VERSION: u32 = 1;

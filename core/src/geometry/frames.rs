@@ -17,7 +17,7 @@
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use crate::mesh::HairMesh;
+use crate::model::mesh::HairMesh;
 
 /// uv triangles smaller than this fraction of the largest one around a vertex are skipped.
 pub const MIN_UV_AREA_FRACTION: f64 = 1e-10;
@@ -176,7 +176,7 @@ pub fn fallback_frame(normal: DVec3) -> Frame {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
+    use crate::model::mesh::test_meshes::grid;
 
     fn assert_unit_frame(frame: &Frame) {
         for axis in [frame.u, frame.v, frame.w] {

@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 
-use crate::mesh::HairMesh;
+use crate::model::mesh::HairMesh;
 
 /// Möller–Trumbore: distance along `direction` (unit or not) to the triangle, if hit in front.
 fn ray_triangle(origin: DVec3, direction: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
@@ -66,7 +66,7 @@ pub fn pick_bundle(mesh: &HairMesh, origin: DVec3, direction: DVec3) -> Option<(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::test_meshes::grid;
+    use crate::model::mesh::test_meshes::grid;
 
     #[test]
     fn the_nearest_face_along_the_ray_wins() {

@@ -10,15 +10,17 @@
 //! parameters (wave, curl) are added by the styling stage; the samples here fix the hair
 //! *shape* (the hair mesh).
 
+pub mod teapot;
+
 use glam::DVec3;
 
-use crate::document::{BodyMesh, Document};
 use crate::edit::{ExtrudeDirection, extrude};
-use crate::import::{ImportError, ImportOptions, import_slice};
-use crate::mesh::HairMesh;
-use crate::project::Project;
-use crate::styling::{Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Wave};
-use crate::{interior, uv};
+use crate::geometry::{interior, uv};
+use crate::io::import::{ImportError, ImportOptions, import_slice};
+use crate::io::project::Project;
+use crate::model::document::{BodyMesh, Document};
+use crate::model::mesh::HairMesh;
+use crate::model::styling::{Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Wave};
 
 /// Attribution required by the head scan's licence; shipped in every head sample.
 pub const HEAD_CREDIT: &str = "Head: \"Infinite, 3D Head Scan\" by Lee Perry-Smith, licensed under CC BY 3.0 \
@@ -296,9 +298,9 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
 /// The furry teapot: the teapot tessellated 3×3 per patch, scaled to about 0.3 m across,
 /// with one layer of short fur. (One layer: the teapot is made of open patches whose few
 /// rims say little about a middle layer far from them, see `interior`.)
-pub fn teapot_project(teapot_text: &str) -> Result<Project, crate::teapot::TeapotError> {
-    let patches = crate::teapot::parse(teapot_text)?;
-    let mut scalp = crate::teapot::tessellate(&patches, 3);
+pub fn teapot_project(teapot_text: &str) -> Result<Project, crate::samples::teapot::TeapotError> {
+    let patches = crate::samples::teapot::parse(teapot_text)?;
+    let mut scalp = crate::samples::teapot::tessellate(&patches, 3);
     let scale = 0.3 / 6.4; // the teapot is about 6.4 units from spout to handle
     for column in &mut scalp.columns {
         column.positions[0] *= scale;

@@ -4,7 +4,7 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::mesh::HairMesh;
+use crate::model::mesh::HairMesh;
 
 /// A parse error naming the line.
 #[derive(Debug, thiserror::Error)]

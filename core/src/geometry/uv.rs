@@ -8,7 +8,7 @@
 
 use glam::{DVec2, DVec3};
 
-use crate::mesh::HairMesh;
+use crate::model::mesh::HairMesh;
 
 /// uv of `point` by the azimuthal-equidistant projection described in the module docs.
 /// `reference` fixes φ = 0 (any vector not parallel to `axis`).

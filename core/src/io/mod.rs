@@ -1,0 +1,8 @@
+//! Files in and out: project files, glTF scalp import, and the exports (the runtime bundle
+//! with its KTX2 textures, and strand files for other tools).
+
+pub mod import;
+pub mod ktx2;
+pub mod project;
+pub mod runtime_bundle;
+pub mod strand_files;

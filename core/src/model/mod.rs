@@ -1,0 +1,7 @@
+//! What the artist makes and saves: the hair mesh, the body it grows on, the styling
+//! parameters, and the undo history of commands over them. Nothing here is view state.
+
+pub mod document;
+pub mod history;
+pub mod mesh;
+pub mod styling;

@@ -1,0 +1,397 @@
+//! Styling parameters (seed 000 §3.4): what an artist sets for curl, twist, noise, clump,
+//! frizz, wave and length variation, globally or per group of bundles. The ops these
+//! parameters drive, and their conventions, are in [`crate::strands::styling`].
+
+use serde::{Deserialize, Serialize};
+
+/// Curl: a helix around the strand. Offset
+/// `ramp(w) · r · (cos φ û + sin φ v̂)`, `φ = 2π · turns_per_m · w + 2π · ξ₁`,
+/// `r = radius_m · (1 + radius_jitter · (2ξ₂ − 1))`, `ramp(w) = smoothstep(0, ramp_in_m, w)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Curl {
+    pub radius_m: f64,
+    pub turns_per_m: f64,
+    /// Length over which the curl grows from nothing at the root to full radius.
+    pub ramp_in_m: f64,
+    /// Relative spread of radii between strands, in `[0, 1]`.
+    pub radius_jitter: f64,
+}
+
+impl Default for Curl {
+    fn default() -> Self {
+        Self {
+            radius_m: 0.0,
+            turns_per_m: 20.0,
+            ramp_in_m: 0.02,
+            radius_jitter: 0.3,
+        }
+    }
+}
+
+/// Twist: every strand of a bundle turns about the bundle's centre strand by
+/// `θ = 2π · turns_per_m · w` around ŵ (its distance from the centre is kept).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Twist {
+    pub turns_per_m: f64,
+}
+
+/// Noise: smooth coherent noise along the strand. Offset
+/// `amplitude_m · τ̂ · Σ_o 0.5^o (n(f 2^o w + k_u), n(f 2^o w + k_v))` in (û, v̂), with `n` a
+/// smooth 1D value noise in `[−1, 1]`, `f` = `frequency_per_m` and strand keys `k` from ξ.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Noise {
+    pub amplitude_m: f64,
+    pub frequency_per_m: f64,
+    pub octaves: u32,
+}
+
+impl Default for Noise {
+    fn default() -> Self {
+        Self {
+            amplitude_m: 0.0,
+            frequency_per_m: 10.0,
+            octaves: 2,
+        }
+    }
+}
+
+/// Clump: strands gather toward clump centres scattered over uv (a jittered grid of
+/// `clumps_per_uv` cells per uv unit). The pull is a compact-kernel average toward nearby
+/// centres, continuous everywhere:
+/// `Δ = Σ K_i (c_i − x) / (Σ K_i + ¼)`, `K_i = max(0, 1 − |c_i − x|² / h²)²`, `h` one cell;
+/// offset `strength · τ̂^tightening · radius_m · clumps_per_uv · (Δ.x û + Δ.y v̂)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Clump {
+    /// 0 (no clumping) to 1 (tips meet at the clump centre).
+    pub strength: f64,
+    pub clumps_per_uv: f64,
+    /// Object-space size of one clump cell.
+    pub radius_m: f64,
+    /// Profile exponent along the strand: larger keeps roots spread and tightens only tips.
+    pub tightening: f64,
+}
+
+impl Default for Clump {
+    fn default() -> Self {
+        Self {
+            strength: 0.0,
+            clumps_per_uv: 40.0,
+            radius_m: 0.01,
+            tightening: 1.5,
+        }
+    }
+}
+
+/// Frizz: a fraction of strands (those with ξ₃ < `fraction`) get high-frequency noise that
+/// grows toward the tip: `amplitude_m · τ̂² · (n(f w + k), n(f w + k'))` in (û, v̂).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Frizz {
+    pub amplitude_m: f64,
+    pub frequency_per_m: f64,
+    pub fraction: f64,
+}
+
+impl Default for Frizz {
+    fn default() -> Self {
+        Self {
+            amplitude_m: 0.0,
+            frequency_per_m: 120.0,
+            fraction: 0.2,
+        }
+    }
+}
+
+/// Wave: a planar wave across the strand. Offset
+/// `ramp(w) · amplitude_m · sin(2π · frequency_per_m · w + phase_spread · 2π ξ₄) · d`, with
+/// `d = cos α û + sin α v̂` (`α` = `direction_rad`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Wave {
+    pub amplitude_m: f64,
+    pub frequency_per_m: f64,
+    pub direction_rad: f64,
+    /// 0: neighbouring strands wave together; 1: fully random phases.
+    pub phase_spread: f64,
+    pub ramp_in_m: f64,
+}
+
+impl Default for Wave {
+    fn default() -> Self {
+        Self {
+            amplitude_m: 0.0,
+            frequency_per_m: 8.0,
+            direction_rad: 0.0,
+            phase_spread: 0.15,
+            ramp_in_m: 0.03,
+        }
+    }
+}
+
+/// Length variation: a strand ends at `1 − fraction · ξ₅` of its bundle's length.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct LengthVariation {
+    pub fraction: f64,
+}
+
+/// All styling parameters of one set of bundles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct StylingParams {
+    pub curl: Curl,
+    pub twist: Twist,
+    pub noise: Noise,
+    pub clump: Clump,
+    pub frizz: Frizz,
+    pub wave: Wave,
+    pub length: LengthVariation,
+    /// Cells per uv unit of the per-strand random fields ξ.
+    pub variation_per_uv: f64,
+    pub seed: u32,
+}
+
+impl Default for StylingParams {
+    fn default() -> Self {
+        Self {
+            curl: Curl::default(),
+            twist: Twist::default(),
+            noise: Noise::default(),
+            clump: Clump::default(),
+            frizz: Frizz::default(),
+            wave: Wave::default(),
+            length: LengthVariation::default(),
+            variation_per_uv: 200.0,
+            seed: 1,
+        }
+    }
+}
+
+/// Global parameters with per-group overrides; a bundle uses the last group that lists it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StylingSet {
+    pub global: StylingParams,
+    pub groups: Vec<StylingGroup>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StylingGroup {
+    pub name: String,
+    pub bundles: Vec<u32>,
+    pub params: StylingParams,
+}
+
+impl StylingSet {
+    pub fn params_for(&self, bundle: u32) -> &StylingParams {
+        self.group_of(bundle)
+            .map(|g| &self.groups[g].params)
+            .unwrap_or(&self.global)
+    }
+
+    /// Index of the group whose parameters `bundle` uses (the last that lists it), `None`
+    /// for the global parameters.
+    pub fn group_of(&self, bundle: u32) -> Option<usize> {
+        self.groups
+            .iter()
+            .rposition(|g| g.bundles.contains(&bundle))
+    }
+
+    /// Moves `bundles` into group `group` (`None`: back to the global parameters), out of
+    /// every other group, so each bundle is listed at most once.
+    pub fn assign(&mut self, bundles: &[u32], group: Option<usize>) -> Result<(), String> {
+        if let Some(g) = group
+            && g >= self.groups.len()
+        {
+            return Err(format!(
+                "group {g} does not exist ({} groups)",
+                self.groups.len()
+            ));
+        }
+        for existing in &mut self.groups {
+            existing.bundles.retain(|b| !bundles.contains(b));
+        }
+        if let Some(g) = group {
+            let target = &mut self.groups[g].bundles;
+            target.extend_from_slice(bundles);
+            target.sort_unstable();
+            target.dedup();
+        }
+        Ok(())
+    }
+
+    /// A new group holding `bundles` (taken out of other groups), starting from the
+    /// parameters they use now; returns its index.
+    pub fn new_group(&mut self, name: impl Into<String>, bundles: &[u32]) -> usize {
+        let params = bundles
+            .first()
+            .map_or(&self.global, |&b| self.params_for(b))
+            .clone();
+        self.groups.push(StylingGroup {
+            name: name.into(),
+            bundles: Vec::new(),
+            params,
+        });
+        let index = self.groups.len() - 1;
+        let _ = self.assign(bundles, Some(index));
+        index
+    }
+
+    /// Every number must be finite and every range respected; names the offending field.
+    pub fn validate(&self) -> Result<(), String> {
+        let check = |p: &StylingParams, at: &str| -> Result<(), String> {
+            let values = [
+                ("curl.radius_m", p.curl.radius_m),
+                ("curl.turns_per_m", p.curl.turns_per_m),
+                ("curl.ramp_in_m", p.curl.ramp_in_m),
+                ("curl.radius_jitter", p.curl.radius_jitter),
+                ("twist.turns_per_m", p.twist.turns_per_m),
+                ("noise.amplitude_m", p.noise.amplitude_m),
+                ("noise.frequency_per_m", p.noise.frequency_per_m),
+                ("clump.strength", p.clump.strength),
+                ("clump.clumps_per_uv", p.clump.clumps_per_uv),
+                ("clump.radius_m", p.clump.radius_m),
+                ("clump.tightening", p.clump.tightening),
+                ("frizz.amplitude_m", p.frizz.amplitude_m),
+                ("frizz.frequency_per_m", p.frizz.frequency_per_m),
+                ("frizz.fraction", p.frizz.fraction),
+                ("wave.amplitude_m", p.wave.amplitude_m),
+                ("wave.frequency_per_m", p.wave.frequency_per_m),
+                ("wave.direction_rad", p.wave.direction_rad),
+                ("wave.phase_spread", p.wave.phase_spread),
+                ("wave.ramp_in_m", p.wave.ramp_in_m),
+                ("length.fraction", p.length.fraction),
+                ("variation_per_uv", p.variation_per_uv),
+            ];
+            for (name, value) in values {
+                if !value.is_finite() {
+                    return Err(format!("{at}.{name}: not a finite number"));
+                }
+            }
+            for (name, value) in [
+                ("length.fraction", p.length.fraction),
+                ("frizz.fraction", p.frizz.fraction),
+                ("clump.strength", p.clump.strength),
+            ] {
+                if !(0.0..=1.0).contains(&value) {
+                    return Err(format!("{at}.{name}: {value} is outside [0, 1]"));
+                }
+            }
+            if p.noise.octaves > 8 {
+                return Err(format!(
+                    "{at}.noise.octaves: {} is more than 8",
+                    p.noise.octaves
+                ));
+            }
+            Ok(())
+        };
+        check(&self.global, "global")?;
+        for (i, group) in self.groups.iter().enumerate() {
+            check(&group.params, &format!("groups[{i}].params"))?;
+        }
+        Ok(())
+    }
+}
+
+impl StylingParams {
+    /// Every op on at moderate, hair-sized amplitudes: the set tests and benchmarks use when
+    /// they want all of styling exercised at once.
+    pub fn every_op() -> Self {
+        StylingParams {
+            curl: Curl {
+                radius_m: 0.004,
+                ..Curl::default()
+            },
+            noise: Noise {
+                amplitude_m: 0.003,
+                ..Noise::default()
+            },
+            clump: Clump {
+                strength: 0.7,
+                ..Clump::default()
+            },
+            frizz: Frizz {
+                amplitude_m: 0.002,
+                fraction: 1.0,
+                ..Frizz::default()
+            },
+            wave: Wave {
+                amplitude_m: 0.01,
+                ..Wave::default()
+            },
+            length: LengthVariation { fraction: 0.3 },
+            twist: Twist { turns_per_m: 3.0 },
+            ..StylingParams::default()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn assigning_moves_bundles_between_groups_and_back_to_global() {
+        let mut set = StylingSet::default();
+        set.global.curl.radius_m = 0.002;
+        let a = set.new_group("fringe", &[3, 1, 2]);
+        assert_eq!(set.groups[a].bundles, vec![1, 2, 3]);
+        assert_eq!(
+            set.params_for(1).curl.radius_m,
+            0.002,
+            "starts from what it used"
+        );
+        set.groups[a].params.curl.radius_m = 0.004;
+        let b = set.new_group("crown", &[2, 7]);
+        assert_eq!(
+            set.groups[b].params.curl.radius_m, 0.004,
+            "2 came from the fringe"
+        );
+        assert_eq!(
+            set.groups[a].bundles,
+            vec![1, 3],
+            "a bundle is in one group"
+        );
+        set.assign(&[3, 7], None).expect("to global");
+        assert_eq!(set.group_of(3), None);
+        assert_eq!(set.group_of(7), None);
+        assert_eq!(set.group_of(2), Some(b));
+        let error = set.assign(&[1], Some(5)).expect_err("no group 5");
+        assert!(error.contains("group 5"), "{error}");
+        assert_eq!(
+            set.group_of(1),
+            Some(a),
+            "a refused assignment changes nothing"
+        );
+    }
+
+    #[test]
+    fn groups_override_and_validation_names_fields() {
+        let mut set = StylingSet::default();
+        set.groups.push(StylingGroup {
+            name: "fringe".into(),
+            bundles: vec![3, 4],
+            params: StylingParams::every_op(),
+        });
+        assert_eq!(set.params_for(3), &StylingParams::every_op());
+        assert_eq!(set.params_for(5), &StylingParams::default());
+        assert!(set.validate().is_ok());
+        set.groups[0].params.wave.amplitude_m = f64::NAN;
+        assert_eq!(
+            set.validate().expect_err("nan"),
+            "groups[0].params.wave.amplitude_m: not a finite number"
+        );
+        set.groups[0].params.wave.amplitude_m = 0.0;
+        set.global.length.fraction = 1.5;
+        assert!(
+            set.validate()
+                .expect_err("range")
+                .starts_with("global.length.fraction")
+        );
+    }
+}

@@ -1,0 +1,287 @@
+//! The bundle-level work of a frame (seed 000 §3.6): per bundle, culling against the view
+//! and eq. 7-12 (strand count with thickness compensation, vertex level with morphing),
+//! turned into batches of strand runs that fit the scratch buffer. `render` runs this on the
+//! CPU once per frame and hands the runs to `strand_gen.wgsl`; the formulas themselves are
+//! in [`crate::strands::lod`].
+
+use crate::runtime::gpu_types::StrandRun;
+use crate::strands::lod::{detail_level, strand_count, thickness_factor, vertex_lod};
+
+/// Where one bundle's hair is, from the runtime textures (`RuntimeTextures::bundle_bounds`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BundleBounds {
+    pub centre: glam::Vec3,
+    /// Radius of a sphere around every control point of the bundle (culling, distance).
+    pub radius_m: f32,
+    /// Size of the bundle's root face (longest corner-to-corner distance): the `h` of strand
+    /// LOD, as §3.6.1 suggests ("the bundle's scalp face size").
+    pub root_size_m: f32,
+    /// Length of the bundle's first column curve (control polygon), the `h` of vertex LOD.
+    pub strand_length_m: f32,
+}
+
+/// Level-of-detail switches of a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LodSettings {
+    /// Strand and vertex LOD (eq. 7-12); off draws every strand at full detail.
+    pub enabled: bool,
+    /// Bundles whose bounding sphere is outside the view are skipped.
+    pub cull: bool,
+    pub alpha_strands: f64,
+    pub alpha_vertices: f64,
+    pub lambda: f64,
+}
+
+/// Default α of strand LOD: every strand while a bundle's root face spans ≥ 20 pixels;
+/// below that, strands drop in proportion (and thicken to compensate).
+pub const DEFAULT_ALPHA_STRANDS: f64 = 0.05;
+/// Default α of vertex LOD: full detail while a strand spans ≥ 50 pixels (32 segments:
+/// ~1.5 pixels each); curly styles may want more (seed 000 Fig. 6).
+pub const DEFAULT_ALPHA_VERTICES: f64 = 0.02;
+/// Default morph window λ (eq. 10-12).
+pub const DEFAULT_LAMBDA: f64 = 0.5;
+
+impl Default for LodSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            cull: true,
+            alpha_strands: DEFAULT_ALPHA_STRANDS,
+            alpha_vertices: DEFAULT_ALPHA_VERTICES,
+            lambda: DEFAULT_LAMBDA,
+        }
+    }
+}
+
+/// The camera as LOD sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct LodCamera {
+    pub eye: glam::Vec3,
+    /// Clip space with depth in `[0, 1]` (wgpu).
+    pub view_projection: glam::Mat4,
+    pub fov_y_rad: f32,
+    pub resolution_px: f32,
+}
+
+/// The bundle-level work of one frame: which strands to generate at which detail, split into
+/// batches of at most `batch_vertices` vertices (the scratch buffer's size).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FramePlan {
+    pub batches: Vec<Vec<StrandRun>>,
+    pub strands: usize,
+    pub vertices: usize,
+    pub culled_bundles: usize,
+}
+
+impl FramePlan {
+    /// Vertices of one batch.
+    pub fn batch_vertices(batch: &[StrandRun]) -> usize {
+        batch.last().map_or(0, |r| {
+            (r.vertex_offset + r.strand_count * r.vertex_count) as usize
+        })
+    }
+
+    /// Segments of one batch.
+    pub fn batch_segments(batch: &[StrandRun]) -> usize {
+        batch.last().map_or(0, |r| {
+            (r.segment_offset + r.strand_count * r.vertex_count.saturating_sub(1)) as usize
+        })
+    }
+}
+
+/// Whether a sphere is at least partly inside the view frustum of `view_projection`.
+pub fn sphere_in_view(view_projection: &glam::Mat4, centre: glam::Vec3, radius: f32) -> bool {
+    let m = view_projection.transpose(); // rows of the matrix as columns
+    let (r0, r1, r2, r3) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
+    let point = centre.extend(1.0);
+    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r2, r3 - r2]
+        .iter()
+        .all(|plane| {
+            let length = plane.truncate().length();
+            length.is_nan() || length <= 0.0 || plane.dot(point) / length >= -radius
+        })
+}
+
+/// Eq. 7-12 for every bundle of `per_bundle` strands (roots bundle-major, as
+/// `RuntimeTextures::strand_roots` makes them), full detail `2^max_vertices_log2 + 1`
+/// vertices: culling, strand counts with thickness compensation, vertex levels with morphing.
+pub fn plan_frame(
+    bundles: &[BundleBounds],
+    per_bundle: u32,
+    max_vertices_log2: u32,
+    camera: &LodCamera,
+    settings: &LodSettings,
+    batch_vertices: usize,
+) -> FramePlan {
+    let mut plan = FramePlan::default();
+    let mut batch: Vec<StrandRun> = Vec::new();
+    let (mut vertex_offset, mut segment_offset) = (0u32, 0u32);
+    let full_vertices = (1u32 << max_vertices_log2) + 1;
+    for (index, bounds) in bundles.iter().enumerate() {
+        if settings.cull && !sphere_in_view(&camera.view_projection, bounds.centre, bounds.radius_m)
+        {
+            plan.culled_bundles += 1;
+            continue;
+        }
+        let (strands, vertex_count, gamma, thickness) = if settings.enabled {
+            // Eq. 7 with the minimum distance of the bundle to the camera.
+            let distance = (bounds.centre.distance(camera.eye) - bounds.radius_m).max(0.0) as f64;
+            let (resolution, fov) = (camera.resolution_px as f64, camera.fov_y_rad as f64);
+            let strand_level = detail_level(
+                bounds.root_size_m as f64,
+                resolution,
+                distance,
+                fov,
+                settings.alpha_strands,
+            );
+            let delta = crate::strands::random::hash_to_unit(crate::strands::random::pcg_hash(
+                index as u32,
+            ));
+            let count = strand_count(strand_level, per_bundle, delta);
+            let vertex_level = detail_level(
+                bounds.strand_length_m as f64,
+                resolution,
+                distance,
+                fov,
+                settings.alpha_vertices,
+            );
+            let lod = vertex_lod(vertex_level, max_vertices_log2, settings.lambda);
+            (
+                count,
+                lod.vertex_count(),
+                lod.gamma as f32,
+                thickness_factor(strand_level, per_bundle) as f32,
+            )
+        } else {
+            (per_bundle, full_vertices, 0.0, 1.0)
+        };
+        let mut first_root = index as u32 * per_bundle;
+        let mut remaining = strands;
+        while remaining > 0 {
+            let room = (batch_vertices as u32).saturating_sub(vertex_offset) / vertex_count;
+            if room == 0 {
+                if batch.is_empty() {
+                    // One strand does not fit an empty batch: nothing can be drawn.
+                    return plan;
+                }
+                plan.batches.push(std::mem::take(&mut batch));
+                (vertex_offset, segment_offset) = (0, 0);
+                continue;
+            }
+            let taken = remaining.min(room);
+            batch.push(StrandRun {
+                first_root,
+                strand_count: taken,
+                vertex_count,
+                vertex_offset,
+                segment_offset,
+                gamma,
+                thickness,
+                _padding: 0,
+            });
+            vertex_offset += taken * vertex_count;
+            segment_offset += taken * (vertex_count - 1);
+            plan.strands += taken as usize;
+            plan.vertices += (taken * vertex_count) as usize;
+            first_root += taken;
+            remaining -= taken;
+        }
+    }
+    if !batch.is_empty() {
+        plan.batches.push(batch);
+    }
+    plan
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bundles() -> Vec<BundleBounds> {
+        (0..40)
+            .map(|i| BundleBounds {
+                centre: glam::Vec3::new((i % 8) as f32 * 0.02, (i / 8) as f32 * 0.02, 0.0),
+                radius_m: 0.1,
+                root_size_m: 0.03,
+                strand_length_m: 0.2,
+            })
+            .collect()
+    }
+
+    fn camera(distance: f32, look_away: bool) -> LodCamera {
+        let eye = glam::Vec3::new(0.07, 0.04, distance);
+        let target = if look_away {
+            eye + glam::Vec3::Z
+        } else {
+            glam::Vec3::new(0.07, 0.04, 0.0)
+        };
+        let fov_y_rad = 30f32.to_radians();
+        LodCamera {
+            eye,
+            view_projection: glam::Mat4::perspective_rh(fov_y_rad, 1.0, 0.01, 100.0)
+                * glam::Mat4::look_at_rh(eye, target, glam::Vec3::Y),
+            fov_y_rad,
+            resolution_px: 1000.0,
+        }
+    }
+
+    /// Every run's roots, in order, and the batch bound.
+    fn check_runs(plan: &FramePlan, batch_vertices: usize) -> Vec<u32> {
+        let mut roots = Vec::new();
+        for batch in &plan.batches {
+            assert!(FramePlan::batch_vertices(batch) <= batch_vertices);
+            let (mut vertex, mut segment) = (0, 0);
+            for run in batch {
+                assert_eq!((run.vertex_offset, run.segment_offset), (vertex, segment));
+                vertex += run.strand_count * run.vertex_count;
+                segment += run.strand_count * (run.vertex_count - 1);
+                roots.extend(run.first_root..run.first_root + run.strand_count);
+                assert!(run.gamma.is_finite() && (0.0..=1.0).contains(&run.gamma));
+                assert!(run.thickness >= 1.0);
+            }
+        }
+        roots
+    }
+
+    #[test]
+    fn lod_off_draws_every_strand_at_full_detail_in_bounded_batches() {
+        let settings = LodSettings {
+            enabled: false,
+            ..LodSettings::default()
+        };
+        let plan = plan_frame(&bundles(), 64, 5, &camera(0.5, false), &settings, 1000);
+        assert_eq!(plan.strands, 40 * 64);
+        assert_eq!(plan.vertices, 40 * 64 * 33);
+        // 30 strands of 33 vertices fit a batch of 1000.
+        assert_eq!(plan.batches.len(), (40 * 64usize).div_ceil(30));
+        let roots = check_runs(&plan, 1000);
+        assert_eq!(
+            roots,
+            (0..40 * 64).collect::<Vec<u32>>(),
+            "each root once, in order"
+        );
+    }
+
+    #[test]
+    fn distance_drops_strands_and_vertices_and_culling_drops_bundles() {
+        let settings = LodSettings::default();
+        let near = plan_frame(&bundles(), 64, 5, &camera(0.3, false), &settings, 1 << 20);
+        let far = plan_frame(&bundles(), 64, 5, &camera(20.0, false), &settings, 1 << 20);
+        let away = plan_frame(&bundles(), 64, 5, &camera(0.3, true), &settings, 1 << 20);
+        assert_eq!(near.strands, 40 * 64, "close up, everything");
+        assert!(
+            far.strands < near.strands / 4 && far.strands >= 40,
+            "{}",
+            far.strands
+        );
+        assert!(far.vertices * 8 < near.vertices);
+        assert!(far.batches[0].iter().all(|r| r.thickness > 1.0));
+        assert_eq!((away.strands, away.culled_bundles), (0, 40));
+        check_runs(&far, 1 << 20);
+        // A strand larger than the batch: nothing, not a hang.
+        assert_eq!(
+            plan_frame(&bundles(), 64, 5, &camera(0.3, false), &settings, 10).strands,
+            0
+        );
+    }
+}

@@ -1,0 +1,298 @@
+//! CPU mirror of `shaders/strand_gen.wgsl`: every strand vertex computed from the five
+//! runtime textures exactly as the shader computes it, in f32 (the styling ops in f64, within
+//! the parity bound of `render/tests/strand_gen.rs`). Functions carry the names of the WGSL
+//! functions they mirror: [`fetch`], [`StrandGen::strand_position`], [`strand_root`],
+//! [`StrandGen::styled_vertex`] and [`StrandGen::main`] (the compute entry point, one batch).
+//! The GPU stage that runs the shader is `render/src/renderer/strand_gen.rs`.
+
+use glam::{DVec3, Vec2, Vec3, Vec4};
+
+use crate::model::styling::StylingParams;
+use crate::runtime::gpu_types::{StrandRoot, StrandRun};
+use crate::runtime::hair::strand_root;
+use crate::runtime::textures::{RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
+use crate::strands::styling::{StylingInput, strand_length_fraction, styling_offset, twist};
+
+/// The per-strand values `strand_gen.wgsl` computes once before a strand's vertices.
+#[derive(Clone, Copy, Debug)]
+pub struct StrandInput<'p> {
+    pub root: StrandRoot,
+    pub params: &'p StylingParams,
+    pub root_uv: glam::DVec2,
+    /// Fraction of the bundle's length this strand keeps (length variation).
+    pub length_fraction: f64,
+}
+
+/// Texture filtering as the texture-path mirror performs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Filtering {
+    /// f32 weights (manual filtering in the shader).
+    Exact,
+    /// Weights quantised to 8 fractional bits, as GPU texture units do.
+    Hardware8Bit,
+}
+
+/// Trilinear sample at continuous texel coordinates (texel centres at `i + 0.5`), clamped
+/// to the edge: the CPU mirror of a filtered `textureSampleLevel`.
+pub fn fetch(texture: &Texture3d, coord: Vec3, filtering: Filtering) -> Vec4 {
+    let axis = |c: f32, size: u32| {
+        let x = (c - 0.5).clamp(0.0, (size - 1) as f32);
+        let i0 = (x.floor() as u32).min(size.saturating_sub(2));
+        let mut frac = x - i0 as f32;
+        if filtering == Filtering::Hardware8Bit {
+            frac = (frac * 256.0).round() / 256.0;
+        }
+        let i1 = (i0 + 1).min(size - 1);
+        (i0, i1, frac)
+    };
+    let (x0, x1, fx) = axis(coord.x, texture.width);
+    let (y0, y1, fy) = axis(coord.y, texture.height);
+    let (z0, z1, fz) = axis(coord.z, texture.depth);
+    let lerp = |a: Vec4, b: Vec4, t: f32| a + (b - a) * t;
+    let plane = |z: u32| {
+        let bottom = lerp(texture.get(x0, y0, z), texture.get(x1, y0, z), fx);
+        let top = lerp(texture.get(x0, y1, z), texture.get(x1, y1, z), fx);
+        lerp(bottom, top, fy)
+    };
+    lerp(plane(z0), plane(z1), fz)
+}
+
+/// The texture-path mirror: a strand position computed exactly as the strand-generation
+/// shader will, from the textures alone, in f32.
+pub struct StrandGen<'a> {
+    pub textures: &'a RuntimeTextures,
+    pub filtering: Filtering,
+}
+
+impl StrandGen<'_> {
+    /// Position of the strand of atlas block `block` at block coordinates `(s, t)` and
+    /// curve parameter `tau ∈ [0, layers]` (layer units).
+    pub fn position(&self, block: usize, s: f32, t: f32, tau: f32) -> Vec3 {
+        let block = &self.textures.atlas.blocks[block];
+        let texel = Vec2::new(
+            block.origin[0] as f32 + 0.5 + s,
+            block.origin[1] as f32 + 0.5 + t,
+        );
+        self.strand_position(texel, block.layers, tau)
+    }
+
+    /// Position at root texel coordinates `texel` of a bundle with `layers` layers and curve
+    /// parameter `tau` (mirror: `strand_position` in `strand_gen.wgsl`).
+    pub fn strand_position(&self, texel: Vec2, layers: u32, tau: f32) -> Vec3 {
+        let tau = tau.clamp(0.0, layers.max(1) as f32);
+        let segment = (tau.floor() as u32).min(layers.max(1) - 1);
+        let local = tau - segment as f32;
+        // Which quadratic, and its parameter.
+        let (first_slice, q) = if local < 0.5 {
+            (SLICES_PER_SEGMENT * segment, local * 2.0)
+        } else {
+            (SLICES_PER_SEGMENT * segment + 2, local * 2.0 - 1.0)
+        };
+        let fetch = |slice: f32| {
+            fetch(
+                &self.textures.hair_mesh,
+                texel.extend(slice + 0.5),
+                self.filtering,
+            )
+            .truncate()
+        };
+        let a = fetch(first_slice as f32 + q);
+        let b = fetch(first_slice as f32 + 1.0 + q);
+        a + (b - a) * q + self.textures.position_offset
+    }
+
+    /// The styled strand rooted at `sample` (bundle-corner coordinates for quads, barycentric
+    /// for triangles — the manifest's sample sets) of atlas block `block_index`.
+    pub fn styled_strand_of_sample(
+        &self,
+        block_index: usize,
+        sample: glam::DVec2,
+        vertex_count: usize,
+        params: &StylingParams,
+    ) -> Vec<Vec3> {
+        let block = &self.textures.atlas.blocks[block_index];
+        let root = strand_root(block, [sample.x as f32, sample.y as f32], 0);
+        self.styled_strand(&root, vertex_count, params)
+    }
+
+    /// What `strand_gen.wgsl` computes once per strand before its vertices (its
+    /// `StrandInput`): the root uv and the length fraction. The root uv seeds every
+    /// per-strand random value, so it is always filtered exactly (manual bilinear in the
+    /// shader), even in hardware mode: 8-bit weights must not shift a strand's curl phase or
+    /// clump.
+    pub fn strand_input<'p>(
+        &self,
+        root: &StrandRoot,
+        params: &'p StylingParams,
+    ) -> StrandInput<'p> {
+        let texel = Vec2::from_array(root.texel);
+        let root_uv = fetch(&self.textures.uv, texel.extend(0.5), Filtering::Exact)
+            .truncate()
+            .truncate()
+            .as_dvec2();
+        StrandInput {
+            root: *root,
+            params,
+            root_uv,
+            length_fraction: strand_length_fraction(params, root_uv),
+        }
+    }
+
+    /// Vertex `k` of `n` of a styled strand (mirror: `styled_vertex`): the position from the
+    /// hair-mesh texture, w and û, v̂ from linear fetches between layer slices, then twist and
+    /// the styling offset of [`crate::strands::styling`] (in f64: the GPU's f32 stays within
+    /// the parity bound of `render/tests/strand_gen.rs`).
+    pub fn styled_vertex(&self, input: &StrandInput<'_>, k: usize, n: usize) -> Vec3 {
+        let (root, params) = (&input.root, input.params);
+        let texel = Vec2::from_array(root.texel);
+        let along = k as f64 / (n.max(2) - 1) as f64;
+        let tau = (root.layers as f64 * input.length_fraction * along) as f32;
+        let p = self.strand_position(texel, root.layers, tau);
+        if k == 0 {
+            return p;
+        }
+        let layer_fetch =
+            |texture: &Texture3d| fetch(texture, texel.extend(tau + 0.5), self.filtering);
+        let u = layer_fetch(&self.textures.u)
+            .truncate()
+            .as_dvec3()
+            .try_normalize()
+            .unwrap_or(DVec3::X);
+        let v = layer_fetch(&self.textures.v)
+            .truncate()
+            .as_dvec3()
+            .try_normalize()
+            .unwrap_or(DVec3::Y);
+        let w_axis = u
+            .cross(v)
+            .try_normalize()
+            .unwrap_or_else(|| crate::geometry::frames::fallback_frame(u).v);
+        let w = layer_fetch(&self.textures.w).x as f64;
+        let mut p = p.as_dvec3();
+        if params.twist.turns_per_m != 0.0 {
+            let centre = Vec2::from_array(root.centre_texel);
+            let centre = self.strand_position(centre, root.layers, tau).as_dvec3();
+            p = twist(params, p, centre, w_axis, w);
+        }
+        let styling = StylingInput {
+            u,
+            v,
+            w_axis,
+            root_uv: input.root_uv,
+            w,
+            along,
+        };
+        (p + styling_offset(params, &styling)).as_vec3()
+    }
+
+    /// The styled strand of `root` at `vertex_count` vertices (at least 2).
+    pub fn styled_strand(
+        &self,
+        root: &StrandRoot,
+        vertex_count: usize,
+        params: &StylingParams,
+    ) -> Vec<Vec3> {
+        let input = self.strand_input(root, params);
+        let n = vertex_count.max(2);
+        (0..n).map(|k| self.styled_vertex(&input, k, n)).collect()
+    }
+
+    /// CPU mirror of the `strand_gen` compute stage for one batch: the vertices of every
+    /// run, in scratch order (`run.vertex_offset + strand · vertex_count + k`), with
+    /// `styling[root.styling]` (an out-of-range index uses `styling[0]`, as the shader does)
+    /// and eq. 11 morphing of odd vertices by the run's γ.
+    pub fn main(
+        &self,
+        roots: &[StrandRoot],
+        runs: &[StrandRun],
+        styling: &[&StylingParams],
+    ) -> Vec<Vec3> {
+        let default = StylingParams::default();
+        let mut out = Vec::new();
+        for run in runs {
+            for strand in 0..run.strand_count {
+                let root = &roots[(run.first_root + strand) as usize];
+                let params = styling
+                    .get(root.styling as usize)
+                    .or(styling.first())
+                    .copied()
+                    .unwrap_or(&default);
+                let points = self.styled_strand(root, run.vertex_count as usize, params);
+                let mut points: Vec<DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
+                crate::strands::lod::morph_odd_vertices(&mut points, run.gamma as f64);
+                out.extend(points.iter().map(|p| p.as_vec3()));
+            }
+        }
+        out
+    }
+}
+
+/// One run over the first `root_count` roots at `vertex_count` vertices, no morphing:
+/// generation without LOD, in one batch.
+pub fn full_detail_runs(root_count: usize, vertex_count: u32) -> Vec<StrandRun> {
+    if root_count == 0 {
+        return Vec::new();
+    }
+    vec![StrandRun {
+        first_root: 0,
+        strand_count: root_count as u32,
+        vertex_count,
+        vertex_offset: 0,
+        segment_offset: 0,
+        gamma: 0.0,
+        thickness: 1.0,
+        _padding: 0,
+    }]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::curve::{ReferenceStrand, SegmentForm};
+    use crate::runtime::atlas::Atlas;
+    use crate::runtime::test_meshes::curved_mesh;
+    use crate::runtime::textures::Precision;
+
+    #[test]
+    fn texture_path_matches_the_f64_reference() {
+        let mesh = curved_mesh();
+        let textures = RuntimeTextures::build(&mesh, Precision::F32);
+        let size = 5.0f32;
+        for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
+            let path = StrandGen {
+                textures: &textures,
+                filtering,
+            };
+            let mut worst = 0.0f64;
+            for (index, block) in textures.atlas.blocks.iter().enumerate() {
+                for (s, t) in [(0.0, 0.0), (0.3, 0.7), (0.91, 0.12), (1.0, 1.0), (0.5, 0.5)] {
+                    let weights = Atlas::corner_weights(block, s, t);
+                    let reference =
+                        ReferenceStrand::with_weights(&mesh, block.bundle as usize, weights)
+                            .expect("bundle");
+                    for i in 0..=30 {
+                        let tau = i as f64 / 10.0;
+                        let expected = reference.point(
+                            tau,
+                            crate::geometry::curve::CurveDefinition::ColumnBlend,
+                            SegmentForm::TwoQuadratics,
+                        );
+                        let got = path.position(index, s as f32, t as f32, tau as f32);
+                        worst = worst.max(got.as_dvec3().distance(expected));
+                    }
+                }
+            }
+            match filtering {
+                // f32 rounding only.
+                Filtering::Exact => assert!(worst < 1e-6 * size as f64, "exact: {worst}"),
+                // 8-bit weights: at most half a step (1/512) of the largest texel difference
+                // per axis; this mesh's neighbouring control points are ≤ 1.6 apart.
+                Filtering::Hardware8Bit => {
+                    assert!(worst > 1e-6, "quantisation must show");
+                    assert!(worst < 3.0 * 1.6 / 512.0, "hardware: {worst}");
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,366 @@
+//! The runtime textures of seed 000 Table 1, built from a hair mesh.
+//!
+//! | texture | dim | texel | slices along r |
+//! |---|---|---|---|
+//! | hair mesh | 3D | object-space position | root, then per segment 3 intermediate + 1 layer slice |
+//! | uv | 2D | root uv | — |
+//! | w | 3D | w | one per layer |
+//! | u, v | 3D | styling directions û, v̂ | one per layer |
+//!
+//! Hair-mesh slices of segment `k` (layer `k` → `k+1`): `4k` = `p_k`, `4k+1` = `q0`,
+//! `4k+2` = `m`, `4k+3` = `q1`, `4k+4` = `p_{k+1}`, where `(p_k, q0, m)` and `(m, q1, p_{k+1})`
+//! are the two quadratics of the column's cubic segment (`curve::cubic_to_quadratics`).
+//! A quadratic at parameter `q` is `lerp(fetch(a + q), fetch(a + 1 + q), q)` with `a` its first
+//! slice: two filtered fetches and one lerp.
+//!
+//! Texels are stored as RGBA (3D textures have no 3-channel formats). The `f16` variant stores
+//! positions relative to [`RuntimeTextures::position_offset`] (the bounding-box centre) so that
+//! half precision is spent on the hair, not on the distance from the origin.
+
+use glam::{DVec3, Vec3, Vec4};
+
+use crate::geometry::curve::{cubic_to_quadratics, curve_segments};
+use crate::geometry::frames::layer_frames;
+use crate::model::mesh::HairMesh;
+use crate::runtime::atlas::{Atlas, BundleBlock, build_atlas};
+use crate::runtime::hair::{RootSamples, strand_root};
+use crate::runtime::half::round_to_f16;
+
+/// Slices of the hair-mesh texture per segment (3 intermediate + 1 layer).
+pub const SLICES_PER_SEGMENT: u32 = 4;
+/// Largest region side in the atlas.
+pub const MAX_REGION_SIDE: usize = 64;
+
+/// Texel precision of the 3D position and direction textures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Precision {
+    F32,
+    F16,
+}
+
+/// A 3D texture of RGBA texels, x fastest, then y, then slice.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture3d {
+    pub width: u32,
+    pub height: u32,
+    pub depth: u32,
+    pub texels: Vec<Vec4>,
+}
+
+impl Texture3d {
+    fn new(width: u32, height: u32, depth: u32) -> Self {
+        Self {
+            width,
+            height,
+            depth,
+            texels: vec![Vec4::ZERO; (width * height * depth) as usize],
+        }
+    }
+
+    pub fn index(&self, x: u32, y: u32, z: u32) -> usize {
+        ((z * self.height + y) * self.width + x) as usize
+    }
+
+    pub fn get(&self, x: u32, y: u32, z: u32) -> Vec4 {
+        self.texels[self.index(x, y, z)]
+    }
+
+    fn set(&mut self, x: u32, y: u32, z: u32, value: Vec4) {
+        let i = self.index(x, y, z);
+        self.texels[i] = value;
+    }
+}
+
+/// The five textures plus the layout needed to sample them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RuntimeTextures {
+    pub atlas: Atlas,
+    pub precision: Precision,
+    /// Added back to sampled hair-mesh positions (zero for f32).
+    pub position_offset: Vec3,
+    /// Positions: `1 + 4·max_layers` slices.
+    pub hair_mesh: Texture3d,
+    /// Root uv (x, y used), one slice.
+    pub uv: Texture3d,
+    /// w (x used), `1 + max_layers` slices.
+    pub w: Texture3d,
+    /// û (xyz), `1 + max_layers` slices.
+    pub u: Texture3d,
+    /// v̂ (xyz), `1 + max_layers` slices.
+    pub v: Texture3d,
+}
+
+fn quantize(v: Vec4, precision: Precision) -> Vec4 {
+    match precision {
+        Precision::F32 => v,
+        Precision::F16 => Vec4::new(
+            round_to_f16(v.x),
+            round_to_f16(v.y),
+            round_to_f16(v.z),
+            round_to_f16(v.w),
+        ),
+    }
+}
+
+impl RuntimeTextures {
+    /// Builds every texture for the bundles that grow hair.
+    pub fn build(mesh: &HairMesh, precision: Precision) -> Self {
+        let atlas = build_atlas(mesh, MAX_REGION_SIDE);
+        let max_layers = atlas.blocks.iter().map(|b| b.layers).max().unwrap_or(0);
+        let (width, height) = (atlas.width, atlas.height);
+        let (lo, hi) = mesh.bounds().unwrap_or((DVec3::ZERO, DVec3::ZERO));
+        let offset = match precision {
+            Precision::F32 => DVec3::ZERO,
+            Precision::F16 if lo.is_finite() && hi.is_finite() => (lo + hi) * 0.5,
+            Precision::F16 => DVec3::ZERO,
+        };
+        let mut hair_mesh = Texture3d::new(width, height, 1 + SLICES_PER_SEGMENT * max_layers);
+        let mut uv = Texture3d::new(width, height, 1);
+        let mut w = Texture3d::new(width, height, 1 + max_layers);
+        let mut u = Texture3d::new(width, height, 1 + max_layers);
+        let mut v = Texture3d::new(width, height, 1 + max_layers);
+        let frames: Vec<_> = (0..=max_layers as usize)
+            .map(|k| layer_frames(mesh, k))
+            .collect();
+        let segments: Vec<_> = mesh
+            .columns
+            .iter()
+            .map(|c| curve_segments(&c.positions))
+            .collect();
+        let position = |p: DVec3| quantize((p - offset).as_vec3().extend(0.0), precision);
+        for y in 0..height {
+            for x in 0..width {
+                let Some(source) = atlas.texels[(y * width + x) as usize] else {
+                    continue;
+                };
+                let c = source.column as usize;
+                let column = &mesh.columns[c];
+                uv.set(
+                    x,
+                    y,
+                    0,
+                    Vec4::new(source.uv.x as f32, source.uv.y as f32, 0.0, 0.0),
+                );
+                let last = column.positions.len() - 1;
+                for k in 0..=max_layers as usize {
+                    // Slices past the column's tip repeat the tip (never sampled by a bundle).
+                    let layer = k.min(last);
+                    hair_mesh.set(
+                        x,
+                        y,
+                        SLICES_PER_SEGMENT * k as u32,
+                        position(column.positions[layer]),
+                    );
+                    w.set(
+                        x,
+                        y,
+                        k as u32,
+                        quantize(Vec4::new(column.w[layer] as f32, 0.0, 0.0, 0.0), precision),
+                    );
+                    let frame = frames[layer][c]
+                        .unwrap_or_else(|| crate::geometry::frames::fallback_frame(DVec3::Y));
+                    u.set(
+                        x,
+                        y,
+                        k as u32,
+                        quantize(frame.u.as_vec3().extend(0.0), precision),
+                    );
+                    v.set(
+                        x,
+                        y,
+                        k as u32,
+                        quantize(frame.v.as_vec3().extend(0.0), precision),
+                    );
+                    if k < max_layers as usize {
+                        let base = SLICES_PER_SEGMENT * k as u32;
+                        let [first, second] = match segments[c].get(k) {
+                            Some(segment) => cubic_to_quadratics(segment),
+                            None => [[column.positions[last]; 3]; 2],
+                        };
+                        hair_mesh.set(x, y, base + 1, position(first[1]));
+                        hair_mesh.set(x, y, base + 2, position(first[2]));
+                        hair_mesh.set(x, y, base + 3, position(second[1]));
+                    }
+                }
+            }
+        }
+        Self {
+            atlas,
+            precision,
+            position_offset: offset.as_vec3(),
+            hair_mesh,
+            uv,
+            w,
+            u,
+            v,
+        }
+    }
+
+    /// Roots of the first `per_bundle` samples of `samples` in every bundle, mapped onto
+    /// each bundle's block: the bundle-level work of generation. `styling_of_block` gives a
+    /// block's index into the styling array (0 = global, `g + 1` = group `g`).
+    pub fn strand_roots(
+        &self,
+        samples: &RootSamples,
+        per_bundle: usize,
+        styling_of_block: impl Fn(usize, &BundleBlock) -> u32,
+    ) -> Vec<crate::runtime::gpu_types::StrandRoot> {
+        let per_bundle = per_bundle
+            .min(samples.quad.len())
+            .min(samples.triangle.len());
+        let mut roots = Vec::with_capacity(self.atlas.blocks.len() * per_bundle);
+        for (index, block) in self.atlas.blocks.iter().enumerate() {
+            let set = if Atlas::is_triangle(block) {
+                &samples.triangle
+            } else {
+                &samples.quad
+            };
+            let styling = styling_of_block(index, block);
+            roots.extend(
+                set[..per_bundle]
+                    .iter()
+                    .map(|sample| strand_root(block, *sample, styling)),
+            );
+        }
+        roots
+    }
+
+    /// The control points block `block` samples (positions plus the offset), slice by slice.
+    fn block_points(&self, block: &BundleBlock) -> impl Iterator<Item = (u32, Vec3)> + '_ {
+        let texture = &self.hair_mesh;
+        let slices = (SLICES_PER_SEGMENT * block.layers + 1).min(texture.depth);
+        let xs = block.origin[0]..(block.origin[0] + 2).min(texture.width);
+        let ys = block.origin[1]..(block.origin[1] + 2).min(texture.height);
+        (0..slices).flat_map(move |z| {
+            let xs = xs.clone();
+            ys.clone().flat_map(move |y| {
+                xs.clone()
+                    .map(move |x| (z, texture.get(x, y, z).truncate() + self.position_offset))
+            })
+        })
+    }
+
+    /// Bounding box of every control point the bundles' blocks sample, from the hair-mesh
+    /// texture alone: the same box for a project and for its exported runtime bundle. `None`
+    /// without bundles.
+    pub fn hair_bounds(&self) -> Option<(Vec3, Vec3)> {
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for block in &self.atlas.blocks {
+            for (_, p) in self.block_points(block) {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// Per block: a bounding sphere of its control points and the length of its first
+    /// column's layer polygon — the inputs of strand and vertex LOD.
+    pub fn bundle_bounds(&self) -> Vec<crate::runtime::frame_plan::BundleBounds> {
+        self.atlas
+            .blocks
+            .iter()
+            .map(|block| {
+                let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+                for (_, p) in self.block_points(block) {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+                let centre = (lo + hi) * 0.5;
+                let radius_m = self
+                    .block_points(block)
+                    .map(|(_, p)| p.distance(centre))
+                    .fold(0.0f32, f32::max);
+                let roots: Vec<Vec3> = self
+                    .block_points(block)
+                    .filter(|&(slice, _)| slice == 0)
+                    .map(|(_, p)| p)
+                    .collect();
+                let root_size_m = roots
+                    .iter()
+                    .flat_map(|a| roots.iter().map(move |b| a.distance(*b)))
+                    .fold(0.0f32, f32::max);
+                let (x, y) = (block.origin[0], block.origin[1]);
+                let strand_length_m = (0..block.layers)
+                    .map(|k| {
+                        let at = |layer: u32| {
+                            self.hair_mesh
+                                .get(
+                                    x,
+                                    y,
+                                    (SLICES_PER_SEGMENT * layer).min(self.hair_mesh.depth - 1),
+                                )
+                                .truncate()
+                        };
+                        at(k).distance(at(k + 1))
+                    })
+                    .sum();
+                crate::runtime::frame_plan::BundleBounds {
+                    centre,
+                    radius_m,
+                    root_size_m,
+                    strand_length_m,
+                }
+            })
+            .collect()
+    }
+
+    /// Bytes the five textures take on the GPU: RGBA hair mesh, u and v (4 channels), R w,
+    /// at 4 bytes (f32) or 2 bytes (f16) per channel, and the RG uv-texture, always f32
+    /// (see `export::TexelFormat::for_precision`).
+    pub fn gpu_bytes(&self) -> usize {
+        let channel = match self.precision {
+            Precision::F32 => 4,
+            Precision::F16 => 2,
+        };
+        let texels = |t: &Texture3d| (t.width * t.height * t.depth) as usize;
+        channel
+            * (4 * texels(&self.hair_mesh)
+                + 4 * texels(&self.u)
+                + 4 * texels(&self.v)
+                + texels(&self.w))
+            + 8 * texels(&self.uv)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::runtime::strand_gen::{Filtering, StrandGen};
+    use crate::runtime::test_meshes::curved_mesh;
+
+    #[test]
+    fn f16_textures_round_positions_within_half_precision() {
+        let mesh = curved_mesh();
+        let full = RuntimeTextures::build(&mesh, Precision::F32);
+        let half = RuntimeTextures::build(&mesh, Precision::F16);
+        // Everything halves except the uv-texture, which stays f32.
+        let uv_bytes = 8 * (full.uv.width * full.uv.height) as usize;
+        assert_eq!(
+            (half.gpu_bytes() - uv_bytes) * 2,
+            full.gpu_bytes() - uv_bytes
+        );
+        let exact = StrandGen {
+            textures: &full,
+            filtering: Filtering::Exact,
+        };
+        let rounded = StrandGen {
+            textures: &half,
+            filtering: Filtering::Exact,
+        };
+        let extent = 4.0f32; // largest |p − centre| component is below 4 here
+        let mut worst = 0.0f32;
+        for index in 0..full.atlas.blocks.len() {
+            for i in 0..=12 {
+                let tau = i as f32 / 4.0;
+                worst = worst.max(
+                    exact
+                        .position(index, 0.4, 0.6, tau)
+                        .distance(rounded.position(index, 0.4, 0.6, tau)),
+                );
+            }
+        }
+        assert!(worst > 0.0 && worst < extent * 2f32.powi(-10), "{worst}");
+    }
+}
