@@ -22,7 +22,7 @@ use hairloom_core::strands::roots::{SampleDomain, progressive_samples};
 const CURVE_VERTICES: usize = 33;
 
 fn default_project() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/samples/head_long_wavy.hairloom")
+    hairloom_core::samples::default_sample_path()
 }
 
 fn load(project: Option<PathBuf>) -> anyhow::Result<(PathBuf, hairloom_core::Project)> {

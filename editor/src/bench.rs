@@ -52,6 +52,19 @@ pub enum Which {
         #[arg(long, default_value_t = 3)]
         runs: usize,
     },
+    /// Edit-to-frame latency in the editor's viewport setting: a styling slider tick through
+    /// a full rebuild and re-upload (the old path) and through the in-place styling update
+    /// (the new one), a vertex drag (mesh edit, rebuild, upload), and a frame alone; each from
+    /// the edit to the frame's pixels read back, median of `runs`.
+    Edit {
+        #[arg(long)]
+        project: Option<std::path::PathBuf>,
+        /// Frame size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "960x720")]
+        size: String,
+        #[arg(long, default_value_t = 9)]
+        runs: usize,
+    },
     /// Styled strand vertices per second on all cores at 10K and 100K strands.
     Cpu {
         #[arg(long)]
@@ -68,6 +81,11 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             strands,
         } => crate::accuracy::run(project, &out, strands.max(1)),
         Which::Cpu { project } => crate::accuracy::cpu(project),
+        Which::Edit {
+            project,
+            size,
+            runs,
+        } => edit_latency(project, &size, runs.max(1)),
         Which::Gpu {
             project,
             vertices_log2,
@@ -230,10 +248,7 @@ fn gpu(
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
     use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
-    let path = project.unwrap_or_else(|| {
-        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("../assets/samples/head_long_wavy.hairloom")
-    });
+    let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = hairloom_editor::render::parse_size(size)?;
     let document = hairloom_core::io::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
@@ -432,6 +447,144 @@ fn gpu(
     );
     println!(
         "memory: textures + bundle placements + root samples + styling on the GPU (stored: the vertex buffer); mem ratio: stored vertex bytes ÷ this memory."
+    );
+    Ok(())
+}
+
+/// See [`Which::Edit`].
+fn edit_latency(
+    project: Option<std::path::PathBuf>,
+    size: &str,
+    runs: usize,
+) -> anyhow::Result<()> {
+    use hairloom_core::runtime::frame_plan::LodSettings;
+    use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+    use hairloom_core::runtime::strand_gen::Filtering;
+    use hairloom_render::device::{GpuContext, describe};
+    use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
+    use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
+    let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
+    let (width, height) = hairloom_editor::render::parse_size(size)?;
+    let mut document = hairloom_core::io::project::load(&path)?.document;
+    let context = GpuContext::new_headless()?;
+    let generator = StrandGenRenderer::new(&context);
+    let preview = PreviewRenderer::new(&context);
+    // What the viewport draws by default.
+    let view = hairloom_editor::app::viewport::ViewSettings::default();
+    let options = RuntimeOptions {
+        precision: view.precision,
+        strands_per_bundle: view.strands_per_bundle,
+        ..RuntimeOptions::default()
+    };
+    let vertex_count = (1u32 << hairloom_editor::render::PREVIEW_VERTICES_LOG2) + 1;
+    let mut hair = RuntimeHair::from_document(&document, &options);
+    let mut gpu = generator.upload(&context, &hair);
+    let bounds = hair
+        .textures
+        .hair_bounds()
+        .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
+    let pad = (bounds.1 - bounds.0) * 0.05;
+    let camera = Camera::framing(
+        bounds.0 - pad,
+        bounds.1 + pad,
+        glam::Vec3::new(0.75, 0.25, 1.0),
+    );
+    let frame = |gpu: &GpuHair, body: &hairloom_core::BodyMesh| -> anyhow::Result<()> {
+        let scene = hairloom_editor::render::default_scene(
+            body,
+            HairSource::Generated {
+                generator: &generator,
+                hair: gpu,
+                filtering: Filtering::Exact,
+                lod: LodSettings::default(),
+            },
+            vertex_count,
+            bounds,
+            camera,
+        );
+        let plan = preview.plan(&scene, width, height);
+        preview.render(&context, &scene, &plan, width, height)?;
+        Ok(())
+    };
+    frame(&gpu, &hair.body)?; // warm-up: pipelines, first allocations
+    let timed = |mut step: Box<dyn FnMut(usize) -> anyhow::Result<()> + '_>| {
+        let mut samples = Vec::with_capacity(runs);
+        for run in 0..runs {
+            let start = Instant::now();
+            step(run)?;
+            samples.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        anyhow::Ok(median(samples))
+    };
+    let frame_only = timed(Box::new(|_| frame(&gpu, &hair.body)))?;
+    let curl = |run: usize| 0.002 + 0.0001 * run as f64;
+    let mut styled = document.clone();
+    let rebuild = timed(Box::new(|run| {
+        styled.styling.global.curl.radius_m = curl(run);
+        let hair = RuntimeHair::from_document(&styled, &options);
+        let gpu = generator.upload(&context, &hair);
+        frame(&gpu, &hair.body)
+    }))?;
+    let in_place = timed(Box::new(|run| {
+        document.styling.global.curl.radius_m = curl(run);
+        hair.set_styling(&document.styling);
+        generator.update_styling(&context, &mut gpu, &hair);
+        frame(&gpu, &hair.body)
+    }))?;
+    let topology = Topology::build(&document.hair_mesh);
+    let vertex = document
+        .hair_mesh
+        .columns
+        .iter()
+        .enumerate()
+        .find_map(|(c, column)| {
+            let k = column.positions.len() - 1;
+            (k > 0 && !document.hair_mesh.is_interior(&topology, c, k)).then_some(VertexRef {
+                column: c as u32,
+                layer: k as u32,
+            })
+        })
+        .ok_or_else(|| anyhow::anyhow!("no exterior tip vertex to drag"))?;
+    let mut dragged = document.clone();
+    let drag = timed(Box::new(|run| {
+        let outcome = transform_vertices(
+            &document.hair_mesh,
+            &[vertex],
+            VertexTransform::Translate {
+                offset: [0.0, 0.0005 * (run + 1) as f64, 0.0],
+            },
+            0.0,
+        )?;
+        dragged.hair_mesh = outcome.mesh;
+        let hair = RuntimeHair::from_document(&dragged, &options);
+        let gpu = generator.upload(&context, &hair);
+        frame(&gpu, &hair.body)
+    }))?;
+    println!(
+        "edit-to-frame latency, {} ({} strands per bundle, {width}x{height}); {}; adapter {}",
+        path.display(),
+        options.strands_per_bundle,
+        machine(),
+        describe(&context.adapter_info)
+    );
+    println!("{:<46} {:>10} {:>10}", "edit", "median ms", "vs before");
+    println!(
+        "{:<46} {:>10.2} {:>10}",
+        "styling slider, rebuild + re-upload (before)", rebuild, "1.00×"
+    );
+    println!(
+        "{:<46} {:>10.2} {:>9.2}×",
+        "styling slider, styling buffers in place (now)",
+        in_place,
+        in_place / rebuild
+    );
+    println!(
+        "{:<46} {:>10.2} {:>10}",
+        "vertex drag, edit + rebuild + re-upload", drag, "(same)"
+    );
+    println!(
+        "{:<46} {:>10.2} {:>10}",
+        "frame alone (no edit)", frame_only, ""
     );
     Ok(())
 }

@@ -119,11 +119,19 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
         }
     }
 
-    // A styling slider changes the picture on the next frame.
+    // A styling slider changes the picture on the next frame, by rewriting the styling
+    // buffers in place: no texture rebuild, no re-upload.
+    let before = harness.state().viewport.uploads;
     harness
         .get_by_role_and_label(Role::Slider, "Curl radius")
         .set_value_accesskit(0.01);
     let curled = viewport_image(&mut harness);
+    let after = harness.state().viewport.uploads;
+    assert_eq!(
+        after.full, before.full,
+        "a styling edit re-uploaded the hair"
+    );
+    assert!(after.styling > before.styling, "{before:?} -> {after:?}");
     let change = common::mean_error(&image, &curled);
     assert!(
         change > 1.0,

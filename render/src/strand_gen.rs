@@ -13,7 +13,7 @@ use hairloom_core::runtime::gpu_types::{
 };
 use hairloom_core::runtime::hair::RuntimeHair;
 use hairloom_core::runtime::strand_gen::Filtering;
-use hairloom_core::runtime::textures::{Precision, Texture3d};
+use hairloom_core::runtime::textures::{Precision, RuntimeTextures, Texture3d};
 use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, read_buffer};
@@ -173,6 +173,33 @@ fn upload_texture(
     )
 }
 
+/// One placement per atlas block with its styling index (never empty: a storage buffer
+/// cannot be).
+fn bundle_placements(textures: &RuntimeTextures, block_styling: &[u32]) -> Vec<BundleGpu> {
+    let mut bundles: Vec<BundleGpu> = textures
+        .atlas
+        .blocks
+        .iter()
+        .enumerate()
+        .map(|(i, block)| BundleGpu::new(block, block_styling.get(i).copied().unwrap_or(0)))
+        .collect();
+    if bundles.is_empty() {
+        bundles.push(BundleGpu::default());
+    }
+    bundles
+}
+
+/// The styling array, or the default parameters when it is empty.
+fn styling_or_default(styling: Vec<StylingGpu>) -> Vec<StylingGpu> {
+    if styling.is_empty() {
+        vec![StylingGpu::from(
+            &hairloom_core::model::styling::StylingParams::default(),
+        )]
+    } else {
+        styling
+    }
+}
+
 impl StrandGenRenderer {
     pub fn new(context: &GpuContext) -> Self {
         let device = &context.device;
@@ -280,8 +307,6 @@ impl StrandGenRenderer {
         let (textures, samples) = (&hair.textures, &hair.samples);
         let per_bundle = hair.strands_per_bundle as usize;
         let block_styling = &hair.block_styling;
-        let styling = styling_array(&hair.styling);
-        let styling = &styling[..];
         let precision = textures.precision;
         let (hair_mesh, a) =
             upload_texture(context, "hair_mesh", &textures.hair_mesh, precision, 4);
@@ -295,23 +320,15 @@ impl StrandGenRenderer {
                 .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(label),
                     contents,
-                    usage: wgpu::BufferUsages::STORAGE,
+                    // COPY_DST: styling edits rewrite the bundle and styling buffers in place.
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 })
         };
         let per_bundle = per_bundle
             .min(samples.quad.len())
             .min(samples.triangle.len());
-        let mut bundles: Vec<BundleGpu> = textures
-            .atlas
-            .blocks
-            .iter()
-            .enumerate()
-            .map(|(i, block)| BundleGpu::new(block, block_styling.get(i).copied().unwrap_or(0)))
-            .collect();
-        let block_count = bundles.len();
-        if bundles.is_empty() {
-            bundles.push(BundleGpu::default());
-        }
+        let bundles = bundle_placements(textures, block_styling);
+        let block_count = textures.atlas.blocks.len();
         let sample_set = per_bundle.max(1);
         let mut sample_data: Vec<[f32; 2]> = Vec::with_capacity(2 * sample_set);
         for set in [&samples.quad, &samples.triangle] {
@@ -321,14 +338,8 @@ impl StrandGenRenderer {
                 [0.0; 2],
             );
         }
-        let default_styling = [StylingGpu::from(
-            &hairloom_core::model::styling::StylingParams::default(),
-        )];
-        let styling_bytes: &[u8] = bytemuck::cast_slice(if styling.is_empty() {
-            &default_styling
-        } else {
-            styling
-        });
+        let styling = styling_or_default(styling_array(&hair.styling));
+        let styling_bytes: &[u8] = bytemuck::cast_slice(&styling);
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         GpuHair {
@@ -351,6 +362,31 @@ impl StrandGenRenderer {
                 + d
                 + e
                 + (bundle_bytes.len() + sample_bytes.len() + styling_bytes.len()) as u64,
+        }
+    }
+
+    /// Takes `hair`'s styling (parameters and group assignments) into `gpu` without touching
+    /// its textures or samples: the bundle and styling buffers are rewritten in place (the
+    /// styling buffer is replaced only when groups were added). What a styling-only edit
+    /// costs; `hair` must be the asset `gpu` was uploaded from, restyled.
+    pub fn update_styling(&self, context: &GpuContext, gpu: &mut GpuHair, hair: &RuntimeHair) {
+        let bundles = bundle_placements(&hair.textures, &hair.block_styling);
+        context
+            .queue
+            .write_buffer(&gpu.bundle_buffer, 0, bytemuck::cast_slice(&bundles));
+        let styling = styling_or_default(styling_array(&hair.styling));
+        let bytes: &[u8] = bytemuck::cast_slice(&styling);
+        if bytes.len() as u64 <= gpu.styling.size() {
+            context.queue.write_buffer(&gpu.styling, 0, bytes);
+        } else {
+            gpu.bytes += bytes.len() as u64 - gpu.styling.size();
+            gpu.styling = context
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("strand_gen_styling"),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                });
         }
     }
 

@@ -260,3 +260,48 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
     eprintln!("LOD runs: max |GPU − CPU mirror| = {worst:.3e} (size {size:.3})");
     assert!(worst <= 1e-5 * size, "{worst}");
 }
+
+#[test]
+fn restyling_in_place_generates_what_a_fresh_upload_does() {
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let renderer = StrandGenRenderer::new(&context);
+    let mut document = sample("head_curly");
+    let options = RuntimeOptions {
+        strands_per_bundle: 8,
+        ..RuntimeOptions::default()
+    };
+    let mut runtime = RuntimeHair::from_document(&document, &options);
+    let mut gpu = renderer.upload(&context, &runtime);
+    // Other parameters and a new group (a longer styling array than was uploaded).
+    document.styling.global.curl.radius_m = 0.007;
+    document.styling.groups.push(StylingGroup {
+        name: "fringe".into(),
+        bundles: vec![0, 3, 4],
+        params: StylingParams::every_op(),
+    });
+    runtime.set_styling(&document.styling);
+    renderer.update_styling(&context, &mut gpu, &runtime);
+    let fresh = renderer.upload(&context, &RuntimeHair::from_document(&document, &options));
+    let plan = full_detail_plan(gpu.root_count, 9);
+    let restyled = renderer
+        .generate_positions(&context, &gpu, &plan, Filtering::Exact)
+        .expect("restyled");
+    let uploaded = renderer
+        .generate_positions(&context, &fresh, &plan, Filtering::Exact)
+        .expect("fresh");
+    assert_eq!(restyled, uploaded);
+    let unstyled = renderer
+        .generate_positions(
+            &context,
+            &renderer.upload(
+                &context,
+                &RuntimeHair::from_document(&sample("head_curly"), &options),
+            ),
+            &plan,
+            Filtering::Exact,
+        )
+        .expect("unstyled");
+    assert_ne!(restyled, unstyled, "the new styling must show");
+}

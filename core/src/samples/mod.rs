@@ -22,6 +22,17 @@ use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::HairMesh;
 use crate::model::styling::{Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Wave};
 
+/// The sample every tool opens when none is named (the editor embeds the same file).
+pub const DEFAULT_SAMPLE: &str = "head_long_wavy.hairloom";
+
+/// Where [`DEFAULT_SAMPLE`] lives in the source tree (`assets/samples/`), for the CLI's
+/// benchmarks and measurements.
+pub fn default_sample_path() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/samples")
+        .join(DEFAULT_SAMPLE)
+}
+
 /// Attribution required by the head scan's licence; shipped in every head sample.
 pub const HEAD_CREDIT: &str = "Head: \"Infinite, 3D Head Scan\" by Lee Perry-Smith, licensed under CC BY 3.0 \
 (https://creativecommons.org/licenses/by/3.0/), based on a work at www.triplegangers.com.";

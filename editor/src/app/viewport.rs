@@ -209,7 +209,20 @@ impl Projector {
 struct UploadedHair {
     gpu: GpuHair,
     bounds: (Vec3, Vec3),
-    body: hairloom_core::model::document::BodyMesh,
+    /// The asset on the CPU (its body is drawn; its styling is restyled in place).
+    hair: RuntimeHair,
+    /// The hair mesh the textures were built from: a change that leaves it (and the body)
+    /// alone is styling only.
+    mesh: hairloom_core::HairMesh,
+}
+
+/// Uploads of the hair since the viewport was made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct UploadCounts {
+    /// Textures, samples, placements and styling built and uploaded.
+    pub full: u64,
+    /// Only the styling buffers rewritten (a styling-only edit).
+    pub styling: u64,
 }
 
 /// GPU resources of the viewport (absent without a wgpu device).
@@ -239,6 +252,8 @@ pub struct Viewport {
     pub orbit: Orbit,
     pub settings: ViewSettings,
     uploaded: Option<(u64, ViewSettings)>,
+    /// How often the hair went to the GPU, whole or restyled (tests count them).
+    pub uploads: UploadCounts,
     drawn: Option<DrawnKey>,
     /// Strands and vertices of the last frame, after culling and LOD.
     pub drawn_strands: usize,
@@ -339,6 +354,7 @@ impl Viewport {
             orbit: Orbit::default(),
             settings: ViewSettings::default(),
             uploaded: None,
+            uploads: UploadCounts::default(),
             drawn: None,
             drawn_strands: 0,
             drawn_vertices: 0,
@@ -569,19 +585,41 @@ impl Viewport {
         };
         let key = (state.revision, settings);
         if self.uploaded != Some(key) {
-            let hair = RuntimeHair::from_document(
-                state.document(),
-                &RuntimeOptions {
-                    precision: self.settings.precision,
-                    strands_per_bundle: self.settings.strands_per_bundle,
-                    ..RuntimeOptions::default()
-                },
-            );
-            gpu.hair = hair.textures.hair_bounds().map(|bounds| UploadedHair {
-                gpu: gpu.generator.upload(&gpu.context, &hair),
-                bounds,
-                body: hair.body,
-            });
+            let document = state.document();
+            // A styling-only change (same hair mesh, body and view settings) rewrites the
+            // styling buffers in place: no texture rebuild, no re-upload.
+            let restyle = match (&mut gpu.hair, self.uploaded) {
+                (Some(uploaded), Some((_, uploaded_settings)))
+                    if uploaded_settings == settings
+                        && uploaded.mesh == document.hair_mesh
+                        && uploaded.hair.body == document.body =>
+                {
+                    uploaded.hair.set_styling(&document.styling);
+                    gpu.generator
+                        .update_styling(&gpu.context, &mut uploaded.gpu, &uploaded.hair);
+                    true
+                }
+                _ => false,
+            };
+            if restyle {
+                self.uploads.styling += 1;
+            } else {
+                let hair = RuntimeHair::from_document(
+                    document,
+                    &RuntimeOptions {
+                        precision: self.settings.precision,
+                        strands_per_bundle: self.settings.strands_per_bundle,
+                        ..RuntimeOptions::default()
+                    },
+                );
+                gpu.hair = hair.textures.hair_bounds().map(|bounds| UploadedHair {
+                    gpu: gpu.generator.upload(&gpu.context, &hair),
+                    bounds,
+                    hair,
+                    mesh: document.hair_mesh.clone(),
+                });
+                self.uploads.full += 1;
+            }
             self.uploaded = Some(key);
             self.drawn = None;
         }
@@ -603,7 +641,7 @@ impl Viewport {
                     let (lo, hi) = hair.bounds;
                     self.camera_bounds = Some(hair.bounds);
                     let scene = default_scene(
-                        &hair.body,
+                        &hair.hair.body,
                         HairSource::Generated {
                             generator: &gpu.generator,
                             hair: &hair.gpu,
