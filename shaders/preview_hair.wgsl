@@ -4,8 +4,8 @@
 // strand); each segment is two triangles (6 vertices). Tangents follow eq. 5-6 (ends mirror
 // their neighbour about the end segment), so shading holds when vertex LOD changes counts;
 // ribbon width grows by the run's thickness factor (eq. 8 compensation).
-// Structs: keep in sync with render/src/preview.rs (`HairUniforms`) and
-// core/src/gpu_types.rs (`StrandRun`).
+// Structs: keep in sync with render/src/preview.rs (`HairUniforms`); `StrandRun` is in
+// shaders/shared/strand_run.wgsl.
 
 struct HairUniforms {
     view_projection: mat4x4<f32>,
@@ -18,16 +18,7 @@ struct HairUniforms {
     batch: vec4<u32>,
 }
 
-struct StrandRun {
-    first_root: u32,
-    strand_count: u32,
-    vertex_count: u32,
-    vertex_offset: u32,
-    segment_offset: u32,
-    gamma: f32,
-    thickness: f32,
-    _padding: u32,
-}
+// struct StrandRun: shaders/shared/strand_run.wgsl, prepended by render/src/.
 
 @group(0) @binding(0) var<uniform> hair: HairUniforms;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
@@ -63,7 +54,7 @@ fn safe_normalize(v: vec3<f32>) -> vec3<f32> {
     return v * inverseSqrt(length_squared);
 }
 
-// Eq. 5-6 (mirror: hairloom_core::lod::tangents): inner vertices use p[k+1] − p[k−1]; an end
+// Eq. 5-6 (mirror: core/src/runtime/preview_hair.rs; f64 definition: strands::lod::tangents): inner vertices use p[k+1] − p[k−1]; an end
 // reflects its neighbour's tangent about the end segment.
 fn strand_tangent(base: u32, k: u32, n: u32) -> vec3<f32> {
     if n == 2u {

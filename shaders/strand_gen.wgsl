@@ -6,16 +6,16 @@
 //   layer slices;
 // - styling ops (twist, curl, noise, clump, frizz, wave, length variation) seeded by the
 //   root uv; an op whose amplitude is zero costs nothing.
-// CPU mirror: hairloom_core::runtime::TexturePath::strand_gen (same steps; its styling
+// CPU mirror: core/src/runtime/strand_gen.rs, `StrandGen::main` (same steps; its styling
 // arithmetic is f64, this is f32).
 // Roots are never stored per strand: root `i` is sample `i % per_bundle` of bundle
-// `i / per_bundle`, placed on the bundle's block (mirror: runtime::strand_root).
+// `i / per_bundle`, placed on the bundle's block (mirror: runtime::hair::strand_root).
 // Work arrives as runs (bundle-level work: culling, strand and vertex LOD, done per frame):
 // consecutive strands of one bundle at one vertex count. Output:
 // `positions[run.vertex_offset + strand * run.vertex_count + k]` = (position, along), one
 // bounded scratch buffer per batch of runs; odd vertices morph toward their neighbours'
 // midpoint by the run's γ (eq. 11).
-// Structs: keep in sync with core/src/gpu_types.rs.
+// Structs: keep in sync with core/src/runtime/gpu_types.rs.
 
 struct StrandGenParams {
     position_offset: vec4<f32>,
@@ -37,16 +37,7 @@ struct BundleGpu {
     _padding: vec2<u32>,
 }
 
-struct StrandRun {
-    first_root: u32,
-    strand_count: u32,
-    vertex_count: u32,
-    vertex_offset: u32,
-    segment_offset: u32,
-    gamma: f32,
-    thickness: f32,
-    _padding: u32,
-}
+// struct StrandRun: shaders/shared/strand_run.wgsl, prepended by render/src/.
 
 struct StrandRoot {
     texel: vec2<f32>,
@@ -86,7 +77,7 @@ struct Styling {
 const SLICES_PER_SEGMENT: u32 = 4u;
 const FILTERING_EXACT: u32 = 0u;
 const TAU: f32 = 6.283185307179586;
-// Mirror: NOISE_KEY_SPAN in core/src/styling.rs.
+// Mirror: NOISE_KEY_SPAN in core/src/strands/styling.rs.
 const NOISE_KEY_SPAN: f32 = 16.0;
 
 @group(0) @binding(0) var<uniform> params: StrandGenParams;
@@ -138,7 +129,7 @@ fn fetch(texture: texture_3d<f32>, coord: vec3<f32>) -> vec4<f32> {
     return textureSampleLevel(texture, linear_clamp, coord / size, 0.0);
 }
 
-// Mirror: TexturePath::position_at.
+// Mirror: StrandGen::strand_position.
 fn strand_position(texel: vec2<f32>, layers: u32, tau_in: f32) -> vec3<f32> {
     let layer_count = max(layers, 1u);
     let tau = clamp(tau_in, 0.0, f32(layer_count));
@@ -155,7 +146,7 @@ fn strand_position(texel: vec2<f32>, layers: u32, tau_in: f32) -> vec3<f32> {
     return a + (b - a) * q + params.position_offset.xyz;
 }
 
-// --- Deterministic randomness (mirror: core/src/random.rs, core/src/styling.rs) ---
+// --- Deterministic randomness (mirror: core/src/strands/random.rs, core/src/strands/styling.rs) ---
 
 fn pcg_hash(value: u32) -> u32 {
     let state = value * 747796405u + 2891336453u;
@@ -380,7 +371,7 @@ struct StrandInput {
     length_fraction: f32,
 }
 
-// Vertex k of n of a styled strand (mirror: TexturePath::styled_strand_at).
+// Vertex k of n of a styled strand (mirror: StrandGen::styled_vertex).
 fn styled_vertex(input: StrandInput, k: u32, n: u32) -> vec3<f32> {
     let root = input.root;
     let s = input.style;

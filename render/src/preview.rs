@@ -16,7 +16,10 @@ use crate::device::{GpuContext, PassTimer, read_buffer, submit_timed};
 use crate::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
 use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
 
-pub const HAIR_SHADER: &str = include_str!("../../shaders/preview_hair.wgsl");
+pub const HAIR_SHADER: &str = concat!(
+    include_str!("../../shaders/shared/strand_run.wgsl"),
+    include_str!("../../shaders/preview_hair.wgsl")
+);
 pub const BODY_SHADER: &str = include_str!("../../shaders/preview_body.wgsl");
 
 const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;

@@ -18,8 +18,12 @@ use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, read_buffer};
 
-/// The WGSL source, validated by naga in `cargo test`.
-pub const SHADER_SOURCE: &str = include_str!("../../shaders/strand_gen.wgsl");
+/// The WGSL source: `shaders/shared/strand_run.wgsl` then `shaders/strand_gen.wgsl`
+/// (validated by naga in `cargo test`).
+pub const SHADER_SOURCE: &str = concat!(
+    include_str!("../../shaders/shared/strand_run.wgsl"),
+    include_str!("../../shaders/strand_gen.wgsl")
+);
 
 /// Why generation failed.
 #[derive(Debug, thiserror::Error)]

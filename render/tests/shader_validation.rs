@@ -3,21 +3,29 @@
 
 use std::path::Path;
 
-fn shaders() -> Vec<(String, String)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
-    let mut out: Vec<(String, String)> = std::fs::read_dir(&dir)
-        .expect("shaders/ exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
-        .map(|p| {
-            (
-                p.display().to_string(),
-                std::fs::read_to_string(&p).expect("read shader"),
-            )
-        })
-        .collect();
+/// Every `.wgsl` file under `dir` (recursively), sorted by path.
+fn wgsl_files(dir: &Path) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).expect("shaders/ exists") {
+        let path = entry.expect("dir entry").path();
+        if path.is_dir() {
+            out.extend(wgsl_files(&path));
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            let source = std::fs::read_to_string(&path).expect("read shader");
+            out.push((path.display().to_string(), source));
+        }
+    }
     out.sort();
     out
+}
+
+/// The sources the renderer compiles: each shader with the shared files it includes.
+fn embedded() -> [(&'static str, &'static str); 3] {
+    [
+        ("strand_gen", hairloom_render::strand_gen::SHADER_SOURCE),
+        ("preview_hair", hairloom_render::preview::HAIR_SHADER),
+        ("preview_body", hairloom_render::preview::BODY_SHADER),
+    ]
 }
 
 fn parse(name: &str, source: &str) -> naga::Module {
@@ -34,17 +42,23 @@ fn parse(name: &str, source: &str) -> naga::Module {
 
 #[test]
 fn every_shader_validates() {
-    let shaders = shaders();
-    assert!(!shaders.is_empty());
-    for (name, source) in &shaders {
+    for (name, source) in embedded() {
         parse(name, source);
     }
-    // The source the renderer embeds is the file on disk.
-    assert!(
-        shaders
+    // Every file on disk is what the renderer embeds: a shader (the tail of one embedded
+    // source) or a shared file (prepended to at least one); none is left out or stale.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+    let files = wgsl_files(&dir);
+    assert!(files.len() >= 4, "{files:?}");
+    for (path, source) in &files {
+        let used = embedded()
             .iter()
-            .any(|(_, s)| s == hairloom_render::strand_gen::SHADER_SOURCE)
-    );
+            .any(|(_, s)| s.ends_with(source.as_str()) || s.starts_with(source.as_str()));
+        assert!(
+            used,
+            "{path} is not part of any shader the renderer compiles"
+        );
+    }
 }
 
 /// Size of the WGSL struct `name` in `module`, by naga's layouter.

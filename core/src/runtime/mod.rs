@@ -7,6 +7,7 @@ pub mod frame_plan;
 pub mod gpu_types;
 pub mod hair;
 pub mod half;
+pub mod preview_hair;
 pub mod strand_gen;
 pub mod textures;
 

@@ -308,7 +308,7 @@ impl RuntimeTextures {
 
     /// Bytes the five textures take on the GPU: RGBA hair mesh, u and v (4 channels), R w,
     /// at 4 bytes (f32) or 2 bytes (f16) per channel, and the RG uv-texture, always f32
-    /// (see `export::TexelFormat::for_precision`).
+    /// (see `io::ktx2::TexelFormat::for_precision`).
     pub fn gpu_bytes(&self) -> usize {
         let channel = match self.precision {
             Precision::F32 => 4,
