@@ -5,5 +5,6 @@
 //! against.
 
 pub mod device;
+pub mod measure;
 pub mod preview;
 pub mod strand_gen;

@@ -741,3 +741,26 @@ pub enum PreviewError {
     #[error("reading the frame back failed: {0}")]
     Readback(String),
 }
+
+/// The look every Hairloom picture shares (renders, the editor's viewport, benchmarks):
+/// brown strands a little over a thousandth of the hair's size wide, a skin-toned body.
+pub fn default_scene<'a>(
+    body: &'a hairloom_core::BodyMesh,
+    hair: HairSource<'a>,
+    vertex_count: u32,
+    (lo, hi): (Vec3, Vec3),
+    camera: Camera,
+) -> PreviewScene<'a> {
+    PreviewScene {
+        body_positions: &body.positions,
+        body_triangles: &body.triangles,
+        hair,
+        vertex_count,
+        strand_width_m: (hi - lo).length() * 0.0012,
+        // Linear colours (the target is sRGB): dark brown roots, lighter tips.
+        root_color: [0.018, 0.008, 0.004],
+        tip_color: [0.16, 0.075, 0.03],
+        body_color: [0.55, 0.38, 0.30],
+        camera,
+    }
+}

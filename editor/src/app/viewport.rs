@@ -32,8 +32,9 @@ use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
 
 use super::gizmo::{GizmoAdapter, GizmoStep};
 use super::state::{DragTool, EditorState, SelectMode};
-use crate::render::{AccuracyRow, default_scene, measure_accuracy};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+use hairloom_render::measure::{AccuracyRow, measure_accuracy};
+use hairloom_render::preview::default_scene;
 
 /// Storage buffers per shader stage the generation and preview pipelines bind.
 const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;

@@ -79,8 +79,8 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             project,
             out,
             strands,
-        } => crate::accuracy::run(project, &out, strands.max(1)),
-        Which::Cpu { project } => crate::accuracy::cpu(project),
+        } => super::accuracy::run(project, &out, strands.max(1)),
+        Which::Cpu { project } => super::accuracy::cpu(project),
         Which::Edit {
             project,
             size,
@@ -142,7 +142,7 @@ fn median(mut samples: Vec<f64>) -> f64 {
 
 fn interior(repeat: usize) -> anyhow::Result<()> {
     println!("Interior-vertex placement (affine fit + harmonic residual, f64), median of {repeat}");
-    println!("machine: {}", crate::bench::machine());
+    println!("machine: {}", super::machine());
     println!(
         "{:>9} {:>9} {:>9} {:>14} {:>14} {:>16}",
         "vertices", "interior", "layers", "all layers ms", "one layer ms", "drag (edit) ms"
@@ -192,23 +192,6 @@ fn interior(repeat: usize) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// CPU model and core count, for the header of every table.
-pub fn machine() -> String {
-    let model = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|text| {
-            text.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|s| s.trim().to_string())
-        })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
-    let cores = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1);
-    format!("{model}, {cores} cores")
-}
-
 /// Median of `runs` measurements by wall time (after one warm-up), or the first error.
 fn median_timing<T: Copy, E>(
     mut measure: impl FnMut() -> Result<T, E>,
@@ -249,7 +232,7 @@ fn gpu(
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
     use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
-    let (width, height) = hairloom_editor::render::parse_size(size)?;
+    let (width, height) = super::render::parse_size(size)?;
     let document = hairloom_core::io::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
     let generator = StrandGenRenderer::new(&context);
@@ -262,7 +245,7 @@ fn gpu(
         path.display()
     );
     println!("adapter: {}", describe(&context.adapter_info));
-    println!("machine: {}", machine());
+    println!("machine: {}", super::machine());
     println!(
         "frame: {width}x{height}, {}× MSAA; times are GPU timestamps (* = wall time from submit to idle: no usable timestamps, e.g. a CPU adapter)",
         preview.sample_count
@@ -358,7 +341,7 @@ fn gpu(
                     None
                 };
                 let scene = |hair_source, camera| {
-                    hairloom_editor::render::default_scene(
+                    hairloom_render::preview::default_scene(
                         &document.body,
                         hair_source,
                         vertex_count,
@@ -464,7 +447,7 @@ fn edit_latency(
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
     use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
-    let (width, height) = hairloom_editor::render::parse_size(size)?;
+    let (width, height) = super::render::parse_size(size)?;
     let mut document = hairloom_core::io::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
     let generator = StrandGenRenderer::new(&context);
@@ -476,7 +459,7 @@ fn edit_latency(
         strands_per_bundle: view.strands_per_bundle,
         ..RuntimeOptions::default()
     };
-    let vertex_count = (1u32 << hairloom_editor::render::PREVIEW_VERTICES_LOG2) + 1;
+    let vertex_count = (1u32 << super::render::PREVIEW_VERTICES_LOG2) + 1;
     let mut hair = RuntimeHair::from_document(&document, &options);
     let mut gpu = generator.upload(&context, &hair);
     let bounds = hair
@@ -490,7 +473,7 @@ fn edit_latency(
         glam::Vec3::new(0.75, 0.25, 1.0),
     );
     let frame = |gpu: &GpuHair, body: &hairloom_core::BodyMesh| -> anyhow::Result<()> {
-        let scene = hairloom_editor::render::default_scene(
+        let scene = hairloom_render::preview::default_scene(
             body,
             HairSource::Generated {
                 generator: &generator,
@@ -564,7 +547,7 @@ fn edit_latency(
         "edit-to-frame latency, {} ({} strands per bundle, {width}x{height}); {}; adapter {}",
         path.display(),
         options.strands_per_bundle,
-        machine(),
+        super::machine(),
         describe(&context.adapter_info)
     );
     println!("{:<46} {:>10} {:>10}", "edit", "median ms", "vs before");

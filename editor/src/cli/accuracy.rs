@@ -204,10 +204,7 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
         reference.len(),
         bundle_width * 1e3
     );
-    println!(
-        "machine: {} (CPU evaluation, one thread)",
-        crate::bench::machine()
-    );
+    println!("machine: {} (CPU evaluation, one thread)", super::machine());
     println!(
         "{:<48} {:>11} {:>11} {:>9} {:>12} {:>13} {:>7}",
         "switch", "max error", "mean error", "max % bw", "max vs quad", "ms / M verts", "× ref"
@@ -444,7 +441,7 @@ pub fn cpu(project: Option<PathBuf>) -> anyhow::Result<()> {
         "CPU reference strand generation (f64, styled, 33 vertices): {}",
         path.display()
     );
-    println!("machine: {}, {threads} threads", crate::bench::machine());
+    println!("machine: {}, {threads} threads", super::machine());
     println!(
         "{:>9} {:>10} {:>10} {:>16} {:>16}",
         "strands", "vertices", "ms", "vertices / s", "1-thread ratio"

@@ -1,0 +1,397 @@
+//! The `hairloom` command line: one file per command family (`render`, `bench`, `accuracy`),
+//! the rest here. Subcommands work headless: `check` validates a project (exit 0, or 2 with a message
+//! naming the problem), `info` prints counts, `import` turns a glTF scalp into a project,
+//! `adapters` lists the GPU adapters wgpu finds, and `bench` measures.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use hairloom_core::io::project;
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::textures::Precision;
+
+mod accuracy;
+mod bench;
+mod render;
+
+use hairloom_editor::files;
+
+#[derive(Parser)]
+#[command(
+    name = "hairloom",
+    version,
+    about = "Hair-mesh modeling and styling editor"
+)]
+#[command(args_conflicts_with_subcommands = true)]
+struct Cli {
+    /// A project to open in the editor (without one, the editor opens a bundled sample).
+    file: Option<PathBuf>,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate a project file: exit 0 when valid, 2 with a message naming the problem.
+    Check { file: PathBuf },
+    /// Print counts of a project: root faces, bundles, vertices, layers.
+    Info {
+        file: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Create a project from a glTF/GLB scalp (every face becomes a bare bundle).
+    Import {
+        scalp: PathBuf,
+        /// Project file to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Mesh to read when the file has several.
+        #[arg(long)]
+        mesh: Option<String>,
+        /// Model units per file unit.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Replace the file's uv with a seamless generated projection.
+        #[arg(long)]
+        generate_uv: bool,
+    },
+    /// Export the runtime bundle (manifest + KTX2 textures) and/or strands for other tools.
+    Export {
+        project: PathBuf,
+        /// Folder for the runtime bundle.
+        #[arg(long)]
+        runtime: Option<PathBuf>,
+        /// Strand file; the format follows the extension: .hair, .usda or .glb.
+        #[arg(long)]
+        strands: Vec<PathBuf>,
+        /// Strands per bundle.
+        #[arg(long, default_value_t = 64)]
+        strands_per_bundle: u32,
+        /// Strands have 2^N + 1 vertices.
+        #[arg(long, default_value_t = files::EXPORT_VERTICES_LOG2)]
+        vertices_log2: u32,
+        /// Runtime texture precision.
+        #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
+        precision: PrecisionArg,
+    },
+    /// Render a project, or an exported runtime bundle folder, headless to a PNG: strands
+    /// generated on the GPU from the runtime textures, body, Kajiya-Kay shading, MSAA.
+    Render {
+        /// A .hairloom project or a runtime bundle folder.
+        input: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// Image size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "960x960")]
+        size: String,
+        /// Strands per bundle (default: the bundle's own count, or 64 for a project).
+        #[arg(long)]
+        strands_per_bundle: Option<u32>,
+        /// Camera direction from the model: front, side, back, three-quarter, or x,y,z.
+        #[arg(long, default_value = "three-quarter")]
+        view: String,
+        /// Strands have 2^N + 1 vertices.
+        #[arg(long, default_value_t = render::PREVIEW_VERTICES_LOG2)]
+        vertices_log2: u32,
+        /// Texture precision of a project render (a runtime bundle has its own).
+        #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
+        precision: PrecisionArg,
+        /// Texture filtering in the generation shader.
+        #[arg(long, value_enum, default_value_t = FilteringArg::Exact)]
+        filtering: FilteringArg,
+        /// Draw every strand at full detail (no strand or vertex LOD).
+        #[arg(long)]
+        no_lod: bool,
+        /// Strand LOD α (eq. 7): larger keeps more strands at a distance.
+        #[arg(long, default_value_t = hairloom_core::runtime::frame_plan::DEFAULT_ALPHA_STRANDS)]
+        alpha_strands: f64,
+        /// Vertex LOD α (eq. 7): larger keeps more vertices at a distance.
+        #[arg(long, default_value_t = hairloom_core::runtime::frame_plan::DEFAULT_ALPHA_VERTICES)]
+        alpha_vertices: f64,
+        /// Vertex LOD morph window λ in [0, 1] (eq. 10-12); 0 switches levels abruptly.
+        #[arg(long, default_value_t = hairloom_core::runtime::frame_plan::DEFAULT_LAMBDA)]
+        lambda: f64,
+    },
+    /// List the GPU adapters wgpu can use and the one Hairloom would pick.
+    Adapters,
+    /// Measure performance; prints a table (see BENCHMARKS.md).
+    Bench {
+        #[command(subcommand)]
+        which: bench::Which,
+    },
+}
+
+/// Texture precision on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum PrecisionArg {
+    F32,
+    F16,
+}
+
+impl From<PrecisionArg> for Precision {
+    fn from(value: PrecisionArg) -> Self {
+        match value {
+            PrecisionArg::F32 => Precision::F32,
+            PrecisionArg::F16 => Precision::F16,
+        }
+    }
+}
+
+/// Texture filtering on the command line: exact (manual, f32 weights) or hardware.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum FilteringArg {
+    Exact,
+    Hardware,
+}
+
+impl From<FilteringArg> for Filtering {
+    fn from(value: FilteringArg) -> Self {
+        match value {
+            FilteringArg::Exact => Filtering::Exact,
+            FilteringArg::Hardware => Filtering::Hardware8Bit,
+        }
+    }
+}
+
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => return editor(cli.file.as_deref()),
+        Some(Command::Check { file }) => return check(&file),
+        Some(Command::Info { file, json }) => info(&file, json),
+        Some(Command::Import {
+            scalp,
+            out,
+            mesh,
+            scale,
+            generate_uv,
+        }) => import(&scalp, &out, mesh, scale, generate_uv),
+        Some(Command::Export {
+            project,
+            runtime,
+            strands,
+            strands_per_bundle,
+            vertices_log2,
+            precision,
+        }) => files::run(
+            &project,
+            runtime.as_deref(),
+            &strands,
+            strands_per_bundle,
+            vertices_log2,
+            precision.into(),
+        ),
+        Some(Command::Render {
+            input,
+            out,
+            size,
+            strands_per_bundle,
+            view,
+            vertices_log2,
+            precision,
+            filtering,
+            no_lod,
+            alpha_strands,
+            alpha_vertices,
+            lambda,
+        }) => {
+            let lod_values = [alpha_strands, alpha_vertices, lambda];
+            if lod_values.iter().any(|v| !v.is_finite() || *v < 0.0) || lambda > 1.0 {
+                eprintln!(
+                    "error: --alpha-strands and --alpha-vertices must be finite and ≥ 0, --lambda in [0, 1]"
+                );
+                return ExitCode::from(2);
+            }
+            if vertices_log2 > 8 {
+                eprintln!("error: --vertices-log2 {vertices_log2} is more than 8");
+                return ExitCode::from(2);
+            }
+            let settings = render::RenderSettings {
+                size,
+                strands_per_bundle,
+                view,
+                vertices_log2,
+                precision: precision.into(),
+                filtering: filtering.into(),
+                lod: hairloom_core::runtime::frame_plan::LodSettings {
+                    enabled: !no_lod,
+                    cull: true,
+                    alpha_strands,
+                    alpha_vertices,
+                    lambda,
+                },
+            };
+            render::run(&input, &out, &settings)
+        }
+        Some(Command::Adapters) => adapters(),
+        Some(Command::Bench { which }) => bench::run(which),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Opens the interactive editor on `file`, or on the embedded sample.
+fn editor(file: Option<&Path>) -> ExitCode {
+    use hairloom_editor::app::{EditorState, HairloomApp};
+    let state = match file {
+        Some(path) => match EditorState::open(path) {
+            Ok(state) => state,
+            Err(error) => {
+                eprintln!("error: {error}");
+                return ExitCode::from(2);
+            }
+        },
+        None => EditorState::sample(),
+    };
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([1400.0, 900.0])
+            .with_title(state.title()),
+        renderer: eframe::Renderer::Wgpu,
+        wgpu_options: eframe::egui_wgpu::WgpuConfiguration {
+            wgpu_setup: hairloom_editor::app::wgpu_setup(),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    match eframe::run_native(
+        "Hairloom",
+        options,
+        Box::new(|cc| Ok(Box::new(HairloomApp::new(cc, state)))),
+    ) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!(
+                "error: cannot open the editor window: {error}\n(no display? `hairloom render FILE --out PICTURE.png` works headless)"
+            );
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn check(file: &Path) -> ExitCode {
+    match project::load(file) {
+        Ok(project) => {
+            let stats = project.document.hair_mesh.stats();
+            println!(
+                "{}: valid (format {}, {} bundles, {} vertices, {} undo steps)",
+                file.display(),
+                project.format_version,
+                stats.root_faces,
+                stats.vertices,
+                project.history.undo.len()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(error) => {
+            eprintln!("{error}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn info(file: &Path, json: bool) -> anyhow::Result<()> {
+    let project = project::load(file)?;
+    let document = &project.document;
+    let stats = document.hair_mesh.stats();
+    if json {
+        let value = serde_json::json!({
+            "name": document.name,
+            "stats": stats,
+            "body_triangles": document.body.triangles.len(),
+            "undo_steps": project.history.undo.len(),
+            "redo_steps": project.history.redo.len(),
+        });
+        println!("{}", serde_json::to_string_pretty(&value)?);
+        return Ok(());
+    }
+    println!("name:             {}", document.name);
+    if !document.source.is_empty() {
+        println!("source:           {}", document.source);
+    }
+    println!(
+        "root faces:       {} ({} quads, {} triangles, {} removed)",
+        stats.root_faces, stats.quads, stats.triangles, stats.removed_bundles
+    );
+    println!("bundles:          {} with hair", stats.hair_bundles);
+    println!("root vertices:    {}", stats.root_vertices);
+    println!(
+        "vertices:         {} ({} interior, placed automatically)",
+        stats.vertices, stats.interior_vertices
+    );
+    println!(
+        "layers:           {} to {}",
+        stats.min_layers, stats.max_layers
+    );
+    println!("body triangles:   {}", document.body.triangles.len());
+    println!(
+        "history:          {} undo, {} redo (limit {})",
+        project.history.undo.len(),
+        project.history.redo.len(),
+        project.history.limit
+    );
+    Ok(())
+}
+
+fn import(
+    scalp: &Path,
+    out: &Path,
+    mesh: Option<String>,
+    scale: f64,
+    generate_uv: bool,
+) -> anyhow::Result<()> {
+    let options = hairloom_core::io::import::ImportOptions {
+        mesh_name: mesh,
+        scale,
+        ..hairloom_core::io::import::ImportOptions::default()
+    };
+    let (document, summary) = files::scalp_document(scalp, &options, generate_uv)?;
+    project::save(out, &hairloom_core::Project::new(document))?;
+    println!("{summary} → {}", out.display());
+    Ok(())
+}
+
+fn adapters() -> anyhow::Result<()> {
+    let all = hairloom_render::device::list_adapters();
+    if all.is_empty() {
+        println!(
+            "no adapter found (install mesa-vulkan-drivers for the lavapipe software adapter)"
+        );
+    }
+    for info in &all {
+        println!("{}", hairloom_render::device::describe(info));
+    }
+    match hairloom_render::device::GpuContext::new_headless() {
+        Ok(context) => println!(
+            "chosen: {}",
+            hairloom_render::device::describe(&context.adapter_info)
+        ),
+        Err(error) => println!("chosen: none ({error})"),
+    }
+    Ok(())
+}
+
+/// CPU model and core count, for the header of every table.
+pub fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    format!("{model}, {cores} cores")
+}
