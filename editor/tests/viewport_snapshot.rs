@@ -84,7 +84,7 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
     let frame_ms = harness
         .state()
         .viewport
-        .frame_ms
+        .frame_ms()
         .expect("the frame was timed");
     assert!(frame_ms > 0.0 && frame_ms.is_finite());
     eprintln!("viewport frame (generate + draw, wall): {frame_ms:.1} ms");

@@ -653,7 +653,7 @@ impl HairloomApp {
                 "{} strands, {} vertices drawn",
                 self.viewport.drawn_strands, self.viewport.drawn_vertices
             ));
-            if let Some(ms) = self.viewport.frame_ms {
+            if let Some(ms) = self.viewport.frame_ms() {
                 ui.separator();
                 ui.label(format!("GPU generate + draw {ms:.1} ms"));
             }

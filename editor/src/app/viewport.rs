@@ -245,6 +245,14 @@ struct DrawnKey {
     size: [u32; 2],
 }
 
+impl Viewport {
+    /// Wall time from submitting the last drawn frame to the GPU finishing it (generation
+    /// and drawing); `None` until one has finished.
+    pub fn frame_ms(&self) -> Option<f64> {
+        self.frame_ms.lock().ok().and_then(|slot| *slot)
+    }
+}
+
 pub struct Viewport {
     gpu: Option<GpuView>,
     /// A lost device or a GPU error the device reported outside any error scope: shown in
@@ -260,7 +268,8 @@ pub struct Viewport {
     pub drawn_strands: usize,
     pub drawn_vertices: usize,
     /// Wall time of generating and drawing the last frame on the GPU (submit to idle).
-    pub frame_ms: Option<f64>,
+    /// Written by the queue's work-done callback, so drawing never waits on the GPU.
+    frame_ms: Arc<std::sync::Mutex<Option<f64>>>,
     pub adapter: String,
     pub error: Option<String>,
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
@@ -359,7 +368,7 @@ impl Viewport {
             drawn: None,
             drawn_strands: 0,
             drawn_vertices: 0,
-            frame_ms: None,
+            frame_ms: Arc::default(),
             error: None,
             rect: None,
             transform: None,
@@ -660,10 +669,16 @@ impl Viewport {
                     let rendered =
                         gpu.preview
                             .render_texture(&gpu.context, &scene, &plan, size[0], size[1]);
-                    // Wait for the GPU so the status bar can say what generating and drawing
-                    // this frame cost (the viewport only redraws when something changed).
-                    let _ = gpu.context.device.poll(wgpu::PollType::wait_indefinitely());
-                    self.frame_ms = Some(started.elapsed().as_secs_f64() * 1e3);
+                    // The status bar says what generating and drawing this frame cost, from
+                    // submission to the GPU finishing it, without waiting here: egui's own
+                    // submission on the same queue orders the texture before its use.
+                    let (frame_ms, ctx) = (Arc::clone(&self.frame_ms), ui.ctx().clone());
+                    gpu.context.queue.on_submitted_work_done(move || {
+                        if let Ok(mut slot) = frame_ms.lock() {
+                            *slot = Some(started.elapsed().as_secs_f64() * 1e3);
+                        }
+                        ctx.request_repaint(); // the status bar shows the new time
+                    });
                     match rendered {
                         Ok(texture) => {
                             // egui composites gamma-encoded bytes: sample the sRGB image raw.
