@@ -8,7 +8,7 @@ use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::runtime::textures::Precision;
 
 use crate::device::GpuContext;
-use crate::strand_gen::{StrandGenError, StrandGenRenderer, full_detail_plan};
+use crate::renderer::strand_gen::{StrandGenError, StrandGenRenderer, full_detail_plan};
 
 /// One accuracy switch setting measured on the GPU against f32 textures with exact
 /// filtering (the setting the CPU mirror tests pin to 1e-5 × size).

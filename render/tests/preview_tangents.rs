@@ -10,7 +10,7 @@ use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::preview_hair::batch_tangents;
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::{headless_for_test, read_buffer};
-use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
+use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
 use wgpu::util::DeviceExt;
 
 /// Writes `strand_tangent` of every batch vertex to `tangents_out`.
@@ -86,7 +86,7 @@ fn gpu_ribbon_tangents_match_the_cpu_mirror() {
     let device = &context.device;
     let source = format!(
         "{}\n{READBACK_ENTRY}",
-        hairloom_render::preview::HAIR_SHADER
+        hairloom_render::renderer::preview_hair::HAIR_SHADER
     );
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("preview_hair_tangent_readback"),

@@ -22,9 +22,18 @@ fn wgsl_files(dir: &Path) -> Vec<(String, String)> {
 /// The sources the renderer compiles: each shader with the shared files it includes.
 fn embedded() -> [(&'static str, &'static str); 3] {
     [
-        ("strand_gen", hairloom_render::strand_gen::SHADER_SOURCE),
-        ("preview_hair", hairloom_render::preview::HAIR_SHADER),
-        ("preview_body", hairloom_render::preview::BODY_SHADER),
+        (
+            "strand_gen",
+            hairloom_render::renderer::strand_gen::SHADER_SOURCE,
+        ),
+        (
+            "preview_hair",
+            hairloom_render::renderer::preview_hair::HAIR_SHADER,
+        ),
+        (
+            "preview_body",
+            hairloom_render::renderer::preview_body::BODY_SHADER,
+        ),
     ]
 }
 
@@ -77,8 +86,9 @@ fn gpu_structs_match_their_wgsl() {
     use hairloom_core::runtime::gpu_types::{
         BundleGpu, StrandGenParams, StrandRoot, StrandRun, StylingGpu,
     };
-    use hairloom_render::preview::{BODY_SHADER, BodyUniforms, HAIR_SHADER, HairUniforms};
-    use hairloom_render::strand_gen::SHADER_SOURCE;
+    use hairloom_render::renderer::preview_body::{BODY_SHADER, BodyUniforms};
+    use hairloom_render::renderer::preview_hair::{HAIR_SHADER, HairUniforms};
+    use hairloom_render::renderer::strand_gen::SHADER_SOURCE;
     for (source, name, rust_size) in [
         (
             SHADER_SOURCE,

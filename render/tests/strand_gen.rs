@@ -8,7 +8,7 @@ use hairloom_core::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
 use hairloom_core::runtime::textures::Precision;
 use hairloom_render::device::headless_for_test;
-use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
+use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
 
 fn sample(name: &str) -> hairloom_core::model::document::Document {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -107,7 +107,7 @@ fn gpu_strands_match_the_cpu_mirror() {
 
 #[test]
 fn generation_runs_in_batches_with_bounded_scratch() {
-    use hairloom_render::strand_gen::BATCH_STRANDS;
+    use hairloom_render::renderer::strand_gen::BATCH_STRANDS;
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };

@@ -28,13 +28,14 @@ use hairloom_core::runtime::textures::Precision;
 use hairloom_core::{Topology, VertexRef};
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
+use hairloom_render::renderer::strand_gen::{GpuHair, StrandGenRenderer};
 
 use super::gizmo::{GizmoAdapter, GizmoStep};
 use super::state::{DragTool, EditorState, SelectMode};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_render::measure::{AccuracyRow, measure_accuracy};
 use hairloom_render::preview::default_scene;
+use hairloom_render::renderer::preview_body::GpuBody;
 
 /// Storage buffers per shader stage the generation and preview pipelines bind.
 const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
@@ -215,6 +216,8 @@ struct UploadedHair {
     /// The hair mesh the textures were built from: a change that leaves it (and the body)
     /// alone is styling only.
     mesh: hairloom_core::HairMesh,
+    /// The body on the GPU, uploaded with the hair (not per frame).
+    body: GpuBody,
 }
 
 /// Uploads of the hair since the viewport was made.
@@ -624,6 +627,7 @@ impl Viewport {
                 );
                 gpu.hair = hair.textures.hair_bounds().map(|bounds| UploadedHair {
                     gpu: gpu.generator.upload(&gpu.context, &hair),
+                    body: GpuBody::upload(&gpu.context, &hair.body),
                     bounds,
                     hair,
                     mesh: document.hair_mesh.clone(),
@@ -651,7 +655,7 @@ impl Viewport {
                     let (lo, hi) = hair.bounds;
                     self.camera_bounds = Some(hair.bounds);
                     let scene = default_scene(
-                        &hair.hair.body,
+                        &hair.body,
                         HairSource::Generated {
                             generator: &gpu.generator,
                             hair: &hair.gpu,

@@ -230,13 +230,14 @@ fn gpu(
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-    use hairloom_render::strand_gen::{StrandGenRenderer, full_detail_plan};
+    use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = super::render::parse_size(size)?;
     let document = hairloom_core::io::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
     let generator = StrandGenRenderer::new(&context);
     let preview = PreviewRenderer::new(&context);
+    let body = hairloom_render::renderer::preview_body::GpuBody::upload(&context, &document.body);
     let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
     let max_binding = context.device.limits().max_storage_buffer_binding_size;
     let trust = !context.is_cpu();
@@ -342,7 +343,7 @@ fn gpu(
                 };
                 let scene = |hair_source, camera| {
                     hairloom_render::preview::default_scene(
-                        &document.body,
+                        &body,
                         hair_source,
                         vertex_count,
                         (lo, hi),
@@ -445,7 +446,8 @@ fn edit_latency(
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-    use hairloom_render::strand_gen::{GpuHair, StrandGenRenderer};
+    use hairloom_render::renderer::preview_body::GpuBody;
+    use hairloom_render::renderer::strand_gen::{GpuHair, StrandGenRenderer};
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = super::render::parse_size(size)?;
     let mut document = hairloom_core::io::project::load(&path)?.document;
@@ -472,7 +474,7 @@ fn edit_latency(
         bounds.1 + pad,
         glam::Vec3::new(0.75, 0.25, 1.0),
     );
-    let frame = |gpu: &GpuHair, body: &hairloom_core::BodyMesh| -> anyhow::Result<()> {
+    let frame = |gpu: &GpuHair, body: &GpuBody| -> anyhow::Result<()> {
         let scene = hairloom_render::preview::default_scene(
             body,
             HairSource::Generated {
@@ -489,7 +491,9 @@ fn edit_latency(
         preview.render(&context, &scene, &plan, width, height)?;
         Ok(())
     };
-    frame(&gpu, &hair.body)?; // warm-up: pipelines, first allocations
+    // The body is uploaded once per document, as the viewport does.
+    let body = GpuBody::upload(&context, &hair.body);
+    frame(&gpu, &body)?; // warm-up: pipelines, first allocations
     let timed = |mut step: Box<dyn FnMut(usize) -> anyhow::Result<()> + '_>| {
         let mut samples = Vec::with_capacity(runs);
         for run in 0..runs {
@@ -499,20 +503,20 @@ fn edit_latency(
         }
         anyhow::Ok(median(samples))
     };
-    let frame_only = timed(Box::new(|_| frame(&gpu, &hair.body)))?;
+    let frame_only = timed(Box::new(|_| frame(&gpu, &body)))?;
     let curl = |run: usize| 0.002 + 0.0001 * run as f64;
     let mut styled = document.clone();
     let rebuild = timed(Box::new(|run| {
         styled.styling.global.curl.radius_m = curl(run);
         let hair = RuntimeHair::from_document(&styled, &options);
         let gpu = generator.upload(&context, &hair);
-        frame(&gpu, &hair.body)
+        frame(&gpu, &GpuBody::upload(&context, &hair.body))
     }))?;
     let in_place = timed(Box::new(|run| {
         document.styling.global.curl.radius_m = curl(run);
         hair.set_styling(&document.styling);
         generator.update_styling(&context, &mut gpu, &hair);
-        frame(&gpu, &hair.body)
+        frame(&gpu, &body)
     }))?;
     let topology = Topology::build(&document.hair_mesh);
     let vertex = document
@@ -539,9 +543,10 @@ fn edit_latency(
             0.0,
         )?;
         dragged.hair_mesh = outcome.mesh;
+        // A mesh edit leaves the body alone: it stays uploaded.
         let hair = RuntimeHair::from_document(&dragged, &options);
         let gpu = generator.upload(&context, &hair);
-        frame(&gpu, &hair.body)
+        frame(&gpu, &body)
     }))?;
     println!(
         "edit-to-frame latency, {} ({} strands per bundle, {width}x{height}); {}; adapter {}",

@@ -15,7 +15,8 @@ use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::runtime::textures::Precision;
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
-use hairloom_render::strand_gen::StrandGenRenderer;
+use hairloom_render::renderer::preview_body::GpuBody;
+use hairloom_render::renderer::strand_gen::StrandGenRenderer;
 
 /// Vertices per strand in previews by default: 2^4 + 1.
 pub const PREVIEW_VERTICES_LOG2: u32 = 4;
@@ -129,8 +130,9 @@ pub fn render_pixels(
     let pad = (hi - lo) * 0.05;
     let camera = Camera::framing(lo - pad, hi + pad, direction);
     let renderer = PreviewRenderer::new(context);
+    let body = GpuBody::upload(context, &hair.body);
     let scene = default_scene(
-        &hair.body,
+        &body,
         HairSource::Generated {
             generator: &generator,
             hair: &gpu_hair,

@@ -21,8 +21,8 @@ use crate::device::{GpuContext, read_buffer};
 /// The WGSL source: `shaders/shared/strand_run.wgsl` then `shaders/strand_gen.wgsl`
 /// (validated by naga in `cargo test`).
 pub const SHADER_SOURCE: &str = concat!(
-    include_str!("../../shaders/shared/strand_run.wgsl"),
-    include_str!("../../shaders/strand_gen.wgsl")
+    include_str!("../../../shaders/shared/strand_run.wgsl"),
+    include_str!("../../../shaders/strand_gen.wgsl")
 );
 
 /// Why generation failed.

@@ -1,0 +1,180 @@
+//! A view: the render targets of one picture (colour, MSAA colour, depth), kept across
+//! frames and made again only when the size changes, and the read-back of its pixels.
+
+use crate::device::{GpuContext, read_buffer};
+
+/// Colour target format; the picture is sRGB.
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The non-sRGB view format of the resolved colour target: sampling it returns the
+/// sRGB-encoded bytes, which is what egui composites.
+pub const UI_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// The MSAA sample count for the view's targets: 8× where the adapter allows it for both
+/// colour and depth, else 4×, else none.
+pub fn sample_count(context: &GpuContext) -> u32 {
+    let flags = |format| context.adapter.get_texture_format_features(format).flags;
+    let (color, depth) = (flags(COLOR_FORMAT), flags(DEPTH_FORMAT));
+    [8, 4]
+        .into_iter()
+        .find(|&count| color.sample_count_supported(count) && depth.sample_count_supported(count))
+        .unwrap_or(1)
+}
+
+/// The targets of one `width × height` picture.
+pub struct View {
+    pub width: u32,
+    pub height: u32,
+    pub sample_count: u32,
+    /// Single-sampled colour: what is read back or sampled by a UI.
+    resolved: wgpu::Texture,
+    resolved_view: wgpu::TextureView,
+    msaa_view: Option<wgpu::TextureView>,
+    depth_view: wgpu::TextureView,
+}
+
+impl View {
+    pub fn new(context: &GpuContext, width: u32, height: u32, sample_count: u32) -> Self {
+        let (width, height) = (width.max(1), height.max(1));
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        // The colour target may also be viewed without the sRGB suffix (see UI_VIEW_FORMAT).
+        let ui_view = [UI_VIEW_FORMAT];
+        let target =
+            |label: &str, format: wgpu::TextureFormat, samples: u32, usage: wgpu::TextureUsages| {
+                context.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size,
+                    mip_level_count: 1,
+                    sample_count: samples,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: if format == COLOR_FORMAT && samples == 1 {
+                        &ui_view
+                    } else {
+                        &[]
+                    },
+                })
+            };
+        let resolved = target(
+            "view_color",
+            COLOR_FORMAT,
+            1,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let msaa_view = (sample_count > 1).then(|| {
+            target(
+                "view_msaa",
+                COLOR_FORMAT,
+                sample_count,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            )
+            .create_view(&Default::default())
+        });
+        let depth_view = target(
+            "view_depth",
+            DEPTH_FORMAT,
+            sample_count,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
+        Self {
+            width,
+            height,
+            sample_count,
+            resolved_view: resolved.create_view(&Default::default()),
+            resolved,
+            msaa_view,
+            depth_view,
+        }
+    }
+
+    /// Keeps this view when it already has this size, else makes a new one.
+    pub fn ensure<'v>(
+        view: &'v mut Option<View>,
+        context: &GpuContext,
+        width: u32,
+        height: u32,
+        sample_count: u32,
+    ) -> &'v View {
+        let (width, height) = (width.max(1), height.max(1));
+        let fits = view
+            .as_ref()
+            .is_some_and(|v| (v.width, v.height, v.sample_count) == (width, height, sample_count));
+        if !fits {
+            *view = Some(View::new(context, width, height, sample_count));
+        }
+        view.as_ref().expect("made above")
+    }
+
+    /// The resolved colour texture.
+    pub fn color(&self) -> &wgpu::Texture {
+        &self.resolved
+    }
+
+    /// Where passes draw (the MSAA target when there is one) and what the last pass
+    /// resolves into.
+    pub fn attachments(&self) -> (&wgpu::TextureView, Option<&wgpu::TextureView>) {
+        match &self.msaa_view {
+            Some(msaa) => (msaa, Some(&self.resolved_view)),
+            None => (&self.resolved_view, None),
+        }
+    }
+
+    pub fn depth(&self) -> &wgpu::TextureView {
+        &self.depth_view
+    }
+
+    /// Submits `encoder` with a copy of the colour target and returns its RGBA8 (sRGB) rows,
+    /// top first.
+    pub fn read_back(
+        context: &GpuContext,
+        color: &wgpu::Texture,
+        mut encoder: wgpu::CommandEncoder,
+    ) -> Result<Vec<u8>, String> {
+        let (width, height) = (color.width(), color.height());
+        // Rows of a texture-to-buffer copy are padded to 256 bytes.
+        let padded_row = (width * 4).div_ceil(256) * 256;
+        let readback = context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("view_readback"),
+            size: (padded_row * height) as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: color,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(height),
+                },
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+        context.queue.submit([encoder.finish()]);
+        let mapped = read_buffer(context, &readback)?;
+        let mut pixels = Vec::with_capacity((width * height * 4) as usize);
+        for row in 0..height {
+            let start = (row * padded_row) as usize;
+            pixels.extend_from_slice(&mapped[start..start + (width * 4) as usize]);
+        }
+        Ok(pixels)
+    }
+}
