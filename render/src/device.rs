@@ -288,6 +288,37 @@ pub fn submit_timed(
     Ok((wall_ms, gpu_ms))
 }
 
+/// Whether a test must fail instead of skipping when no GPU adapter can be found: `make
+/// test` sets `HAIRLOOM_REQUIRE_GPU=1` (it installs lavapipe); plain `cargo test` skips.
+pub fn gpu_required() -> bool {
+    std::env::var("HAIRLOOM_REQUIRE_GPU").as_deref() == Ok("1")
+}
+
+/// The one skip rule of every GPU test: prints `skipped: <test>: <why>` and returns `true`
+/// (skip) where no GPU is required, panics with `why` where one is.
+pub fn skip_test_without_gpu(test: &str, why: &str) -> bool {
+    assert!(
+        !gpu_required(),
+        "{test}: {why} (HAIRLOOM_REQUIRE_GPU=1: make test installs lavapipe)"
+    );
+    eprintln!("skipped: {test}: {why} (set HAIRLOOM_REQUIRE_GPU=1 to make this a failure)");
+    true
+}
+
+/// A headless device for a test, or `None` after [`skip_test_without_gpu`] said why not.
+pub fn headless_for_test(test: &str) -> Option<GpuContext> {
+    match GpuContext::new_headless() {
+        Ok(context) => {
+            eprintln!("{test}: adapter {}", describe(&context.adapter_info));
+            Some(context)
+        }
+        Err(error) => {
+            skip_test_without_gpu(test, &error.to_string());
+            None
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -343,36 +374,5 @@ mod tests {
             choose_adapter(&[], None),
             Err(DeviceError::NoAdapter)
         ));
-    }
-}
-
-/// Whether a test must fail instead of skipping when no GPU adapter can be found: `make
-/// test` sets `HAIRLOOM_REQUIRE_GPU=1` (it installs lavapipe); plain `cargo test` skips.
-pub fn gpu_required() -> bool {
-    std::env::var("HAIRLOOM_REQUIRE_GPU").as_deref() == Ok("1")
-}
-
-/// The one skip rule of every GPU test: prints `skipped: <test>: <why>` and returns `true`
-/// (skip) where no GPU is required, panics with `why` where one is.
-pub fn skip_test_without_gpu(test: &str, why: &str) -> bool {
-    assert!(
-        !gpu_required(),
-        "{test}: {why} (HAIRLOOM_REQUIRE_GPU=1: make test installs lavapipe)"
-    );
-    eprintln!("skipped: {test}: {why} (set HAIRLOOM_REQUIRE_GPU=1 to make this a failure)");
-    true
-}
-
-/// A headless device for a test, or `None` after [`skip_test_without_gpu`] said why not.
-pub fn headless_for_test(test: &str) -> Option<GpuContext> {
-    match GpuContext::new_headless() {
-        Ok(context) => {
-            eprintln!("{test}: adapter {}", describe(&context.adapter_info));
-            Some(context)
-        }
-        Err(error) => {
-            skip_test_without_gpu(test, &error.to_string());
-            None
-        }
     }
 }

@@ -485,12 +485,12 @@ mod tests {
         let mut value: serde_json::Value = serde_json::from_slice(&original).expect("json");
         value["format_version"] = 99.into();
         std::fs::write(&manifest_path, serde_json::to_vec(&value).expect("json")).expect("write");
-        let error = load_runtime_bundle(&dir).err().expect("newer version");
+        let error = load_runtime_bundle(&dir).expect_err("newer version");
         assert!(error.to_string().contains("format_version 99"), "{error}");
         std::fs::write(&manifest_path, &original).expect("restore");
         let texture = std::fs::read(dir.join("w.ktx2")).expect("w");
         std::fs::write(dir.join("w.ktx2"), &texture[..texture.len() / 2]).expect("truncate");
-        let error = load_runtime_bundle(&dir).err().expect("truncated");
+        let error = load_runtime_bundle(&dir).expect_err("truncated");
         assert!(error.to_string().contains("w.ktx2"), "{error}");
         let _ = std::fs::remove_dir_all(&dir);
     }
