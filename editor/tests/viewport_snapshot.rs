@@ -147,6 +147,22 @@ fn the_accuracy_switches_show_measured_error_and_time() {
     harness.get_by_label("Strands & accuracy").click();
     harness.run();
     harness.get_by_label("Measure").click();
+    // The measurement runs on a worker thread; the UI keeps drawing (a spinner) meanwhile.
+    harness.step();
+    assert!(
+        harness.query_by_label("measuring…").is_some()
+            || harness.state().viewport.accuracy.is_some(),
+        "the panel says it is measuring"
+    );
+    let started = std::time::Instant::now();
+    while harness.state().viewport.accuracy.is_none() {
+        assert!(
+            started.elapsed() < std::time::Duration::from_secs(300),
+            "no measurement after 300 s"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        harness.step();
+    }
     harness.run();
     let revision = harness.state().state.revision;
     let (measured_at, rows) = harness.state().viewport.accuracy.clone().expect("measured");

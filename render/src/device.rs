@@ -24,7 +24,9 @@ pub enum DeviceError {
     },
 }
 
-/// An adapter, device and queue ready for headless work.
+/// An adapter, device and queue ready for headless work. Cloning shares the same device
+/// (wgpu handles are reference-counted), so a worker thread can measure on it.
+#[derive(Clone)]
 pub struct GpuContext {
     pub adapter: wgpu::Adapter,
     pub adapter_info: wgpu::AdapterInfo,

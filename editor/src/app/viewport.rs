@@ -232,7 +232,8 @@ pub struct UploadCounts {
 /// GPU resources of the viewport (absent without a wgpu device).
 struct GpuView {
     context: GpuContext,
-    generator: StrandGenRenderer,
+    /// Shared with accuracy measurements on a worker thread.
+    generator: Arc<StrandGenRenderer>,
     preview: PreviewRenderer,
     egui_renderer: Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>,
     hair: Option<UploadedHair>,
@@ -247,6 +248,9 @@ struct DrawnKey {
     orbit: Orbit,
     size: [u32; 2],
 }
+
+/// What an accuracy measurement gives: every switch's row, or why it failed.
+type AccuracyResult = Result<Vec<AccuracyRow>, String>;
 
 impl Viewport {
     /// Wall time from submitting the last drawn frame to the GPU finishing it (generation
@@ -292,6 +296,9 @@ pub struct Viewport {
     /// The last accuracy measurement: the document revision it was made at, and the rows
     /// (or why it failed).
     pub accuracy: Option<(u64, Result<Vec<AccuracyRow>, String>)>,
+    /// A measurement running on a worker thread: the revision it measures and where its
+    /// rows arrive.
+    measuring: Option<(u64, std::sync::mpsc::Receiver<AccuracyResult>)>,
     /// The pointer path of a region drag in progress.
     drag_path: Vec<egui::Pos2>,
     /// The box the camera frames (the drawn hair's), for picking with the same camera.
@@ -349,7 +356,7 @@ impl Viewport {
                 state.queue.clone(),
             );
             GpuView {
-                generator: StrandGenRenderer::new(&context),
+                generator: Arc::new(StrandGenRenderer::new(&context)),
                 preview: PreviewRenderer::new(&context),
                 egui_renderer: state.renderer.clone(),
                 context,
@@ -381,6 +388,7 @@ impl Viewport {
             targets_cache: None,
             gizmo_centre: None,
             accuracy: None,
+            measuring: None,
             drag_path: Vec::new(),
             camera_bounds: None,
             interior: None,
@@ -512,25 +520,54 @@ impl Viewport {
                     }
                 }
             });
+        // A finished measurement lands here (the worker never touches the panel).
+        if let Some((revision, receiver)) = &self.measuring {
+            match receiver.try_recv() {
+                Ok(result) => {
+                    self.accuracy = Some((*revision, result));
+                    self.measuring = None;
+                }
+                Err(std::sync::mpsc::TryRecvError::Empty) => {
+                    ui.ctx()
+                        .request_repaint_after(std::time::Duration::from_millis(50));
+                }
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                    self.accuracy = Some((*revision, Err("the measurement stopped".into())));
+                    self.measuring = None;
+                }
+            }
+        }
         ui.horizontal(|ui| {
             let measure = ui
-                .add_enabled(self.gpu.is_some(), egui::Button::new("Measure"))
+                .add_enabled(
+                    self.gpu.is_some() && self.measuring.is_none(),
+                    egui::Button::new("Measure"),
+                )
                 .on_hover_text(
                     "Generates every strand of the document (full detail, 17 vertices) with \
-                     each setting on this GPU; errors against f32 / exact",
+                     each setting on this GPU, on a worker thread; errors against f32 / exact",
                 );
             if measure.clicked()
                 && let Some(gpu) = &self.gpu
             {
-                let result = measure_accuracy(
-                    &gpu.context,
-                    &gpu.generator,
-                    state.document(),
-                    self.settings.strands_per_bundle,
-                    17,
-                )
-                .map_err(|e| format!("{e:#}"));
-                self.accuracy = Some((state.revision, result));
+                let (sender, receiver) = std::sync::mpsc::channel();
+                let (context, generator) = (gpu.context.clone(), Arc::clone(&gpu.generator));
+                let document = state.document().clone();
+                let strands_per_bundle = self.settings.strands_per_bundle;
+                let ctx = ui.ctx().clone();
+                std::thread::spawn(move || {
+                    let result =
+                        measure_accuracy(&context, &generator, &document, strands_per_bundle, 17)
+                            .map_err(|e| format!("{e:#}"));
+                    let _ = sender.send(result);
+                    ctx.request_repaint();
+                });
+                self.measuring = Some((state.revision, receiver));
+            }
+            if self.measuring.is_some() {
+                ui.spinner();
+                ui.weak("measuring…");
+                return;
             }
             match &self.accuracy {
                 Some((_, Err(error))) => {
