@@ -20,6 +20,7 @@ use hairloom_core::{Document, HairMesh};
 use hairloom_tests::grid_mesh;
 use proptest::prelude::*;
 
+/// Every op on (the shared set) with a tight, fast curl: the hardest case for the frames.
 fn every_op() -> StylingParams {
     StylingParams {
         curl: Curl {
@@ -27,26 +28,7 @@ fn every_op() -> StylingParams {
             turns_per_m: 30.0,
             ..Curl::default()
         },
-        twist: Twist { turns_per_m: 2.0 },
-        noise: Noise {
-            amplitude_m: 0.005,
-            ..Noise::default()
-        },
-        clump: Clump {
-            strength: 0.8,
-            ..Clump::default()
-        },
-        frizz: Frizz {
-            amplitude_m: 0.003,
-            fraction: 0.5,
-            ..Frizz::default()
-        },
-        wave: Wave {
-            amplitude_m: 0.01,
-            ..Wave::default()
-        },
-        length: LengthVariation { fraction: 0.4 },
-        ..StylingParams::default()
+        ..StylingParams::every_op()
     }
 }
 
