@@ -1,0 +1,176 @@
+//! Pointer and keyboard input: click, box, lasso and paint selection, and the viewport's keys.
+
+use super::*;
+
+/// Applies region hits to a selection: replace it, add to it, or (`remove`) take them out.
+/// Returns how many were hit.
+pub(super) fn apply_hits<T: Ord + Copy>(
+    selection: &mut std::collections::BTreeSet<T>,
+    hits: &[T],
+    replace: bool,
+    remove: bool,
+) -> usize {
+    if replace {
+        selection.clear();
+    }
+    for hit in hits {
+        if remove {
+            selection.remove(hit);
+        } else {
+            selection.insert(*hit);
+        }
+    }
+    hits.len()
+}
+
+/// Pick distance for vertices, in points.
+pub(super) const PICK_RADIUS_PX: f64 = 10.0;
+
+impl Viewport {
+    /// Click and region selection (see the module documentation).
+    pub(super) fn select(
+        &mut self,
+        ui: &egui::Ui,
+        state: &mut EditorState,
+        response: &egui::Response,
+        projector: Projector,
+    ) {
+        let modifiers = ui.input(|i| i.modifiers);
+        let mesh = &state.document().hair_mesh;
+        if response.clicked()
+            && let Some(pointer) = response.interact_pointer_pos()
+        {
+            let add = modifiers.command || modifiers.shift;
+            match state.tool.mode {
+                SelectMode::Bundles => {
+                    let (origin, direction) = projector.ray(pointer);
+                    let hit = hairloom_core::edit::pick::pick_bundle(mesh, origin, direction);
+                    if !add {
+                        state.selection.clear();
+                    }
+                    if let Some((bundle, _)) = hit {
+                        if !state.selection.insert(bundle) {
+                            state.selection.remove(&bundle);
+                        }
+                        state.message = format!("bundle {bundle}");
+                    }
+                }
+                SelectMode::Vertices => {
+                    let topology = Topology::build(mesh);
+                    let hit = select::nearest_vertex(
+                        mesh,
+                        &topology,
+                        |p| projector.project_xy(p),
+                        [pointer.x as f64, pointer.y as f64],
+                        PICK_RADIUS_PX,
+                    );
+                    if !add {
+                        state.vertex_selection.clear();
+                    }
+                    if let Some(v) = hit {
+                        if !state.vertex_selection.insert(v) {
+                            state.vertex_selection.remove(&v);
+                        }
+                        state.message = format!("vertex: column {} layer {}", v.column, v.layer);
+                    }
+                }
+            }
+            return;
+        }
+        let selecting = response.dragged_by(egui::PointerButton::Primary) && !modifiers.alt;
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            self.drag_path.clear();
+        }
+        if selecting && let Some(pointer) = response.interact_pointer_pos() {
+            self.drag_path.push(pointer);
+        }
+        if response.drag_stopped() && self.drag_path.len() > 1 {
+            let points: Vec<[f64; 2]> = std::mem::take(&mut self.drag_path)
+                .iter()
+                .map(|p| [p.x as f64, p.y as f64])
+                .collect();
+            let region = match state.tool.drag {
+                DragTool::Box => Region::Box {
+                    a: points[0],
+                    b: points[points.len() - 1],
+                },
+                DragTool::Lasso => Region::Lasso(points),
+                DragTool::Paint => Region::Paint {
+                    points,
+                    radius_px: state.tool.paint_radius_px as f64,
+                },
+            };
+            let project = |p| projector.project_xy(p);
+            let replace = !modifiers.shift && !modifiers.command;
+            let remove = modifiers.command;
+            let count = match state.tool.mode {
+                SelectMode::Bundles => {
+                    let hits = select::bundles_in_region(mesh, project, &region);
+                    apply_hits(&mut state.selection, &hits, replace, remove)
+                }
+                SelectMode::Vertices => {
+                    let topology = Topology::build(mesh);
+                    let hits = select::vertices_in_region(mesh, &topology, project, &region);
+                    apply_hits(&mut state.vertex_selection, &hits, replace, remove)
+                }
+            };
+            state.message = format!("{count} in the region");
+        }
+    }
+
+    /// Single-key commands while the pointer is over the viewport.
+    pub(super) fn keys(
+        &mut self,
+        ui: &egui::Ui,
+        state: &mut EditorState,
+        response: &egui::Response,
+    ) {
+        if !response.hovered() || ui.ctx().egui_wants_keyboard_input() {
+            return;
+        }
+        use egui::{Key, Modifiers};
+        let pressed = |key| ui.input_mut(|i| i.consume_key(Modifiers::NONE, key));
+        for (key, kind) in [
+            (Key::G, TransformKind::Move),
+            (Key::R, TransformKind::Rotate),
+            (Key::S, TransformKind::Scale),
+        ] {
+            if pressed(key) {
+                self.begin_transform(ui, state, kind);
+                return;
+            }
+        }
+        if pressed(Key::A) {
+            state.select_all(true);
+        }
+        if ui.input_mut(|i| i.consume_key(Modifiers::ALT, Key::A)) {
+            state.select_all(false);
+        }
+        if pressed(Key::Tab) {
+            state.tool.mode = match state.tool.mode {
+                SelectMode::Bundles => SelectMode::Vertices,
+                SelectMode::Vertices => SelectMode::Bundles,
+            };
+        }
+        if ui.input_mut(|i| {
+            i.consume_key(Modifiers::COMMAND, Key::Plus)
+                || i.consume_key(Modifiers::COMMAND, Key::Equals)
+        }) {
+            state.grow_selection(true);
+        }
+        if ui.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::Minus)) {
+            state.grow_selection(false);
+        }
+        if pressed(Key::F) {
+            self.frame_selection(state);
+        }
+    }
+
+    /// Whether the pointer is over the viewport (the app routes E here then).
+    pub fn is_hovered(&self, ui: &egui::Ui) -> bool {
+        let pointer = ui.input(|i| i.pointer.hover_pos());
+        self.rect
+            .zip(pointer)
+            .is_some_and(|(rect, pointer)| rect.contains(pointer))
+    }
+}

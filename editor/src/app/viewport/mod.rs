@@ -1,0 +1,295 @@
+//! 3D viewport: the document's strands generated on the GPU from its runtime textures every
+//! time the document or the view changes (the same path as `hairloom render` and a game),
+//! drawn offscreen by the render crate and shown as an egui image.
+//!
+//! Navigation (Blender's): middle-drag orbits, shift+middle-drag pans, the wheel zooms; on a
+//! trackpad alt+left-drag orbits and shift+alt+left-drag pans. F frames the selection (the
+//! hair without one), 1 / 3 / 7 look from the front / side / top.
+//!
+//! Selection: a click selects the bundle (or, in vertex mode, the exterior vertex) under the
+//! pointer, shift/ctrl+click adds or removes it, a click on nothing clears; a left drag
+//! selects with the box, lasso or paint brush (shift adds, ctrl removes). A selects all,
+//! alt+A none, ctrl +/- grows / shrinks, Tab switches bundles / vertices.
+//!
+//! Transform (modal, like Blender): G moves, R rotates, S scales the selection following
+//! the pointer, E extrudes the selected bundles with the pointer setting the distance; X / Y / Z lock an axis, the wheel changes the soft-selection radius; a click
+//! or Enter confirms (one undo step), Esc or a right-click cancels. Interior vertices follow
+//! live.
+
+mod camera;
+mod input;
+mod overlay;
+mod paint;
+mod settings;
+mod transform_tools;
+
+use std::sync::Arc;
+
+use eframe::egui_wgpu;
+use glam::{DVec3, Vec3};
+use hairloom_core::edit::select::{self, Region};
+use hairloom_core::edit::{self, VertexTransform};
+use hairloom_core::runtime::frame_plan::LodSettings;
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::textures::Precision;
+use hairloom_core::{Topology, VertexRef};
+use hairloom_render::device::{GpuContext, describe};
+use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
+use hairloom_render::renderer::strand_gen::{GpuHair, StrandGenRenderer};
+
+use super::gizmo::{GizmoAdapter, GizmoStep};
+use super::state::{DragTool, EditorState, SelectMode};
+use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+use hairloom_render::measure::{AccuracyRow, measure_accuracy};
+use hairloom_render::preview::default_scene;
+use hairloom_render::renderer::preview_body::GpuBody;
+
+/// Storage buffers per shader stage the generation and preview pipelines bind.
+const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
+
+/// What the viewport shows and how it generates strands.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewSettings {
+    /// Overlay the hair mesh: layer faces and columns, interior vertices in a second colour.
+    pub wireframe: bool,
+    /// Overlay the styling frame (û red, v̂ green, ŵ blue) at every hair-mesh vertex.
+    pub frame_glyphs: bool,
+    /// Show the move / rotate / scale gizmo at the selection.
+    pub gizmo: bool,
+    pub strands_per_bundle: u32,
+    pub precision: Precision,
+    pub filtering: Filtering,
+    pub lod: LodSettings,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        Self {
+            wireframe: false,
+            frame_glyphs: false,
+            gizmo: true,
+            strands_per_bundle: 32,
+            precision: Precision::F32,
+            filtering: Filtering::Exact,
+            lod: LodSettings::default(),
+        }
+    }
+}
+
+struct UploadedHair {
+    gpu: GpuHair,
+    bounds: (Vec3, Vec3),
+    /// The asset on the CPU (its body is drawn; its styling is restyled in place).
+    hair: RuntimeHair,
+    /// The hair mesh the textures were built from: a change that leaves it (and the body)
+    /// alone is styling only.
+    mesh: hairloom_core::HairMesh,
+    /// The body on the GPU, uploaded with the hair (not per frame).
+    body: GpuBody,
+}
+
+/// Uploads of the hair since the viewport was made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct UploadCounts {
+    /// Textures, samples, placements and styling built and uploaded.
+    pub full: u64,
+    /// Only the styling buffers rewritten (a styling-only edit).
+    pub styling: u64,
+}
+
+/// GPU resources of the viewport (absent without a wgpu device).
+struct GpuView {
+    context: GpuContext,
+    /// Shared with accuracy measurements on a worker thread.
+    generator: Arc<StrandGenRenderer>,
+    preview: PreviewRenderer,
+    egui_renderer: Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>,
+    hair: Option<UploadedHair>,
+    texture: Option<(wgpu::Texture, egui::TextureId)>,
+}
+
+/// Key of what was last drawn, to draw again only when something changed.
+#[derive(Clone, Copy, PartialEq)]
+struct DrawnKey {
+    revision: u64,
+    settings: ViewSettings,
+    orbit: Orbit,
+    size: [u32; 2],
+}
+
+/// What an accuracy measurement gives: every switch's row, or why it failed.
+type AccuracyResult = Result<Vec<AccuracyRow>, String>;
+
+impl Viewport {
+    /// Wall time from submitting the last drawn frame to the GPU finishing it (generation
+    /// and drawing); `None` until one has finished.
+    pub fn frame_ms(&self) -> Option<f64> {
+        self.frame_ms.lock().ok().and_then(|slot| *slot)
+    }
+}
+
+pub struct Viewport {
+    gpu: Option<GpuView>,
+    /// A lost device or a GPU error the device reported outside any error scope: shown in
+    /// the viewport instead of panicking (wgpu's default).
+    device_problem: Arc<std::sync::Mutex<Option<String>>>,
+    pub orbit: Orbit,
+    pub settings: ViewSettings,
+    uploaded: Option<(u64, ViewSettings)>,
+    /// How often the hair went to the GPU, whole or restyled (tests count them).
+    pub uploads: UploadCounts,
+    drawn: Option<DrawnKey>,
+    /// Strands and vertices of the last frame, after culling and LOD.
+    pub drawn_strands: usize,
+    pub drawn_vertices: usize,
+    /// Wall time of generating and drawing the last frame on the GPU (submit to idle).
+    /// Written by the queue's work-done callback, so drawing never waits on the GPU.
+    frame_ms: Arc<std::sync::Mutex<Option<f64>>>,
+    pub adapter: String,
+    pub error: Option<String>,
+    /// Where the viewport was last drawn, in points (snapshot tests crop to it).
+    pub rect: Option<egui::Rect>,
+    transform: Option<ActiveTransform>,
+    /// The on-screen gizmo, at the selection when there is one.
+    gizmo: GizmoAdapter,
+    /// Whether the gizmo was shown last frame (its handles are drawn then).
+    gizmo_shown: bool,
+    /// Where the gizmo's centre was drawn last (tests drag it).
+    pub gizmo_centre: Option<egui::Pos2>,
+    /// The vertices a running gizmo drag moves and its pivot (fixed when it began).
+    gizmo_drag: Option<(Vec<VertexRef>, Option<DVec3>)>,
+    /// What the selection transforms and its centre, for the selection key it was computed
+    /// at (the gizmo asks every frame; topology is rebuilt only when the key changes).
+    targets_cache: Option<(TargetsKey, Vec<VertexRef>, Option<DVec3>)>,
+    /// The last accuracy measurement: the document revision it was made at, and the rows
+    /// (or why it failed).
+    pub accuracy: Option<(u64, Result<Vec<AccuracyRow>, String>)>,
+    /// A measurement running on a worker thread: the revision it measures and where its
+    /// rows arrive.
+    measuring: Option<(u64, std::sync::mpsc::Receiver<AccuracyResult>)>,
+    /// The pointer path of a region drag in progress.
+    drag_path: Vec<egui::Pos2>,
+    /// The box the camera frames (the drawn hair's), for picking with the same camera.
+    camera_bounds: Option<(Vec3, Vec3)>,
+    /// Per column and layer, whether the vertex is interior, for the document revision it
+    /// was computed at (the wireframe marks them; recomputed only when the document changes).
+    interior: Option<(u64, Vec<Vec<bool>>)>,
+    /// Styling frames per layer and column for the document revision they were computed at.
+    frames: Option<(
+        u64,
+        Vec<Vec<Option<hairloom_core::geometry::frames::Frame>>>,
+    )>,
+}
+
+impl Viewport {
+    /// A viewport drawing through eframe's wgpu device, or a placeholder without one.
+    pub fn new(render_state: Option<&egui_wgpu::RenderState>) -> Self {
+        // Generation needs storage buffers in compute and vertex stages (the WebGPU default
+        // of 8); a GL/WebGL2-limited device gets the placeholder and says why.
+        let unsupported = render_state.and_then(|state| {
+            let limits = state.device.limits();
+            (limits.max_storage_buffers_per_shader_stage < MIN_STORAGE_BUFFERS_PER_STAGE).then(
+                || {
+                    format!(
+                        "{}: {} storage buffers per shader stage, the viewport needs {}",
+                        describe(&state.adapter.get_info()),
+                        limits.max_storage_buffers_per_shader_stage,
+                        MIN_STORAGE_BUFFERS_PER_STAGE
+                    )
+                },
+            )
+        });
+        let render_state = render_state.filter(|_| unsupported.is_none());
+        let device_problem = Arc::new(std::sync::Mutex::new(None::<String>));
+        if let Some(state) = render_state {
+            let lost = device_problem.clone();
+            state
+                .device
+                .set_device_lost_callback(move |reason, message| {
+                    if let Ok(mut problem) = lost.lock() {
+                        *problem = Some(format!("the GPU device was lost ({reason:?}): {message}"));
+                    }
+                });
+            let failed = device_problem.clone();
+            state.device.on_uncaptured_error(Arc::new(move |error| {
+                if let Ok(mut problem) = failed.lock() {
+                    problem.get_or_insert_with(|| format!("GPU error: {error}"));
+                }
+            }));
+        }
+        let gpu = render_state.map(|state| {
+            let context = GpuContext::from_parts(
+                state.adapter.clone(),
+                state.device.clone(),
+                state.queue.clone(),
+            );
+            GpuView {
+                generator: Arc::new(StrandGenRenderer::new(&context)),
+                preview: PreviewRenderer::new(&context),
+                egui_renderer: state.renderer.clone(),
+                context,
+                hair: None,
+                texture: None,
+            }
+        });
+        Self {
+            adapter: gpu.as_ref().map_or_else(
+                || unsupported.clone().unwrap_or("no GPU device".into()),
+                |g| describe(&g.context.adapter_info),
+            ),
+            gpu,
+            device_problem,
+            orbit: Orbit::default(),
+            settings: ViewSettings::default(),
+            uploaded: None,
+            uploads: UploadCounts::default(),
+            drawn: None,
+            drawn_strands: 0,
+            drawn_vertices: 0,
+            frame_ms: Arc::default(),
+            error: None,
+            rect: None,
+            transform: None,
+            gizmo: GizmoAdapter::default(),
+            gizmo_shown: false,
+            gizmo_drag: None,
+            targets_cache: None,
+            gizmo_centre: None,
+            accuracy: None,
+            measuring: None,
+            drag_path: Vec::new(),
+            camera_bounds: None,
+            interior: None,
+            frames: None,
+        }
+    }
+
+    pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
+        let (rect, response) =
+            ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
+        self.rect = Some(rect);
+        if let Some(projector) = self.projector(state, rect) {
+            if self.transform.is_some() {
+                self.drive_transform(ui, state, &response, projector);
+            } else {
+                self.navigate(ui, &response);
+                if !self.drive_gizmo(ui, state, &response, projector) {
+                    self.select(ui, state, &response, projector);
+                }
+                self.keys(ui, state, &response);
+            }
+        }
+        self.draw(ui, state, rect);
+        self.paint_overlay(ui, state, rect);
+    }
+
+    /// The wgpu device the viewport draws with (tests provoke device errors on it).
+    pub fn device(&self) -> Option<&wgpu::Device> {
+        self.gpu.as_ref().map(|g| &g.context.device)
+    }
+}
+
+pub use camera::Orbit;
+use camera::Projector;
+pub use transform_tools::TransformKind;
+use transform_tools::{ActiveTransform, TargetsKey};

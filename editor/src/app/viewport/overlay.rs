@@ -1,0 +1,186 @@
+//! The 2D overlay over the picture: hair-mesh wireframe, styling frames, the selection and
+//! the region being dragged.
+
+use super::*;
+
+impl Viewport {
+    /// The hair-mesh wireframe (when on) and the selected bundles' outlines, drawn over the
+    /// picture with the picture's camera (not depth-tested: an X-ray view).
+    pub(super) fn paint_overlay(&mut self, ui: &egui::Ui, state: &EditorState, rect: egui::Rect) {
+        let mesh = &state.document().hair_mesh;
+        let Some(projector) = self.projector(state, rect) else {
+            return;
+        };
+        let project = |p: DVec3| projector.project(p);
+        let painter = ui.painter_at(rect);
+        let outline = |bundle: &hairloom_core::Bundle, stroke: egui::Stroke| {
+            for layer in 0..=bundle.layers as usize {
+                let corners: Vec<_> = bundle
+                    .vertices
+                    .iter()
+                    .filter_map(|&c| project(*mesh.columns.get(c as usize)?.positions.get(layer)?))
+                    .collect();
+                if corners.len() == bundle.vertices.len() {
+                    painter.add(egui::Shape::closed_line(corners, stroke));
+                }
+            }
+            for &c in &bundle.vertices {
+                let Some(column) = mesh.columns.get(c as usize) else {
+                    continue;
+                };
+                let points: Vec<_> = column.positions
+                    [..=(bundle.layers as usize).min(column.positions.len() - 1)]
+                    .iter()
+                    .filter_map(|p| project(*p))
+                    .collect();
+                painter.add(egui::Shape::line(points, stroke));
+            }
+        };
+        let vertex_mode = state.tool.mode == SelectMode::Vertices;
+        if self.settings.wireframe || vertex_mode {
+            let stroke = egui::Stroke::new(
+                1.0,
+                egui::Color32::from_rgba_unmultiplied(120, 170, 230, 110),
+            );
+            for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
+                outline(bundle, stroke);
+            }
+            if self
+                .interior
+                .as_ref()
+                .is_none_or(|(r, _)| *r != state.revision)
+            {
+                let topology = hairloom_core::Topology::build(mesh);
+                let interior = (0..mesh.columns.len())
+                    .map(|c| {
+                        (0..mesh.columns[c].positions.len())
+                            .map(|layer| mesh.is_interior(&topology, c, layer))
+                            .collect()
+                    })
+                    .collect();
+                self.interior = Some((state.revision, interior));
+            }
+            let interior = self.interior.as_ref().map(|(_, i)| i);
+            for (c, column) in mesh.columns.iter().enumerate() {
+                for (layer, p) in column.positions.iter().enumerate() {
+                    let Some(at) = project(*p) else { continue };
+                    let is_interior = interior
+                        .and_then(|i| i.get(c)?.get(layer).copied())
+                        .unwrap_or(false);
+                    let colour = if is_interior {
+                        egui::Color32::from_rgb(240, 200, 80) // placed automatically
+                    } else {
+                        egui::Color32::from_rgb(120, 200, 255) // shaped by the artist
+                    };
+                    painter.circle_filled(at, 1.8, colour);
+                }
+            }
+        }
+        let selected = egui::Stroke::new(1.5, egui::Color32::from_rgb(255, 150, 40));
+        for &b in &state.selection {
+            if let Some(bundle) = mesh.bundles.get(b as usize) {
+                outline(bundle, selected);
+            }
+        }
+        if self.settings.frame_glyphs {
+            if self
+                .frames
+                .as_ref()
+                .is_none_or(|(r, _)| *r != state.revision)
+            {
+                let frames = (0..=mesh.max_layers())
+                    .map(|layer| hairloom_core::geometry::frames::layer_frames(mesh, layer))
+                    .collect();
+                self.frames = Some((state.revision, frames));
+            }
+            let length = mesh.size() * 0.012;
+            if let Some((_, frames)) = &self.frames {
+                for (layer, frames) in frames.iter().enumerate() {
+                    for (c, frame) in frames.iter().enumerate() {
+                        let (Some(frame), Some(p)) = (
+                            frame,
+                            mesh.position(VertexRef {
+                                column: c as u32,
+                                layer: layer as u32,
+                            }),
+                        ) else {
+                            continue;
+                        };
+                        let Some(at) = project(p) else { continue };
+                        let alpha = if frame.fallback { 90 } else { 220 };
+                        for (axis, (r, g, b)) in [
+                            (frame.u, (235, 70, 60)),
+                            (frame.v, (90, 200, 90)),
+                            (frame.w, (80, 140, 255)),
+                        ] {
+                            if let Some(tip) = project(p + axis * length) {
+                                painter.line_segment(
+                                    [at, tip],
+                                    egui::Stroke::new(
+                                        1.2,
+                                        egui::Color32::from_rgba_unmultiplied(r, g, b, alpha),
+                                    ),
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if self.gizmo_shown && self.transform.is_none() {
+            self.gizmo.paint(&painter);
+        }
+        let orange = egui::Color32::from_rgb(255, 150, 40);
+        for v in &state.vertex_selection {
+            if let Some(at) = mesh.position(*v).and_then(project) {
+                painter.circle_filled(at, 3.5, orange);
+            }
+        }
+        // The region being dragged.
+        if self.drag_path.len() > 1 {
+            let stroke = egui::Stroke::new(1.0, egui::Color32::WHITE);
+            let (first, last) = (self.drag_path[0], self.drag_path[self.drag_path.len() - 1]);
+            match state.tool.drag {
+                DragTool::Box => {
+                    painter.rect_stroke(
+                        egui::Rect::from_two_pos(first, last),
+                        0.0,
+                        stroke,
+                        egui::StrokeKind::Middle,
+                    );
+                }
+                DragTool::Lasso => {
+                    painter.add(egui::Shape::closed_line(self.drag_path.clone(), stroke));
+                }
+                DragTool::Paint => {
+                    painter.circle_stroke(last, state.tool.paint_radius_px, stroke);
+                    painter.add(egui::Shape::line(
+                        self.drag_path.clone(),
+                        egui::Stroke::new(
+                            state.tool.paint_radius_px * 2.0,
+                            egui::Color32::from_rgba_unmultiplied(255, 255, 255, 24),
+                        ),
+                    ));
+                }
+            }
+        }
+        if let Some(active) = &self.transform {
+            if let Some(pivot) = project(active.pivot) {
+                painter.circle_stroke(pivot, 5.0, egui::Stroke::new(1.5, orange));
+                if let Some(pointer) = active.applied.map(|(p, _, _)| p) {
+                    painter.line_segment(
+                        [pivot, pointer],
+                        egui::Stroke::new(1.0, egui::Color32::from_white_alpha(120)),
+                    );
+                }
+            }
+            painter.text(
+                rect.left_top() + egui::vec2(10.0, 10.0),
+                egui::Align2::LEFT_TOP,
+                &state.message,
+                egui::FontId::proportional(14.0),
+                egui::Color32::WHITE,
+            );
+        }
+    }
+}
