@@ -4,6 +4,7 @@
 
 use glam::Vec4;
 
+use crate::io::runtime_bundle::ExportError;
 use crate::runtime::half::{f16_bits, f16_to_f32};
 use crate::runtime::textures::{Precision, Texture3d};
 
@@ -94,13 +95,12 @@ pub fn ktx2_bytes(
     height: u32,
     depth: u32,
     data: &[u8],
-) -> Result<Vec<u8>, crate::io::runtime_bundle::ExportError> {
-    let (basic, type_size) = ktx2::dfd::Basic::from_format(format.ktx2()).map_err(|e| {
-        crate::io::runtime_bundle::ExportError::Ktx2 {
+) -> Result<Vec<u8>, ExportError> {
+    let (basic, type_size) =
+        ktx2::dfd::Basic::from_format(format.ktx2()).map_err(|e| ExportError::Ktx2 {
             format: format.vk_name(),
             message: format!("{e:?}"),
-        }
-    })?;
+        })?;
     let block = ktx2::dfd::Block::Basic(basic).to_vec();
     let dfd_total = 4 + block.len();
     let level_index_offset = ktx2::Header::LENGTH;
@@ -122,9 +122,7 @@ pub fn ktx2_bytes(
     };
     let mut level_offset = kvd_offset + kvd.len();
     level_offset = level_offset.div_ceil(alignment) * alignment;
-    let to_u32 = |v: usize| {
-        u32::try_from(v).map_err(|_| crate::io::runtime_bundle::ExportError::TooLarge(v))
-    };
+    let to_u32 = |v: usize| u32::try_from(v).map_err(|_| ExportError::TooLarge(v));
     let header = ktx2::Header {
         format: Some(format.ktx2()),
         type_size,

@@ -512,28 +512,27 @@ fn edit_latency(
             .map(|_| ())
             .map_err(|e| anyhow::anyhow!("{e}"))
     };
+    let timed_both = |mut step: Box<dyn FnMut(usize, bool) -> anyhow::Result<()> + '_>| {
+        let to_gpu = timed(Box::new(|run| step(run, false)))?;
+        let to_pixels = timed(Box::new(|run| step(run, true)))?;
+        anyhow::Ok([to_gpu, to_pixels])
+    };
     let frame_only = timed(Box::new(|_| frame(&gpu, &body)))?;
     let curl = |run: usize| 0.002 + 0.0001 * run as f64;
     let mut styled = document.clone();
-    let mut rebuild = [0.0; 2];
-    for (slot, draw) in [(0, false), (1, true)] {
-        rebuild[slot] = timed(Box::new(|run| {
-            styled.styling.global.curl.radius_m = curl(run);
-            let hair = RuntimeHair::from_document(&styled, &options);
-            let gpu = generator.upload(&context, &hair);
-            let body = GpuBody::upload(&context, &hair.body);
-            if draw { frame(&gpu, &body) } else { idle() }
-        }))?;
-    }
-    let mut in_place = [0.0; 2];
-    for (slot, draw) in [(0, false), (1, true)] {
-        in_place[slot] = timed(Box::new(|run| {
-            document.styling.global.curl.radius_m = curl(run);
-            hair.set_styling(&document.styling);
-            generator.update_styling(&context, &mut gpu, &hair);
-            if draw { frame(&gpu, &body) } else { idle() }
-        }))?;
-    }
+    let rebuild = timed_both(Box::new(|run, draw| {
+        styled.styling.global.curl.radius_m = curl(run);
+        let hair = RuntimeHair::from_document(&styled, &options);
+        let gpu = generator.upload(&context, &hair);
+        let body = GpuBody::upload(&context, &hair.body);
+        if draw { frame(&gpu, &body) } else { idle() }
+    }))?;
+    let in_place = timed_both(Box::new(|run, draw| {
+        document.styling.global.curl.radius_m = curl(run);
+        hair.set_styling(&document.styling);
+        generator.update_styling(&context, &mut gpu, &hair);
+        if draw { frame(&gpu, &body) } else { idle() }
+    }))?;
     let topology = Topology::build(&document.hair_mesh);
     let vertex = document
         .hair_mesh
@@ -549,24 +548,21 @@ fn edit_latency(
         })
         .ok_or_else(|| anyhow::anyhow!("no exterior tip vertex to drag"))?;
     let mut dragged = document.clone();
-    let mut drag = [0.0; 2];
-    for (slot, draw) in [(0, false), (1, true)] {
-        drag[slot] = timed(Box::new(|run| {
-            let outcome = transform_vertices(
-                &document.hair_mesh,
-                &[vertex],
-                VertexTransform::Translate {
-                    offset: [0.0, 0.0005 * (run + 1) as f64, 0.0],
-                },
-                0.0,
-            )?;
-            dragged.hair_mesh = outcome.mesh;
-            // A mesh edit leaves the body alone: it stays uploaded.
-            let hair = RuntimeHair::from_document(&dragged, &options);
-            let gpu = generator.upload(&context, &hair);
-            if draw { frame(&gpu, &body) } else { idle() }
-        }))?;
-    }
+    let drag = timed_both(Box::new(|run, draw| {
+        let outcome = transform_vertices(
+            &document.hair_mesh,
+            &[vertex],
+            VertexTransform::Translate {
+                offset: [0.0, 0.0005 * (run + 1) as f64, 0.0],
+            },
+            0.0,
+        )?;
+        dragged.hair_mesh = outcome.mesh;
+        // A mesh edit leaves the body alone: it stays uploaded.
+        let hair = RuntimeHair::from_document(&dragged, &options);
+        let gpu = generator.upload(&context, &hair);
+        if draw { frame(&gpu, &body) } else { idle() }
+    }))?;
     println!(
         "edit-to-frame latency, {} ({} strands per bundle, {width}x{height}); {}; adapter {}",
         path.display(),
