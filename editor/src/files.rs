@@ -10,7 +10,7 @@ use anyhow::{Context, bail};
 use hairloom_core::Document;
 use hairloom_core::io::import::{ImportOptions, import_file};
 use hairloom_core::io::project::write_atomic;
-use hairloom_core::io::runtime_bundle::runtime_bundle;
+use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
 use hairloom_core::io::strand_files::{glb_lines, hair_file, usda_file};
 use hairloom_core::runtime::hair::RuntimeOptions;
 use hairloom_core::runtime::textures::Precision;
@@ -74,7 +74,6 @@ pub fn write_runtime_bundle(
     precision: Precision,
     strands_per_bundle: u32,
 ) -> anyhow::Result<String> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let options = RuntimeOptions {
         precision,
         strands_per_bundle,
@@ -82,11 +81,8 @@ pub fn write_runtime_bundle(
     };
     let files = runtime_bundle(document, &options)
         .with_context(|| format!("exporting {}", document.name))?;
-    for (name, bytes) in &files {
-        let path = dir.join(name);
-        write_atomic(&path, bytes, |_| {})
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
+    write_bundle_folder(dir, &files, |_| {})
+        .with_context(|| format!("writing the runtime bundle {}", dir.display()))?;
     let total: usize = files.iter().map(|(_, b)| b.len()).sum();
     Ok(format!(
         "{}: runtime bundle, {} files, {:.1} KiB",

@@ -264,3 +264,137 @@ fn random_byte_corruption_never_panics() {
         let _ = import(&bytes, &ImportOptions::default());
     }
 }
+
+/// Hostile files of issue "Hostile and oversized input": each must be a named error.
+#[test]
+fn an_accessor_index_out_of_range_is_named_not_a_panic_in_gltf_json() {
+    let mut builder = GltfBuilder::default();
+    builder.add_quad_mesh("scalp");
+    let mut json = builder.json();
+    // gltf-json 1.4.1's validation indexes `accessors[9]` unchecked and panics.
+    json["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = serde_json::json!(9);
+    let message = error_text(&builder.glb(&json));
+    assert!(message.contains("accessor 9 does not exist"), "{message}");
+    let mut json = builder.json();
+    json["accessors"][0]["bufferView"] = serde_json::json!(77);
+    let message = error_text(&builder.glb(&json));
+    assert!(
+        message.contains("buffer view 77 does not exist"),
+        "{message}"
+    );
+    let mut json = builder.json();
+    json["bufferViews"][0]["buffer"] = serde_json::json!(5);
+    let message = error_text(&builder.glb(&json));
+    assert!(message.contains("buffer 5 does not exist"), "{message}");
+    // A node cycle and a node index out of range: the walk stays bounded.
+    let mut json = builder.json();
+    json["nodes"] = serde_json::json!([{"children": [1]}, {"children": [0, 42]}]);
+    json["scenes"][0]["nodes"] = serde_json::json!([0, 99]);
+    import(&builder.glb(&json), &ImportOptions::default()).expect("imports untransformed");
+}
+
+#[test]
+fn a_glb_header_shorter_than_itself_is_named() {
+    let mut glb = b"glTF".to_vec();
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&4u32.to_le_bytes());
+    glb.extend_from_slice(&[0; 12]);
+    let message = error_text(&glb);
+    assert!(message.contains("declares 4 bytes"), "{message}");
+}
+
+#[test]
+fn buffers_are_read_only_from_regular_files_inside_the_gltf_folder() {
+    let mut builder = GltfBuilder::default();
+    builder.add_quad_mesh("scalp");
+    let temp = tempfile::tempdir().expect("temp dir");
+    let folder = temp.path().join("scalp");
+    std::fs::create_dir(&folder).expect("mkdir");
+    std::fs::write(temp.path().join("outside.bin"), &builder.bin).expect("write");
+    std::fs::write(folder.join("inside bin.bin"), &builder.bin).expect("write");
+    let path = folder.join("scalp.gltf");
+    let import_with_uri = |uri: &str| {
+        let mut json = builder.json();
+        json["buffers"][0]["uri"] = serde_json::json!(uri);
+        std::fs::write(&path, serde_json::to_vec(&json).expect("json")).expect("write");
+        import_file(&path, &ImportOptions::default())
+    };
+    // Inside, %-encoded: read.
+    import_with_uri("inside%20bin.bin").expect("a buffer inside the folder");
+    let outside = temp.path().join("outside.bin").display().to_string();
+    let file_uri = format!("file://{outside}");
+    for uri in [
+        "../outside.bin",
+        "sub/../../outside.bin",
+        outside.as_str(),
+        file_uri.as_str(),
+        "/proc/self/environ",
+        "/dev/zero",
+    ] {
+        let message = import_with_uri(uri).expect_err(uri).to_string();
+        assert!(message.contains("refused"), "{uri}: {message}");
+        // Nothing about the outside file (such as its size) is revealed.
+        assert!(
+            !message.contains(&builder.bin.len().to_string()),
+            "{uri}: {message}"
+        );
+    }
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink("/dev/zero", folder.join("zero.bin")).expect("link");
+        let message = import_with_uri("zero.bin").expect_err("link").to_string();
+        assert!(message.contains("refused"), "{message}");
+        let fifo = folder.join("fifo.bin");
+        if std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success())
+        {
+            // Would hang forever if opened blocking.
+            let message = import_with_uri("fifo.bin").expect_err("fifo").to_string();
+            assert!(message.contains("FIFO"), "{message}");
+        }
+    }
+    // Embedded data (a base64 data URI) is fine, and an import from bytes alone refuses
+    // external files.
+    use base64::Engine as _;
+    let data = base64::engine::general_purpose::STANDARD.encode(&builder.bin);
+    import_with_uri(&format!("data:application/octet-stream;base64,{data}")).expect("data URI");
+    let mut json = builder.json();
+    json["buffers"][0]["uri"] = serde_json::json!("inside%20bin.bin");
+    let message = error_text(&serde_json::to_vec(&json).expect("json"));
+    assert!(message.contains("no folder"), "{message}");
+}
+
+#[test]
+fn ten_thousand_primitives_sharing_an_accessor_hit_a_named_cap() {
+    // 790 KB of this used to take 18 s and 2 GB: each primitive re-read the accessor.
+    let mut builder = GltfBuilder::default();
+    let positions: Vec<f32> = (0..3000 * 3)
+        .map(|i| (i % 7) as f32 + i as f32 * 1e-3)
+        .collect();
+    let p = builder.add_f32(&positions, "VEC3", 3000);
+    let primitive = serde_json::json!({"attributes": {"POSITION": p}});
+    builder.meshes.push(serde_json::json!({
+        "name": "many", "primitives": vec![primitive; 10_000]
+    }));
+    let glb = builder.glb(&builder.json());
+    let message = error_text(&glb);
+    assert!(
+        message.contains("10000 primitives, above the import cap of 4096"),
+        "{message}"
+    );
+    let options = ImportOptions {
+        limits: hairloom_core::io::import::ImportLimits {
+            max_primitives: 20_000,
+            ..Default::default()
+        },
+        ..ImportOptions::default()
+    };
+    let message = import(&glb, &options).expect_err("vertex cap").to_string();
+    assert!(
+        message.contains("vertices, above the import cap of 4000000")
+            && message.contains("--max-vertices"),
+        "{message}"
+    );
+}

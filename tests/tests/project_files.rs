@@ -210,8 +210,45 @@ fn a_writer_killed_mid_save_leaves_the_previous_file_intact() {
         "the previous file changed"
     );
     assert_eq!(project::load(&path).expect("still loads"), original);
-    // A later save still succeeds next to the leftover temporary file.
+    // A later save succeeds and removes the killed writer's leftover temporary file.
     project::save(&path, &original).expect("save again");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("list")
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert!(leftovers.is_empty(), "left behind: {leftovers:?}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_link_planted_at_a_guessable_temporary_name_is_not_followed() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let victim = dir.path().join("victim.txt");
+    std::fs::write(&victim, b"precious").expect("victim");
+    let path = dir.path().join("scalp.hairloom");
+    // Every name an attacker could guess from our process id, in the old and new schemes.
+    let pid = std::process::id();
+    for name in [
+        format!(".scalp.hairloom.tmp-{pid}"),
+        format!(".scalp.hairloom.tmp-{pid}-"),
+        format!(".scalp.hairloom.tmp-{}", pid + 1),
+    ] {
+        std::os::unix::fs::symlink(&victim, dir.path().join(name)).expect("plant link");
+    }
+    let project = hairloom_core::Project::new(hairloom_core::Document::new(
+        "scalp",
+        hairloom_tests::grid_mesh(2, 2, 1, 0.1),
+    ));
+    project::save(&path, &project).expect("save");
+    assert_eq!(std::fs::read(&victim).expect("victim"), b"precious");
+    assert_eq!(project::load(&path).expect("loads"), project);
+    assert!(
+        !std::fs::symlink_metadata(&path)
+            .expect("saved")
+            .file_type()
+            .is_symlink()
+    );
 }
 
 #[test]

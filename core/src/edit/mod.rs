@@ -51,6 +51,8 @@ pub enum EditError {
         layer: u32,
         layers: u32,
     },
+    #[error("bundle {bundle} already has {cap} layers, the most a bundle may have")]
+    LayerCap { bundle: u32, cap: u32 },
     #[error("{what} must be finite, got {value}")]
     NotFinite { what: &'static str, value: String },
     #[error("the edit would leave an invalid mesh: {0}")]

@@ -41,6 +41,13 @@ pub fn extrude(
         });
     }
     let selected: BTreeSet<u32> = bundles.iter().copied().collect();
+    let cap = crate::runtime::textures::MAX_LAYERS_PER_BUNDLE;
+    if let Some(&bundle) = selected
+        .iter()
+        .find(|&&b| mesh.bundles[b as usize].layers >= cap)
+    {
+        return Err(EditError::LayerCap { bundle, cap });
+    }
     let mut out = mesh.clone();
     // Normals at the current top layer of each extruded bundle, accumulated per (column, layer).
     let mut normals: HashMap<(u32, usize), DVec3> = HashMap::new();

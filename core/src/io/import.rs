@@ -8,12 +8,17 @@
 //!
 //! Accessor data is read by our own bounds-checked reader: a truncated buffer, an index out
 //! of range, a NaN or an unsupported layout is an [`ImportError`] naming the file, the mesh,
-//! the primitive and the accessor — never a panic.
+//! the primitive and the accessor — never a panic. External buffers are read only from the
+//! glTF's own folder, and every size is capped ([`ImportLimits`]; `docs/resource-policy.md`).
 
 use std::collections::HashMap;
 use std::path::Path;
 
-use glam::{DMat4, DVec2, DVec3};
+use glam::{DMat4, DQuat, DVec2, DVec3};
+use gltf::json;
+use gltf::json::validation::Checked;
+
+use crate::io::input_files::{InputFileError, InputFolder, read_regular_file};
 
 use crate::model::document::BodyMesh;
 use crate::model::mesh::HairMesh;
@@ -31,6 +36,8 @@ pub struct ImportOptions {
     pub max_quad_fold_deg: f64,
     /// Uniform scale applied after the node transform (model units per file unit).
     pub scale: f64,
+    /// Caps on file sizes and mesh size.
+    pub limits: ImportLimits,
 }
 
 impl Default for ImportOptions {
@@ -41,6 +48,7 @@ impl Default for ImportOptions {
             pair_quads: true,
             max_quad_fold_deg: 60.0,
             scale: 1.0,
+            limits: ImportLimits::default(),
         }
     }
 }
@@ -52,6 +60,26 @@ pub enum ImportError {
     Read {
         file: String,
         source: std::io::Error,
+    },
+    #[error("{file}: {source}")]
+    Input {
+        file: String,
+        source: InputFileError,
+    },
+    #[error("{file}: buffer {buffer}: {message}")]
+    Buffer {
+        file: String,
+        buffer: usize,
+        message: String,
+    },
+    #[error("{file}: mesh \"{mesh}\" has {value} {what}, above the import cap of {cap}{raise}")]
+    Limit {
+        file: String,
+        mesh: String,
+        what: &'static str,
+        value: usize,
+        cap: usize,
+        raise: &'static str,
     },
     #[error("{file}: not a valid glTF file: {message}")]
     Gltf { file: String, message: String },
@@ -154,21 +182,54 @@ impl ImportedMesh {
     }
 }
 
-/// Imports a mesh from a `.gltf` or `.glb` file.
-pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedMesh, ImportError> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| ImportError::Read {
-        file: file.clone(),
-        source,
-    })?;
-    import_slice(&bytes, path.parent(), &file, options)
+/// Caps on what one import may read and build (see `docs/resource-policy.md`). Each has a
+/// named error; the CLI can raise `max_vertices` with `--max-vertices`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImportLimits {
+    /// The `.gltf` / `.glb` file and each external buffer file.
+    pub max_file_bytes: u64,
+    /// Vertices over all primitives of the mesh, before welding.
+    pub max_vertices: usize,
+    /// Triangles over all primitives of the mesh.
+    pub max_triangles: usize,
+    /// Primitives in the mesh.
+    pub max_primitives: usize,
 }
 
-/// Imports from bytes; `base` resolves external buffer URIs, `file` names the source in
-/// messages.
+impl Default for ImportLimits {
+    fn default() -> Self {
+        Self {
+            max_file_bytes: 512 << 20,
+            max_vertices: 4_000_000,
+            max_triangles: 8_000_000,
+            max_primitives: 4096,
+        }
+    }
+}
+
+/// Imports a mesh from a `.gltf` or `.glb` file. External buffers are read only from the
+/// file's own folder (see [`crate::io::input_files`]).
+pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedMesh, ImportError> {
+    let file = path.display().to_string();
+    let input = |source| ImportError::Input {
+        file: file.clone(),
+        source,
+    };
+    let bytes =
+        read_regular_file(path, options.limits.max_file_bytes, "a glTF file").map_err(input)?;
+    let folder = InputFolder::of_file(path).map_err(input)?;
+    import_slice(&bytes, Some(&folder), &file, options)
+}
+
+/// Imports from bytes; `folder` is where external buffer URIs may lead (none: only the GLB
+/// blob and data URIs), `file` names the source in messages.
+///
+/// The JSON is read with `gltf-json`'s deserializer only: the `gltf` crate's validation and
+/// its document wrappers index arrays unchecked (an accessor index out of range panics), so
+/// every index here is resolved by our own checked lookups instead.
 pub fn import_slice(
     bytes: &[u8],
-    base: Option<&Path>,
+    folder: Option<&InputFolder>,
     file: &str,
     options: &ImportOptions,
 ) -> Result<ImportedMesh, ImportError> {
@@ -176,97 +237,107 @@ pub fn import_slice(
         file: file.to_string(),
         message,
     };
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| gltf_error(e.to_string()))?;
-    let buffers = gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
-        .map_err(|e| gltf_error(format!("buffer data: {e}")))?;
-    let document = &gltf.document;
-    let meshes: Vec<gltf::Mesh> = document.meshes().collect();
-    let mesh = match &options.mesh_name {
-        Some(name) => meshes
-            .iter()
-            .find(|m| m.name() == Some(name.as_str()))
-            .ok_or_else(|| ImportError::NoMesh {
-                file: file.to_string(),
-                message: format!("no mesh named \"{name}\" (meshes: {})", mesh_names(&meshes)),
-            })?,
-        None => match meshes.as_slice() {
-            [] => {
-                return Err(ImportError::NoMesh {
-                    file: file.to_string(),
-                    message: "the file contains no mesh".into(),
-                });
-            }
-            [only] => only,
-            _ => {
-                return Err(ImportError::NoMesh {
-                    file: file.to_string(),
-                    message: format!(
-                        "the file has several meshes; choose one by name ({})",
-                        mesh_names(&meshes)
-                    ),
-                });
-            }
-        },
-    };
+    let (json_bytes, blob) = split_glb(bytes).map_err(gltf_error)?;
+    let root = json::Root::from_slice(json_bytes).map_err(|e| gltf_error(e.to_string()))?;
+    let limits = options.limits;
+    let mesh_index = choose_mesh(&root, options.mesh_name.as_deref(), file)?;
+    let mesh = &root.meshes[mesh_index];
     let mesh_name = mesh
-        .name()
-        .map(str::to_string)
-        .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+        .name
+        .clone()
+        .unwrap_or_else(|| format!("mesh {mesh_index}"));
+    let limit =
+        |what: &'static str, value: usize, cap: usize, raise: &'static str| ImportError::Limit {
+            file: file.to_string(),
+            mesh: mesh_name.clone(),
+            what,
+            value,
+            cap,
+            raise,
+        };
+    if mesh.primitives.len() > limits.max_primitives {
+        return Err(limit(
+            "primitives",
+            mesh.primitives.len(),
+            limits.max_primitives,
+            "",
+        ));
+    }
     let transform =
-        node_transform(document, mesh.index()) * DMat4::from_scale(DVec3::splat(options.scale));
+        node_transform(&root, mesh_index) * DMat4::from_scale(DVec3::splat(options.scale));
     let normal_transform = transform.inverse().transpose();
+    let buffers = Buffers::load(&root, blob, folder, file, limits.max_file_bytes)?;
+    let mut reader = AccessorReader {
+        root: &root,
+        buffers: &buffers,
+        file,
+        mesh: &mesh_name,
+        primitive: 0,
+        cache: HashMap::new(),
+    };
 
     let mut positions: Vec<DVec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut corner_uvs: Vec<[DVec2; 3]> = Vec::new();
     let mut has_uv = false;
-    for primitive in mesh.primitives() {
-        let p_index = primitive.index();
+    for (p_index, primitive) in mesh.primitives.iter().enumerate() {
+        reader.primitive = p_index;
         let primitive_error = |message: String| ImportError::Primitive {
             file: file.to_string(),
             mesh: mesh_name.clone(),
             primitive: p_index,
             message,
         };
-        if primitive.mode() != gltf::mesh::Mode::Triangles {
-            return Err(primitive_error(format!(
-                "mode {:?} is not supported; a scalp must be made of triangles",
-                primitive.mode()
-            )));
+        match primitive.mode {
+            Checked::Valid(json::mesh::Mode::Triangles) => {}
+            Checked::Valid(mode) => {
+                return Err(primitive_error(format!(
+                    "mode {mode:?} is not supported; a scalp must be made of triangles"
+                )));
+            }
+            Checked::Invalid => return Err(primitive_error("unknown primitive mode".into())),
         }
-        let context = AccessorContext {
-            file,
-            mesh: &mesh_name,
-            primitive: p_index,
-            buffers: &buffers,
+        let attribute = |semantic: json::mesh::Semantic| {
+            primitive
+                .attributes
+                .get(&Checked::Valid(semantic))
+                .map(|index| index.value())
         };
-        let Some(position_accessor) = primitive.get(&gltf::Semantic::Positions) else {
+        let Some(position_accessor) = attribute(json::mesh::Semantic::Positions) else {
             return Err(primitive_error("missing POSITION attribute".into()));
         };
-        let local_positions = context.read_vec(&position_accessor, "POSITION", 3)?;
-        let vertex_count = local_positions.len();
-        let normals = match primitive.get(&gltf::Semantic::Normals) {
+        let vertex_count = reader.count(position_accessor, "POSITION")?;
+        if positions.len().saturating_add(vertex_count) > limits.max_vertices {
+            return Err(limit(
+                "vertices",
+                positions.len().saturating_add(vertex_count),
+                limits.max_vertices,
+                " (raise it with --max-vertices)",
+            ));
+        }
+        let local_positions = reader.read(position_accessor, "POSITION", 3)?;
+        let normals = match attribute(json::mesh::Semantic::Normals) {
             Some(accessor) => {
-                let normals = context.read_vec(&accessor, "NORMAL", 3)?;
-                if normals.len() != vertex_count {
-                    return Err(context.error(
-                        &accessor,
+                let normals = reader.read(accessor, "NORMAL", 3)?;
+                if normals.len() / 3 != vertex_count {
+                    return Err(reader.error(
+                        accessor,
                         "NORMAL",
-                        format!("{} normals for {vertex_count} positions", normals.len()),
+                        format!("{} normals for {vertex_count} positions", normals.len() / 3),
                     ));
                 }
                 Some(normals)
             }
             None => None,
         };
-        let uvs = match primitive.get(&gltf::Semantic::TexCoords(0)) {
+        let uvs = match attribute(json::mesh::Semantic::TexCoords(0)) {
             Some(accessor) => {
-                let uvs = context.read_vec(&accessor, "TEXCOORD_0", 2)?;
-                if uvs.len() != vertex_count {
-                    return Err(context.error(
-                        &accessor,
+                let uvs = reader.read(accessor, "TEXCOORD_0", 2)?;
+                if uvs.len() / 2 != vertex_count {
+                    return Err(reader.error(
+                        accessor,
                         "TEXCOORD_0",
-                        format!("{} uv values for {vertex_count} positions", uvs.len()),
+                        format!("{} uv values for {vertex_count} positions", uvs.len() / 2),
                     ));
                 }
                 has_uv = true;
@@ -274,15 +345,19 @@ pub fn import_slice(
             }
             None => None,
         };
-        let indices: Vec<u32> = match primitive.indices() {
+        let indices: Vec<u32> = match primitive.indices.map(|i| i.value()) {
             Some(accessor) => {
-                let values = context.read_vec(&accessor, "indices", 1)?;
+                let count = reader.count(accessor, "indices")?;
+                let triangle_total = triangles.len().saturating_add(count / 3);
+                if triangle_total > limits.max_triangles {
+                    return Err(limit("triangles", triangle_total, limits.max_triangles, ""));
+                }
+                let values = reader.read(accessor, "indices", 1)?;
                 let mut indices = Vec::with_capacity(values.len());
-                for (i, v) in values.iter().enumerate() {
-                    let index = v[0];
+                for (i, &index) in values.iter().enumerate() {
                     if index < 0.0 || index >= vertex_count as f64 {
-                        return Err(context.error(
-                            &accessor,
+                        return Err(reader.error(
+                            accessor,
                             "indices",
                             format!("index {index} at position {i} is out of range ({vertex_count} vertices)"),
                         ));
@@ -290,8 +365,8 @@ pub fn import_slice(
                     indices.push(index as u32);
                 }
                 if indices.len() % 3 != 0 {
-                    return Err(context.error(
-                        &accessor,
+                    return Err(reader.error(
+                        accessor,
                         "indices",
                         format!(
                             "{} indices is not a whole number of triangles",
@@ -307,15 +382,19 @@ pub fn import_slice(
                         "{vertex_count} vertices without indices is not a whole number of triangles"
                     )));
                 }
+                let triangle_total = triangles.len().saturating_add(vertex_count / 3);
+                if triangle_total > limits.max_triangles {
+                    return Err(limit("triangles", triangle_total, limits.max_triangles, ""));
+                }
                 (0..vertex_count as u32).collect()
             }
         };
         // Flip triangles whose winding disagrees with the file's normals, so every face is
         // counter-clockwise seen from outside, as the hair mesh requires.
         let base = positions.len() as u32;
-        let world: Vec<DVec3> = local_positions
-            .iter()
-            .map(|p| transform.transform_point3(DVec3::new(p[0], p[1], p[2])))
+        let vec3 = |values: &[f64], i: usize| DVec3::from_slice(&values[3 * i..3 * i + 3]);
+        let world: Vec<DVec3> = (0..vertex_count)
+            .map(|i| transform.transform_point3(vec3(&local_positions, i)))
             .collect();
         for triangle in indices.chunks_exact(3) {
             let mut t = [triangle[0], triangle[1], triangle[2]];
@@ -324,17 +403,14 @@ pub fn import_slice(
                     .cross(world[t[2] as usize] - world[t[0] as usize]);
                 let vertex_normal: DVec3 = t
                     .iter()
-                    .map(|&i| {
-                        let n = &normals[i as usize];
-                        normal_transform.transform_vector3(DVec3::new(n[0], n[1], n[2]))
-                    })
+                    .map(|&i| normal_transform.transform_vector3(vec3(normals, i as usize)))
                     .sum();
                 if face_normal.dot(vertex_normal) < 0.0 {
                     t.swap(1, 2);
                 }
             }
             let uv = t.map(|i| match &uvs {
-                Some(uvs) => DVec2::new(uvs[i as usize][0], uvs[i as usize][1]),
+                Some(uvs) => DVec2::new(uvs[2 * i as usize], uvs[2 * i as usize + 1]),
                 None => DVec2::ZERO,
             });
             triangles.push(t.map(|i| i + base));
@@ -379,156 +455,414 @@ pub fn import_slice(
     })
 }
 
-fn mesh_names(meshes: &[gltf::Mesh]) -> String {
-    meshes
+/// The JSON chunk and the optional BIN chunk of a GLB, or the whole input as JSON. The
+/// header is checked here first: `gltf::Glb::from_slice` subtracts the header size from
+/// the declared length unchecked.
+fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok((bytes, None));
+    }
+    if bytes.len() < 20 {
+        return Err(format!(
+            "a {}-byte GLB is shorter than its header",
+            bytes.len()
+        ));
+    }
+    let word =
+        |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    if word(4) != 2 {
+        return Err(format!("GLB version {} is not 2", word(4)));
+    }
+    if word(8) as usize != bytes.len() {
+        return Err(format!(
+            "the GLB header declares {} bytes but the file has {}",
+            word(8),
+            bytes.len()
+        ));
+    }
+    let glb = gltf::Glb::from_slice(bytes).map_err(|e| format!("GLB container: {e}"))?;
+    match (glb.json, glb.bin) {
+        (std::borrow::Cow::Borrowed(json), Some(std::borrow::Cow::Borrowed(bin))) => {
+            Ok((json, Some(bin)))
+        }
+        (std::borrow::Cow::Borrowed(json), None) => Ok((json, None)),
+        _ => Err("GLB container copied its chunks".into()),
+    }
+}
+
+fn choose_mesh(root: &json::Root, name: Option<&str>, file: &str) -> Result<usize, ImportError> {
+    let no_mesh = |message: String| ImportError::NoMesh {
+        file: file.to_string(),
+        message,
+    };
+    match name {
+        Some(name) => root
+            .meshes
+            .iter()
+            .position(|m| m.name.as_deref() == Some(name))
+            .ok_or_else(|| {
+                no_mesh(format!(
+                    "no mesh named \"{name}\" (meshes: {})",
+                    mesh_names(root)
+                ))
+            }),
+        None => match root.meshes.len() {
+            0 => Err(no_mesh("the file contains no mesh".into())),
+            1 => Ok(0),
+            _ => Err(no_mesh(format!(
+                "the file has several meshes; choose one by name ({})",
+                mesh_names(root)
+            ))),
+        },
+    }
+}
+
+fn mesh_names(root: &json::Root) -> String {
+    let mut names: Vec<String> = root
+        .meshes
         .iter()
-        .map(|m| {
-            m.name()
+        .enumerate()
+        .take(20)
+        .map(|(i, m)| {
+            m.name
+                .as_ref()
                 .map(|n| format!("\"{n}\""))
-                .unwrap_or_else(|| format!("#{}", m.index()))
+                .unwrap_or_else(|| format!("#{i}"))
         })
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect();
+    if root.meshes.len() > 20 {
+        names.push(format!("… {} more", root.meshes.len() - 20));
+    }
+    names.join(", ")
 }
 
 /// World transform of the first node (in scene order, depth first) that instances `mesh`;
-/// identity when no node does.
-fn node_transform(document: &gltf::Document, mesh: usize) -> DMat4 {
-    fn visit(node: gltf::Node, parent: DMat4, mesh: usize, depth: usize) -> Option<DMat4> {
-        // Guard against malicious cycles (validation rejects them, but stay bounded).
-        if depth > 64 {
-            return None;
-        }
-        let local = node.transform().matrix();
-        let local = DMat4::from_cols_array_2d(&local.map(|c| c.map(f64::from)));
-        let world = parent * local;
-        if node.mesh().is_some_and(|m| m.index() == mesh) {
-            return Some(world);
-        }
-        node.children()
-            .find_map(|child| visit(child, world, mesh, depth + 1))
+/// identity when no node does. Indices are looked up checked, and the walk is bounded in
+/// depth and in nodes visited (a hostile file may make the node graph cyclic or shared).
+fn node_transform(root: &json::Root, mesh: usize) -> DMat4 {
+    struct Walk<'a> {
+        root: &'a json::Root,
+        mesh: usize,
+        visited: usize,
     }
-    let scenes: Vec<gltf::Scene> = document
-        .default_scene()
+    impl Walk<'_> {
+        fn visit(&mut self, node: usize, parent: DMat4, depth: usize) -> Option<DMat4> {
+            self.visited += 1;
+            if depth > 64 || self.visited > 100_000 {
+                return None;
+            }
+            let node = self.root.nodes.get(node)?;
+            let world = parent * local_transform(node);
+            if node.mesh.is_some_and(|m| m.value() == self.mesh) {
+                return Some(world);
+            }
+            node.children
+                .iter()
+                .flatten()
+                .find_map(|child| self.visit(child.value(), world, depth + 1))
+        }
+    }
+    let mut walk = Walk {
+        root,
+        mesh,
+        visited: 0,
+    };
+    let scenes = root
+        .scene
+        .map(|s| s.value())
         .into_iter()
-        .chain(document.scenes())
-        .collect();
+        .chain(0..root.scenes.len());
     scenes
-        .into_iter()
+        .filter_map(|s| root.scenes.get(s))
         .find_map(|scene| {
             scene
-                .nodes()
-                .find_map(|node| visit(node, DMat4::IDENTITY, mesh, 0))
+                .nodes
+                .iter()
+                .find_map(|node| walk.visit(node.value(), DMat4::IDENTITY, 0))
         })
         .filter(|m| m.is_finite())
         .unwrap_or(DMat4::IDENTITY)
 }
 
-struct AccessorContext<'a> {
+fn local_transform(node: &json::scene::Node) -> DMat4 {
+    if let Some(matrix) = node.matrix {
+        return DMat4::from_cols_array(&matrix.map(f64::from));
+    }
+    let t = node.translation.unwrap_or([0.0; 3]).map(f64::from);
+    let r = node
+        .rotation
+        .map(|q| q.0)
+        .unwrap_or([0.0, 0.0, 0.0, 1.0])
+        .map(f64::from);
+    let s = node.scale.unwrap_or([1.0; 3]).map(f64::from);
+    let rotation = DQuat::from_array(r).normalize();
+    DMat4::from_scale_rotation_translation(DVec3::from(s), rotation, DVec3::from(t))
+}
+
+/// The bytes of every buffer: the GLB blob, a base64 data URI, or a regular file inside the
+/// glTF's folder (never anything else: see [`crate::io::input_files`]).
+struct Buffers<'a> {
+    data: Vec<std::borrow::Cow<'a, [u8]>>,
+}
+
+impl<'a> Buffers<'a> {
+    fn load(
+        root: &json::Root,
+        blob: Option<&'a [u8]>,
+        folder: Option<&InputFolder>,
+        file: &str,
+        cap_bytes: u64,
+    ) -> Result<Self, ImportError> {
+        let mut data = Vec::with_capacity(root.buffers.len());
+        let mut total_bytes = 0u64;
+        for (index, buffer) in root.buffers.iter().enumerate() {
+            let fail = |message: String| ImportError::Buffer {
+                file: file.to_string(),
+                buffer: index,
+                message,
+            };
+            let declared = buffer.byte_length.0;
+            total_bytes = total_bytes.saturating_add(declared);
+            if total_bytes > cap_bytes {
+                return Err(fail(format!(
+                    "the buffers declare more than the cap of {cap_bytes} bytes"
+                )));
+            }
+            let bytes: std::borrow::Cow<[u8]> = match buffer.uri.as_deref() {
+                None => match (index, blob) {
+                    (0, Some(blob)) => std::borrow::Cow::Borrowed(blob),
+                    _ => {
+                        return Err(fail(
+                            "it has no uri and is not the GLB's binary chunk".into(),
+                        ));
+                    }
+                },
+                Some(uri) if uri.starts_with("data:") => {
+                    std::borrow::Cow::Owned(decode_data_uri(uri).map_err(fail)?)
+                }
+                Some(uri) => {
+                    let Some(folder) = folder else {
+                        return Err(fail(format!(
+                            "it names the external file \"{uri}\", but this input has no folder to read it from"
+                        )));
+                    };
+                    let name = percent_decode(uri).map_err(fail)?;
+                    let bytes = folder
+                        .read(&name, cap_bytes, "a glTF buffer")
+                        .map_err(|source| fail(source.to_string()))?;
+                    std::borrow::Cow::Owned(bytes)
+                }
+            };
+            if (bytes.len() as u64) < declared {
+                return Err(fail(format!(
+                    "it holds {} bytes but the file declares byteLength {declared}",
+                    bytes.len()
+                )));
+            }
+            data.push(match bytes {
+                std::borrow::Cow::Borrowed(b) => {
+                    std::borrow::Cow::Borrowed(&b[..declared as usize])
+                }
+                std::borrow::Cow::Owned(mut b) => {
+                    b.truncate(declared as usize);
+                    std::borrow::Cow::Owned(b)
+                }
+            });
+        }
+        Ok(Self { data })
+    }
+
+    fn get(&self, index: usize) -> Option<&[u8]> {
+        self.data.get(index).map(|b| b.as_ref())
+    }
+}
+
+/// The bytes of a base64 `data:` URI (the only data URI form glTF exporters write).
+fn decode_data_uri(uri: &str) -> Result<Vec<u8>, String> {
+    use base64::Engine as _;
+    let Some((header, payload)) = uri.split_once(',') else {
+        return Err("data URI without a comma".into());
+    };
+    if !header.ends_with(";base64") {
+        return Err("only base64 data URIs are supported".into());
+    }
+    base64::engine::general_purpose::STANDARD
+        .decode(payload)
+        .map_err(|e| format!("data URI: {e}"))
+}
+
+/// glTF URIs are RFC 3986 references: `%20` in a file name is a space.
+fn percent_decode(uri: &str) -> Result<String, String> {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = bytes
+                .get(i + 1..i + 3)
+                .and_then(|h| std::str::from_utf8(h).ok())
+                .and_then(|h| u8::from_str_radix(h, 16).ok())
+                .ok_or_else(|| format!("\"{uri}\": a malformed %-escape"))?;
+            out.push(hex);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).map_err(|_| format!("\"{uri}\": not UTF-8 after %-decoding"))
+}
+
+/// Reads accessors with every index, offset and size checked; each accessor is read once
+/// and shared (a file may point thousands of primitives at one accessor).
+struct AccessorReader<'a> {
+    root: &'a json::Root,
+    buffers: &'a Buffers<'a>,
     file: &'a str,
     mesh: &'a str,
     primitive: usize,
-    buffers: &'a [gltf::buffer::Data],
+    cache: HashMap<usize, std::rc::Rc<Vec<f64>>>,
 }
 
-impl AccessorContext<'_> {
-    fn error(&self, accessor: &gltf::Accessor, semantic: &str, message: String) -> ImportError {
+impl AccessorReader<'_> {
+    fn error(&self, accessor: usize, semantic: &str, message: String) -> ImportError {
         ImportError::Accessor {
             file: self.file.to_string(),
             mesh: self.mesh.to_string(),
             primitive: self.primitive,
-            accessor: accessor.index(),
+            accessor,
             semantic: semantic.to_string(),
             message,
         }
     }
 
-    /// Reads an accessor of `components` components per element into f64 values, with
-    /// normalised integers mapped to [0, 1] / [−1, 1]. Every read is bounds-checked and
-    /// every value must be finite.
-    fn read_vec(
+    fn accessor(
         &self,
-        accessor: &gltf::Accessor,
+        index: usize,
+        semantic: &str,
+    ) -> Result<&json::accessor::Accessor, ImportError> {
+        self.root.accessors.get(index).ok_or_else(|| {
+            self.error(
+                index,
+                semantic,
+                format!(
+                    "accessor {index} does not exist (the file has {})",
+                    self.root.accessors.len()
+                ),
+            )
+        })
+    }
+
+    /// Element count of an accessor, before reading it.
+    fn count(&self, index: usize, semantic: &str) -> Result<usize, ImportError> {
+        let accessor = self.accessor(index, semantic)?;
+        usize::try_from(accessor.count.0)
+            .map_err(|_| self.error(index, semantic, "count does not fit in memory".into()))
+    }
+
+    /// Reads an accessor of `components` components per element into a flat list of f64,
+    /// with normalised integers mapped to [0, 1] / [−1, 1]. Every value must be finite.
+    fn read(
+        &mut self,
+        index: usize,
         semantic: &str,
         components: usize,
-    ) -> Result<Vec<Vec<f64>>, ImportError> {
-        use gltf::accessor::{DataType, Dimensions};
-        let fail = |message: String| self.error(accessor, semantic, message);
-        let dims = match accessor.dimensions() {
-            Dimensions::Scalar => 1,
-            Dimensions::Vec2 => 2,
-            Dimensions::Vec3 => 3,
-            Dimensions::Vec4 => 4,
-            other => return Err(fail(format!("unsupported element type {other:?}"))),
+    ) -> Result<std::rc::Rc<Vec<f64>>, ImportError> {
+        use json::accessor::{ComponentType, Type};
+        let accessor = self.accessor(index, semantic)?;
+        let fail = |message: String| self.error(index, semantic, message);
+        let dims = match accessor.type_ {
+            Checked::Valid(Type::Scalar) => 1,
+            Checked::Valid(Type::Vec2) => 2,
+            Checked::Valid(Type::Vec3) => 3,
+            Checked::Valid(Type::Vec4) => 4,
+            Checked::Valid(other) => {
+                return Err(fail(format!("unsupported element type {other:?}")));
+            }
+            Checked::Invalid => return Err(fail("unknown element type".into())),
         };
         if dims != components {
             return Err(fail(format!(
                 "expected {components} components per element, found {dims}"
             )));
         }
-        if accessor.sparse().is_some() {
+        if let Some(cached) = self.cache.get(&index) {
+            return Ok(cached.clone());
+        }
+        if accessor.sparse.is_some() {
             return Err(fail("sparse accessors are not supported".into()));
         }
-        let Some(view) = accessor.view() else {
+        let data_type = match accessor.component_type {
+            Checked::Valid(json::accessor::GenericComponentType(t)) => t,
+            Checked::Invalid => return Err(fail("unknown component type".into())),
+        };
+        let Some(view_index) = accessor.buffer_view.map(|v| v.value()) else {
             return Err(fail("accessor has no buffer view".into()));
         };
-        let data_type = accessor.data_type();
-        let component_size = data_type.size();
+        let Some(view) = self.root.buffer_views.get(view_index) else {
+            return Err(fail(format!("buffer view {view_index} does not exist")));
+        };
+        let component_size = match data_type {
+            ComponentType::I8 | ComponentType::U8 => 1,
+            ComponentType::I16 | ComponentType::U16 => 2,
+            ComponentType::U32 | ComponentType::F32 => 4,
+        };
         let element_size = component_size * dims;
-        let stride = view.stride().unwrap_or(element_size);
+        let stride = view.byte_stride.map(|s| s.0).unwrap_or(element_size);
         if stride < element_size {
             return Err(fail(format!(
                 "byte stride {stride} is smaller than the element ({element_size} bytes)"
             )));
         }
-        let Some(buffer) = self.buffers.get(view.buffer().index()) else {
-            return Err(fail(format!("buffer {} is missing", view.buffer().index())));
+        let buffer_index = view.buffer.value();
+        let Some(buffer) = self.buffers.get(buffer_index) else {
+            return Err(fail(format!("buffer {buffer_index} does not exist")));
         };
-        let view_end = view.offset().checked_add(view.length());
-        if view_end.is_none_or(|end| end > buffer.len()) {
+        let view_offset = view.byte_offset.map_or(0, |o| o.0);
+        let view_length = view.byte_length.0;
+        let view_range = usize::try_from(view_offset)
+            .ok()
+            .zip(usize::try_from(view_length).ok())
+            .and_then(|(start, length)| Some(start..start.checked_add(length)?))
+            .filter(|range| range.end <= buffer.len());
+        let Some(view_range) = view_range else {
             return Err(fail(format!(
-                "buffer view {} ({} bytes at offset {}) runs past the end of buffer {} ({} bytes)",
-                view.index(),
-                view.length(),
-                view.offset(),
-                view.buffer().index(),
+                "buffer view {view_index} ({view_length} bytes at offset {view_offset}) runs past the end of buffer {buffer_index} ({} bytes)",
                 buffer.len()
             )));
-        }
-        let view_bytes = &buffer[view.offset()..view.offset() + view.length()];
-        let count = accessor.count();
-        let needed = if count == 0 {
-            0
-        } else {
-            accessor
-                .offset()
-                .checked_add(stride.saturating_mul(count - 1))
-                .and_then(|v| v.checked_add(element_size))
-                .unwrap_or(usize::MAX)
         };
-        if needed > view_bytes.len() {
+        let view_bytes = &buffer[view_range];
+        let count = self.count(index, semantic)?;
+        let offset = usize::try_from(accessor.byte_offset.map_or(0, |o| o.0)).unwrap_or(usize::MAX);
+        let needed = if count == 0 {
+            Some(0)
+        } else {
+            stride
+                .checked_mul(count - 1)
+                .and_then(|v| v.checked_add(offset))
+                .and_then(|v| v.checked_add(element_size))
+        };
+        if needed.is_none_or(|needed| needed > view_bytes.len()) {
             return Err(fail(format!(
-                "{count} elements need {needed} bytes but buffer view {} has {} (truncated file?)",
-                view.index(),
+                "{count} elements need more bytes than buffer view {view_index} has ({}; truncated file?)",
                 view_bytes.len()
             )));
         }
-        let normalized = accessor.normalized();
-        let mut out = Vec::with_capacity(count);
+        let normalized = accessor.normalized;
+        let mut out = Vec::with_capacity(count * dims);
         for i in 0..count {
-            let start = accessor.offset() + i * stride;
-            let mut element = Vec::with_capacity(dims);
+            let start = offset + i * stride;
             for c in 0..dims {
                 let at = start + c * component_size;
                 let b = &view_bytes[at..at + component_size];
                 let value = match data_type {
-                    DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-                    DataType::U16 => {
+                    ComponentType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    ComponentType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    ComponentType::U16 => {
                         let v = u16::from_le_bytes([b[0], b[1]]) as f64;
                         if normalized { v / 65535.0 } else { v }
                     }
-                    DataType::I16 => {
+                    ComponentType::I16 => {
                         let v = i16::from_le_bytes([b[0], b[1]]) as f64;
                         if normalized {
                             (v / 32767.0).max(-1.0)
@@ -536,11 +870,11 @@ impl AccessorContext<'_> {
                             v
                         }
                     }
-                    DataType::U8 => {
+                    ComponentType::U8 => {
                         let v = b[0] as f64;
                         if normalized { v / 255.0 } else { v }
                     }
-                    DataType::I8 => {
+                    ComponentType::I8 => {
                         let v = b[0] as i8 as f64;
                         if normalized { (v / 127.0).max(-1.0) } else { v }
                     }
@@ -550,10 +884,11 @@ impl AccessorContext<'_> {
                         "element {i} component {c} is not finite ({value})"
                     )));
                 }
-                element.push(value);
+                out.push(value);
             }
-            out.push(element);
         }
+        let out = std::rc::Rc::new(out);
+        self.cache.insert(index, out.clone());
         Ok(out)
     }
 }

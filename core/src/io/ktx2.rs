@@ -162,32 +162,91 @@ fn gcd(a: usize, b: usize) -> usize {
     if b == 0 { a } else { gcd(b, a % b) }
 }
 
+/// The 12 bytes every KTX2 file starts with.
+const KTX2_IDENTIFIER: [u8; 12] = [
+    0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB, b'\r', b'\n', 0x1A, b'\n',
+];
+
+/// Bytes of the KTX2 header and of one level-index entry.
+const HEADER_BYTES: usize = 80;
+const LEVEL_INDEX_BYTES: usize = 24;
+
 /// Reads a KTX2 file written by [`ktx2_bytes`] into a texture, checking its format and
 /// size against `format` and `expected_size` (depth 0: a 2D texture) and that every texel
 /// value is finite. The message names what is wrong.
+///
+/// The header is parsed here, with checked arithmetic, rather than by `ktx2::Reader`:
+/// that reader parses the data format descriptor eagerly and panics on some malformed
+/// ones (ktx2 0.5.0: a texel-block dimension byte of 255 overflows and unwraps `None`).
+/// The descriptor is only bounds-checked: for an uncompressed file `vkFormat` is
+/// authoritative (KTX2 spec §3.1), and it must equal the manifest's format.
 pub fn read_texture(
     bytes: &[u8],
     format: TexelFormat,
     expected_size: [u32; 3],
 ) -> Result<Texture3d, String> {
-    let reader = ktx2::Reader::new(bytes).map_err(|e| format!("not a valid KTX2 file: {e:?}"))?;
-    let header = reader.header();
-    if header.format != Some(format.ktx2()) {
+    if bytes.len() < HEADER_BYTES + LEVEL_INDEX_BYTES {
         return Err(format!(
-            "KTX2 format {:?} does not match the manifest ({})",
-            header.format,
+            "{} bytes is shorter than a KTX2 header and level index",
+            bytes.len()
+        ));
+    }
+    if bytes[..12] != KTX2_IDENTIFIER {
+        return Err("not a KTX2 file (wrong identifier)".into());
+    }
+    let word =
+        |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    let long = |at: usize| u64::from(word(at)) | (u64::from(word(at + 4)) << 32);
+    let vk_format = word(12);
+    if vk_format != format.ktx2().value() {
+        return Err(format!(
+            "KTX2 vkFormat {vk_format} does not match the manifest ({} = {})",
+            format.vk_name(),
+            format.ktx2().value()
+        ));
+    }
+    let type_size = word(16);
+    if type_size as usize != format.bytes_per_channel() {
+        return Err(format!(
+            "KTX2 typeSize {type_size} does not match {}",
             format.vk_name()
         ));
     }
-    let size = [header.pixel_width, header.pixel_height, header.pixel_depth];
+    let size = [word(20), word(24), word(28)];
     if size != expected_size {
         return Err(format!(
             "KTX2 size {size:?} does not match the manifest {expected_size:?}"
         ));
     }
-    let Some(level) = reader.levels().next() else {
-        return Err("no mip level".into());
+    let (layers, faces, levels, supercompression) = (word(32), word(36), word(40), word(44));
+    if layers != 0 || faces != 1 || levels > 1 || supercompression != 0 {
+        return Err(format!(
+            "KTX2 with {layers} array layers, {faces} faces, {levels} levels and \
+             supercompression {supercompression}: a runtime texture is one uncompressed level"
+        ));
+    }
+    let in_file = |offset: u64, length: u64| {
+        offset
+            .checked_add(length)
+            .is_some_and(|end| end <= bytes.len() as u64)
     };
+    let (dfd_offset, dfd_length) = (word(48), word(52));
+    if dfd_length < 4 || !in_file(dfd_offset.into(), dfd_length.into()) {
+        return Err(format!(
+            "KTX2 data format descriptor ({dfd_length} bytes at {dfd_offset}) is outside the file"
+        ));
+    }
+    if word(dfd_offset as usize) != dfd_length {
+        return Err("KTX2 data format descriptor's own length disagrees with the index".into());
+    }
+    let (level_offset, level_length) = (long(HEADER_BYTES), long(HEADER_BYTES + 8));
+    if !in_file(level_offset, level_length) {
+        return Err(format!(
+            "KTX2 level ({level_length} bytes at {level_offset}) runs past the end of the file ({} bytes)",
+            bytes.len()
+        ));
+    }
+    let data = &bytes[level_offset as usize..(level_offset + level_length) as usize];
     let depth = size[2].max(1);
     let channels = format.channels();
     let texel_bytes = channels * format.bytes_per_channel();
@@ -197,15 +256,15 @@ pub fn read_texture(
         .and_then(|n| n.checked_mul(depth as usize))
         .filter(|n| n.checked_mul(texel_bytes).is_some())
         .ok_or_else(|| format!("KTX2 size {size:?} is too large"))?;
-    if level.data.len() != texel_count * texel_bytes {
+    if data.len() != texel_count * texel_bytes {
         return Err(format!(
             "{} bytes of texels, expected {}",
-            level.data.len(),
+            data.len(),
             texel_count * texel_bytes
         ));
     }
     let mut texels = Vec::with_capacity(texel_count);
-    for chunk in level.data.chunks_exact(texel_bytes) {
+    for chunk in data.chunks_exact(texel_bytes) {
         let mut texel = Vec4::ZERO;
         for c in 0..channels {
             let value = if format.bytes_per_channel() == 4 {
@@ -261,5 +320,70 @@ mod tests {
             assert_eq!(level.data, &data[..]);
             assert_eq!(reader.dfd_blocks().len(), 1);
         }
+    }
+
+    fn small_file(format: TexelFormat) -> (Vec<u8>, Vec<Vec4>) {
+        let texels: Vec<Vec4> = (0..2 * 3 * 4)
+            .map(|i| Vec4::new(i as f32, -(i as f32), 0.5, 1.0))
+            .collect();
+        let bytes = ktx2_bytes(format, 2, 3, 4, &texel_bytes(&texels, format)).expect("ktx2");
+        (bytes, texels)
+    }
+
+    #[test]
+    fn our_reader_reads_what_we_write() {
+        for format in [TexelFormat::Rgba32Float, TexelFormat::R16Float] {
+            let (bytes, texels) = small_file(format);
+            let texture = read_texture(&bytes, format, [2, 3, 4]).expect("reads");
+            for (read, written) in texture.texels.iter().zip(&texels) {
+                for c in 0..format.channels() {
+                    assert_eq!(read[c], written[c]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn hostile_headers_are_named_errors() {
+        let format = TexelFormat::Rgba32Float;
+        let (bytes, _) = small_file(format);
+        let set = |at: usize, value: u32| {
+            let mut b = bytes.clone();
+            b[at..at + 4].copy_from_slice(&value.to_le_bytes());
+            b
+        };
+        // A descriptor whose texel-block dimension bytes are 255 (panics inside the ktx2
+        // crate's parser): vkFormat decides, so the file still reads.
+        let dfd_offset = u32::from_le_bytes(bytes[48..52].try_into().expect("4")) as usize;
+        let mut dimension_255 = bytes.clone();
+        dimension_255[dfd_offset + 4 + 12..dfd_offset + 4 + 16].fill(255);
+        assert!(read_texture(&dimension_255, format, [2, 3, 4]).is_ok());
+        // 65536 x 65536 x 2^28 texels: the byte count must not wrap to pass the check.
+        let mut huge = set(20, 65536);
+        huge[24..28].copy_from_slice(&65536u32.to_le_bytes());
+        huge[28..32].copy_from_slice(&(1u32 << 28).to_le_bytes());
+        let error = read_texture(&huge, format, [65536, 65536, 1 << 28]).expect_err("huge");
+        assert!(error.contains("too large"), "{error}");
+        let cases: Vec<(Vec<u8>, &str)> = vec![
+            (bytes[..50].to_vec(), "shorter than a KTX2 header"),
+            (set(0, 0), "identifier"),
+            (set(12, 97), "vkFormat 97"),
+            (set(16, 2), "typeSize"),
+            (set(40, 5), "5 levels"),
+            (set(44, 1), "supercompression 1"),
+            (set(48, u32::MAX), "outside the file"),
+            (set(52, u32::MAX - 2), "outside the file"),
+            (set(HEADER_BYTES, u32::MAX), "runs past the end"),
+            (set(HEADER_BYTES + 8, 7), "bytes of texels"),
+        ];
+        for (case, expected) in cases {
+            let error = read_texture(&case, format, [2, 3, 4]).expect_err(expected);
+            assert!(error.contains(expected), "{expected}: {error}");
+        }
+        let mut nan = bytes.clone();
+        let level_offset = u32::from_le_bytes(bytes[80..84].try_into().expect("4")) as usize;
+        nan[level_offset..level_offset + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+        let error = read_texture(&nan, format, [2, 3, 4]).expect_err("NaN");
+        assert!(error.contains("not finite"), "{error}");
     }
 }

@@ -2,6 +2,7 @@
 //! with its KTX2 textures, and strand files for other tools).
 
 pub mod import;
+pub mod input_files;
 pub mod ktx2;
 pub mod project;
 pub mod runtime_bundle;

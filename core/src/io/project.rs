@@ -185,6 +185,11 @@ pub const WRITE_CHUNK_BYTES: usize = 64 * 1024;
 /// written, flushed with `fsync`, and renamed over `path`; then the folder is synced so the
 /// rename itself is durable. On error the temporary file is removed.
 ///
+/// The temporary is `.NAME.tmp-PID-RANDOM`, created exclusively (`O_EXCL`, by `tempfile`):
+/// a file or link planted under a guessable name cannot be followed or overwritten.
+/// Temporaries of the same target left by a writer that was killed (its process is gone)
+/// are removed first.
+///
 /// `after_chunk(bytes_written_so_far)` runs after every [`WRITE_CHUNK_BYTES`]; tests use it
 /// to crash a writer halfway.
 pub fn write_atomic(
@@ -199,33 +204,78 @@ pub fn write_atomic(
     let file_name = path.file_name().ok_or_else(|| {
         std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path names no file")
     })?;
-    let temp_path = folder.join(format!(
-        ".{}.tmp-{}",
-        file_name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut file = std::fs::File::create(&temp_path)?;
-        let mut written = 0;
-        for chunk in bytes.chunks(WRITE_CHUNK_BYTES) {
-            file.write_all(chunk)?;
-            written += chunk.len();
-            after_chunk(written);
-        }
-        file.sync_all()?;
-        drop(file);
-        std::fs::rename(&temp_path, path)?;
-        // Make the rename durable. Opening a folder for sync is not possible everywhere
-        // (Windows); the file content is already durable, so failure here is not fatal.
-        if let Ok(dir) = std::fs::File::open(&folder) {
-            let _ = dir.sync_all();
-        }
-        Ok(())
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temp_path);
+    let prefix = temp_prefix(&file_name.to_string_lossy());
+    remove_stale_temporaries(&folder, &prefix);
+    let mut temp = tempfile::Builder::new()
+        .prefix(&format!("{prefix}{}-", std::process::id()))
+        .tempfile_in(&folder)?;
+    let mut written = 0;
+    for chunk in bytes.chunks(WRITE_CHUNK_BYTES) {
+        temp.write_all(chunk)?;
+        written += chunk.len();
+        after_chunk(written);
     }
-    result
+    temp.as_file().sync_all()?;
+    // On failure `persist` hands the temporary back, and dropping it removes the file.
+    temp.persist(path).map_err(|e| e.error)?;
+    // Make the rename durable. Opening a folder for sync is not possible everywhere
+    // (Windows); the file content is already durable, so failure here is not fatal.
+    if let Ok(dir) = std::fs::File::open(&folder) {
+        let _ = dir.sync_all();
+    }
+    Ok(())
+}
+
+/// Start of the names of [`write_atomic`]'s temporaries for a file called `file_name`.
+pub fn temp_prefix(file_name: &str) -> String {
+    format!(".{file_name}.tmp-")
+}
+
+/// Removes `PREFIX<pid>-…` (and the older `PREFIX<pid>`) files in `folder` whose writing
+/// process no longer runs. Where liveness cannot be told (no `/proc`), only temporaries
+/// older than a day are removed. Failures are ignored: this is housekeeping.
+fn remove_stale_temporaries(folder: &Path, prefix: &str) {
+    let Ok(entries) = std::fs::read_dir(folder) else {
+        return;
+    };
+    let own_pid = std::process::id();
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(rest) = name.to_str().and_then(|n| n.strip_prefix(prefix)) else {
+            continue;
+        };
+        let Ok(pid) = rest.split('-').next().unwrap_or_default().parse::<u32>() else {
+            continue;
+        };
+        // Never touch anything but plain files and links (a link is removed, not followed).
+        let Ok(metadata) = entry.path().symlink_metadata() else {
+            continue;
+        };
+        if metadata.is_dir() || pid == own_pid {
+            continue;
+        }
+        let stale = match process_is_alive(pid) {
+            Some(alive) => !alive,
+            None => metadata
+                .modified()
+                .ok()
+                .and_then(|m| m.elapsed().ok())
+                .is_some_and(|age| age.as_secs() > 24 * 3600),
+        };
+        if stale {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Whether process `pid` runs, where the system can say (`/proc` on Linux).
+fn process_is_alive(pid: u32) -> Option<bool> {
+    let proc = Path::new("/proc");
+    if cfg!(target_os = "linux") && proc.join("self").exists() {
+        Some(proc.join(pid.to_string()).exists())
+    } else {
+        None
+    }
 }
 
 /// A JSON formatter that indents objects and keeps arrays of scalars (and arrays of such

@@ -86,8 +86,90 @@ pub struct Manifest {
     pub triangle_samples: Vec<[f32; 2]>,
 }
 
-/// File name of the body mesh in a runtime bundle.
-pub const BODY_FILE: &str = "body.glb";
+/// File name of the manifest, the bundle's single commit point (see [`write_bundle_folder`]).
+pub const MANIFEST_FILE: &str = "manifest.json";
+
+/// `STEM.HASH.EXT`: the file name of `bytes`, unique to its content (64-bit SipHash-1-3
+/// with fixed keys, so the name is stable across builds). Because a name never changes its
+/// content, writing a new bundle over an old one never alters a file the old manifest
+/// names: a reader sees the old bundle or the new one, never a mix.
+pub fn content_addressed_name(stem: &str, extension: &str, bytes: &[u8]) -> String {
+    use std::hash::Hasher as _;
+    let mut hasher = siphasher::sip::SipHasher13::new();
+    hasher.write(bytes);
+    format!("{stem}.{:016x}.{extension}", hasher.finish())
+}
+
+/// Whether `name` is a data file a runtime bundle export writes (content-addressed, or
+/// the fixed names of bundles written before content addressing).
+fn is_bundle_data_file(name: &str) -> bool {
+    const STEMS: [&str; 6] = ["hair_mesh", "uv", "w", "u", "v", "body"];
+    let Some((stem, rest)) = name.split_once('.') else {
+        return false;
+    };
+    if !STEMS.contains(&stem) {
+        return false;
+    }
+    match rest.split_once('.') {
+        None => matches!(rest, "ktx2" | "glb"),
+        Some((hash, extension)) => {
+            hash.len() == 16
+                && hash.bytes().all(|b| b.is_ascii_hexdigit())
+                && matches!(extension, "ktx2" | "glb")
+        }
+    }
+}
+
+/// Writes a runtime bundle's `files` (from [`bundle_files`], manifest last) into `dir`, so
+/// that a reader at any moment — including after a crash — sees the old bundle or the new
+/// one, whole: every data file is written atomically under its content-addressed name
+/// (one already there has the right content by construction and is kept), then the
+/// manifest is renamed into place (the single commit point), then data files of ours that
+/// the new manifest does not name are removed.
+pub fn write_bundle_folder(
+    dir: &std::path::Path,
+    files: &[(String, Vec<u8>)],
+    mut after_file: impl FnMut(&str),
+) -> std::io::Result<()> {
+    use crate::io::project::write_atomic;
+    std::fs::create_dir_all(dir)?;
+    let Some(((manifest_name, manifest), data)) = files.split_last() else {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "a runtime bundle has at least a manifest",
+        ));
+    };
+    if manifest_name != MANIFEST_FILE {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "the manifest must be the last file",
+        ));
+    }
+    for (name, bytes) in data {
+        let path = dir.join(name);
+        // A content-addressed file already there holds these bytes (it was renamed into
+        // place whole); rewriting it would only cost time.
+        let content_addressed = name.matches('.').count() == 2 && is_bundle_data_file(name);
+        let already_there = content_addressed
+            && std::fs::symlink_metadata(&path)
+                .is_ok_and(|m| m.is_file() && m.len() == bytes.len() as u64);
+        if !already_there {
+            write_atomic(&path, bytes, |_| {})?;
+        }
+        after_file(name);
+    }
+    write_atomic(&dir.join(MANIFEST_FILE), manifest, |_| {})?;
+    after_file(MANIFEST_FILE);
+    let named: std::collections::HashSet<&str> = data.iter().map(|(n, _)| n.as_str()).collect();
+    for entry in std::fs::read_dir(dir)?.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        if is_bundle_data_file(name) && !named.contains(name) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+    Ok(())
+}
 
 /// The files of a runtime bundle of `document` exported with `options`: `(file name,
 /// bytes)`, manifest last.
@@ -121,7 +203,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
             depth,
             &texel_bytes(&texture.texels, format),
         )?;
-        let file = format!("{name}.ktx2");
+        let file = content_addressed_name(name, "ktx2", &bytes);
         files.push((file.clone(), bytes));
         Ok(TextureEntry {
             file,
@@ -159,6 +241,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         false,
         "unit styling direction v per layer slice (xyz)",
     )?;
+    let body_glb = (!hair.body.triangles.is_empty()).then(|| glb_body(&hair.body));
     let manifest = Manifest {
         format: "hairloom-runtime".into(),
         format_version: RUNTIME_FORMAT_VERSION,
@@ -190,12 +273,14 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         strands_per_bundle: hair.strands_per_bundle,
         lod: hair.lod.clone(),
         styling: hair.styling.clone(),
-        body: (!hair.body.triangles.is_empty()).then(|| BODY_FILE.to_string()),
+        body: body_glb
+            .as_ref()
+            .map(|bytes| content_addressed_name("body", "glb", bytes)),
         quad_samples: hair.samples.quad.clone(),
         triangle_samples: hair.samples.triangle.clone(),
     };
-    if manifest.body.is_some() {
-        files.push((BODY_FILE.into(), glb_body(&hair.body)));
+    if let (Some(name), Some(bytes)) = (&manifest.body, body_glb) {
+        files.push((name.clone(), bytes));
     }
     let json =
         serde_json::to_vec_pretty(&manifest).map_err(|e| ExportError::Manifest(e.to_string()))?;
@@ -210,38 +295,97 @@ pub struct BundleError {
     pub message: String,
 }
 
-/// Loads and checks a runtime bundle folder written by [`runtime_bundle`]: the manifest's
-/// version and formats, every KTX2 header against the manifest, sizes, block placements and
-/// layer counts, and finite texel values.
+/// Caps on what a runtime bundle may ask for (see `docs/resource-policy.md`).
+pub mod limits {
+    /// `manifest.json`.
+    pub const MANIFEST_BYTES: u64 = 64 << 20;
+    /// Each texture and the body file.
+    pub const FILE_BYTES: u64 = 512 << 20;
+    /// Width and height of the atlas (the 2D extent of every texture).
+    pub const ATLAS_EXTENT: u32 = 16384;
+    /// Strands per bundle (the editor offers up to 256; 4096 is a very dense fur).
+    pub const STRANDS_PER_BUNDLE: u32 = 4096;
+    /// Root sample entries of each kind.
+    pub const SAMPLES: usize = 1 << 16;
+    /// `lod.max_vertices_log2`: 1025 vertices per strand.
+    pub const MAX_VERTICES_LOG2: u32 = 10;
+}
+
+/// Where a runtime bundle's files come from: a folder on disk ([`load_runtime_bundle`]) or
+/// memory (tests and fuzzing). `read` returns the file's bytes or a message naming why not.
+pub trait BundleFiles {
+    fn read(&self, name: &str, cap_bytes: u64) -> Result<Vec<u8>, String>;
+}
+
+/// A bundle folder: reads only regular files inside it, capped (see
+/// [`crate::io::input_files`]).
+pub struct BundleFolder(pub crate::io::input_files::InputFolder);
+
+impl BundleFiles for BundleFolder {
+    fn read(&self, name: &str, cap_bytes: u64) -> Result<Vec<u8>, String> {
+        self.0
+            .read(name, cap_bytes, "a runtime bundle file")
+            .map_err(|e| e.to_string())
+    }
+}
+
+impl BundleFiles for std::collections::HashMap<String, Vec<u8>> {
+    fn read(&self, name: &str, cap_bytes: u64) -> Result<Vec<u8>, String> {
+        match self.get(name) {
+            Some(bytes) if bytes.len() as u64 <= cap_bytes => Ok(bytes.clone()),
+            Some(_) => Err(format!("larger than the cap of {cap_bytes} bytes")),
+            None => Err("no such file in the bundle".into()),
+        }
+    }
+}
+
+/// Loads and checks a runtime bundle folder written by [`write_bundle_folder`]: see
+/// [`load_runtime_bundle_from`]. Only files inside `dir` are read.
 pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleError> {
+    let folder = crate::io::input_files::InputFolder::new(dir).map_err(|e| BundleError {
+        file: dir.display().to_string(),
+        message: e.to_string(),
+    })?;
+    load_runtime_bundle_from(&BundleFolder(folder), &dir.display().to_string())
+}
+
+/// Loads and checks a runtime bundle: the manifest's version and formats, every KTX2
+/// header against the manifest, sizes, block placements and layer counts, the caps of
+/// [`limits`], and finite texel values. `shown` names the bundle in messages.
+pub fn load_runtime_bundle_from(
+    files: &dyn BundleFiles,
+    shown: &str,
+) -> Result<RuntimeHair, BundleError> {
     let error = |file: &str, message: String| BundleError {
-        file: dir.join(file).display().to_string(),
+        file: format!("{shown}/{file}"),
         message,
     };
-    let manifest_bytes = std::fs::read(dir.join("manifest.json"))
-        .map_err(|e| error("manifest.json", format!("cannot read: {e}")))?;
+    let manifest_bytes = files
+        .read(MANIFEST_FILE, limits::MANIFEST_BYTES)
+        .map_err(|e| error(MANIFEST_FILE, e))?;
     let version: serde_json::Value = serde_json::from_slice(&manifest_bytes)
-        .map_err(|e| error("manifest.json", format!("not JSON: {e}")))?;
+        .map_err(|e| error(MANIFEST_FILE, format!("not JSON: {e}")))?;
     let found = version
         .get("format_version")
         .and_then(|v| v.as_u64())
         .unwrap_or(0);
     if version.get("format").and_then(|v| v.as_str()) != Some("hairloom-runtime") {
         return Err(error(
-            "manifest.json",
+            MANIFEST_FILE,
             "not a Hairloom runtime manifest (\"format\" is not \"hairloom-runtime\")".into(),
         ));
     }
     if found != RUNTIME_FORMAT_VERSION as u64 {
         return Err(error(
-            "manifest.json",
+            MANIFEST_FILE,
             format!(
                 "format_version {found} is not supported (this build reads {RUNTIME_FORMAT_VERSION})"
             ),
         ));
     }
-    let manifest: Manifest = serde_json::from_slice(&manifest_bytes)
-        .map_err(|e| error("manifest.json", e.to_string()))?;
+    let manifest: Manifest =
+        serde_json::from_slice(&manifest_bytes).map_err(|e| error(MANIFEST_FILE, e.to_string()))?;
+    check_manifest_caps(&manifest).map_err(|message| error(MANIFEST_FILE, message))?;
     let load = |entry: &TextureEntry, channels: usize| -> Result<Texture3d, BundleError> {
         let format = TexelFormat::for_precision(manifest.precision, channels);
         if entry.vk_format != format.vk_name() {
@@ -255,8 +399,10 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
                 ),
             ));
         }
-        let bytes = std::fs::read(dir.join(&entry.file))
-            .map_err(|e| error(&entry.file, format!("cannot read: {e}")))?;
+        check_file_name(&entry.file).map_err(|message| error(MANIFEST_FILE, message))?;
+        let bytes = files
+            .read(&entry.file, limits::FILE_BYTES)
+            .map_err(|e| error(&entry.file, e))?;
         read_texture(&bytes, format, entry.size).map_err(|message| error(&entry.file, message))
     };
     let hair_mesh = load(&manifest.hair_mesh, 4)?;
@@ -268,7 +414,7 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
     for texture in [&hair_mesh, &w, &u, &v] {
         if (texture.width, texture.height) != (width, height) {
             return Err(error(
-                "manifest.json",
+                MANIFEST_FILE,
                 format!("3D textures must be {width}x{height} like the uv-texture"),
             ));
         }
@@ -277,7 +423,7 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
         || w.depth != 1 + manifest.max_layers
     {
         return Err(error(
-            "manifest.json",
+            MANIFEST_FILE,
             format!(
                 "texture depths do not match max_layers {}",
                 manifest.max_layers
@@ -290,7 +436,7 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
         if entry.origin[0].saturating_add(1) >= width || entry.origin[1].saturating_add(1) >= height
         {
             return Err(error(
-                "manifest.json",
+                MANIFEST_FILE,
                 format!(
                     "bundles[{i}].origin {:?} does not fit a 2x2 block in {width}x{height}",
                     entry.origin
@@ -299,7 +445,7 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
         }
         if entry.layers == 0 || entry.layers > manifest.max_layers {
             return Err(error(
-                "manifest.json",
+                MANIFEST_FILE,
                 format!(
                     "bundles[{i}].layers {} is outside 1..={}",
                     entry.layers, manifest.max_layers
@@ -308,14 +454,14 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
         }
         if entry.corner_of_block.iter().any(|&c| c > 3) {
             return Err(error(
-                "manifest.json",
+                MANIFEST_FILE,
                 format!("bundles[{i}].corner_of_block has a corner above 3"),
             ));
         }
         let groups = manifest.styling.groups.len() as i32;
         if !(-1..groups).contains(&entry.styling_group) {
             return Err(error(
-                "manifest.json",
+                MANIFEST_FILE,
                 format!(
                     "bundles[{i}].styling_group {} is outside -1..{groups}",
                     entry.styling_group
@@ -339,7 +485,7 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
     ] {
         if samples.len() < manifest.strands_per_bundle as usize {
             return Err(error(
-                "manifest.json",
+                MANIFEST_FILE,
                 format!(
                     "{name} has {} samples, fewer than strands_per_bundle {}",
                     samples.len(),
@@ -352,16 +498,24 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
             .position(|p| !p.iter().all(|c| (0.0..=1.0).contains(c)))
         {
             return Err(error(
-                "manifest.json",
+                MANIFEST_FILE,
                 format!("{name}[{i}] {:?} is outside [0, 1]²", samples[i]),
             ));
         }
     }
+    let atlas_texels = (width as usize)
+        .checked_mul(height as usize)
+        .ok_or_else(|| {
+            error(
+                MANIFEST_FILE,
+                format!("atlas {width}x{height} is too large"),
+            )
+        })?;
     let atlas = crate::runtime::atlas::Atlas {
         width,
         height,
         blocks,
-        texels: vec![None; (width * height) as usize],
+        texels: vec![None; atlas_texels],
     };
     let textures = RuntimeTextures {
         atlas,
@@ -381,7 +535,12 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
                 pair_quads: false,
                 ..Default::default()
             };
-            crate::io::import::import_file(&dir.join(file), &options)
+            // Imported from memory with no folder: a body may not name external buffers.
+            check_file_name(file).map_err(|message| error(MANIFEST_FILE, message))?;
+            let bytes = files
+                .read(file, limits::FILE_BYTES)
+                .map_err(|e| error(file, e))?;
+            crate::io::import::import_slice(&bytes, None, file, &options)
                 .map_err(|e| error(file, e.to_string()))?
                 .to_body()
         }
@@ -405,8 +564,89 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
         sample_seed: None,
     })
 }
+/// A bundle is one flat folder: the manifest names its files by plain name only.
+fn check_file_name(name: &str) -> Result<(), String> {
+    let plain =
+        !name.is_empty() && name != "." && name != ".." && !name.contains(['/', '\\', ':', '\0']);
+    if plain {
+        Ok(())
+    } else {
+        Err(format!(
+            "file name \"{name}\" is refused: a bundle names only plain files in its own folder (no /, \\, .. or :)"
+        ))
+    }
+}
+
+/// The manifest's sizes against [`limits`], before any texture is read.
+fn check_manifest_caps(manifest: &Manifest) -> Result<(), String> {
+    let max_layers = crate::runtime::textures::MAX_LAYERS_PER_BUNDLE;
+    if manifest.max_layers > max_layers {
+        return Err(format!(
+            "max_layers {} is above the cap of {max_layers} layers per bundle",
+            manifest.max_layers
+        ));
+    }
+    for (name, entry) in [
+        ("hair_mesh", &manifest.hair_mesh),
+        ("uv", &manifest.uv),
+        ("w", &manifest.w),
+        ("u", &manifest.u),
+        ("v", &manifest.v),
+    ] {
+        if entry.size[0] > limits::ATLAS_EXTENT || entry.size[1] > limits::ATLAS_EXTENT {
+            return Err(format!(
+                "{name}.size {:?} is above the cap of {} texels across",
+                entry.size,
+                limits::ATLAS_EXTENT
+            ));
+        }
+    }
+    if manifest.strands_per_bundle > limits::STRANDS_PER_BUNDLE {
+        return Err(format!(
+            "strands_per_bundle {} is above the cap of {} (export with fewer strands per bundle)",
+            manifest.strands_per_bundle,
+            limits::STRANDS_PER_BUNDLE
+        ));
+    }
+    for (name, samples) in [
+        ("quad_samples", &manifest.quad_samples),
+        ("triangle_samples", &manifest.triangle_samples),
+    ] {
+        if samples.len() > limits::SAMPLES {
+            return Err(format!(
+                "{name} has {} entries, above the cap of {}",
+                samples.len(),
+                limits::SAMPLES
+            ));
+        }
+    }
+    let lod = &manifest.lod;
+    if lod.max_vertices_log2 > limits::MAX_VERTICES_LOG2 {
+        return Err(format!(
+            "lod.max_vertices_log2 {} is above the cap of {}",
+            lod.max_vertices_log2,
+            limits::MAX_VERTICES_LOG2
+        ));
+    }
+    for (name, value) in [
+        ("lod.alpha_strands", lod.alpha_strands),
+        ("lod.alpha_vertices", lod.alpha_vertices),
+        ("lod.lambda", lod.lambda),
+    ] {
+        if !value.is_finite() || value < 0.0 {
+            return Err(format!("{name} {value} must be a finite number ≥ 0"));
+        }
+    }
+    if !manifest.position_offset.iter().all(|c| c.is_finite()) {
+        return Err("position_offset is not finite".into());
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
+    use std::collections::HashMap;
+
     use super::*;
     use crate::model::mesh::test_meshes::grid;
 
@@ -415,17 +655,22 @@ mod tests {
         let document = Document::new("grid", grid(3, 2, 2, 0.5));
         let files = runtime_bundle(&document, &RuntimeOptions::default()).expect("export");
         let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names.len(), 6);
+        for (name, stem) in names.iter().zip(["hair_mesh", "uv", "w", "u", "v"]) {
+            assert!(
+                name.starts_with(&format!("{stem}.")) && name.ends_with(".ktx2"),
+                "{name}"
+            );
+            assert!(is_bundle_data_file(name), "{name}");
+        }
+        assert_eq!(names[5], MANIFEST_FILE);
+        // Names follow content: the same texture gets the same name, another a new one.
         assert_eq!(
-            names,
-            [
-                "hair_mesh.ktx2",
-                "uv.ktx2",
-                "w.ktx2",
-                "u.ktx2",
-                "v.ktx2",
-                "manifest.json"
-            ]
+            names[0],
+            content_addressed_name("hair_mesh", "ktx2", &files[0].1)
         );
+        assert_ne!(names[0], content_addressed_name("hair_mesh", "ktx2", b"x"));
+        assert!(!is_bundle_data_file("notes.ktx2") && !is_bundle_data_file("w.12.ktx2"));
         let manifest: Manifest = serde_json::from_slice(&files[5].1).expect("manifest");
         assert_eq!(manifest.bundles.len(), 6);
         assert_eq!(manifest.hair_mesh.size[2], 1 + 4 * 2);
@@ -444,16 +689,24 @@ mod tests {
         let mut mesh = grid(3, 2, 2, 0.5);
         crate::geometry::interior::place_interior(&mut mesh, None);
         let document = Document::new("grid", mesh);
-        let dir = std::env::temp_dir().join(format!("hairloom-bundle-test-{}", std::process::id()));
+        let temp = tempfile::tempdir().expect("temp dir");
+        let dir = temp.path().join("bundle");
         for precision in [Precision::F32, Precision::F16] {
             let options = RuntimeOptions {
                 precision,
                 ..RuntimeOptions::default()
             };
-            std::fs::create_dir_all(&dir).expect("dir");
-            for (name, bytes) in runtime_bundle(&document, &options).expect("export") {
-                std::fs::write(dir.join(name), bytes).expect("write");
-            }
+            let files = runtime_bundle(&document, &options).expect("export");
+            write_bundle_folder(&dir, &files, |_| {}).expect("write");
+            // Only the new bundle's files are left (the f32 textures went with the f16 export).
+            let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+                .expect("list")
+                .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+                .collect();
+            on_disk.sort();
+            let mut written: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
+            written.sort();
+            assert_eq!(on_disk, written);
             let loaded = load_runtime_bundle(&dir).expect("loads");
             let built = RuntimeTextures::build(&document.hair_mesh, precision);
             assert_eq!(loaded.textures.hair_mesh, built.hair_mesh);
@@ -488,10 +741,115 @@ mod tests {
         let error = load_runtime_bundle(&dir).expect_err("newer version");
         assert!(error.to_string().contains("format_version 99"), "{error}");
         std::fs::write(&manifest_path, &original).expect("restore");
-        let texture = std::fs::read(dir.join("w.ktx2")).expect("w");
-        std::fs::write(dir.join("w.ktx2"), &texture[..texture.len() / 2]).expect("truncate");
+        let manifest: Manifest = serde_json::from_slice(&original).expect("manifest");
+        let w_file = dir.join(&manifest.w.file);
+        let texture = std::fs::read(&w_file).expect("w");
+        std::fs::write(&w_file, &texture[..texture.len() / 2]).expect("truncate");
         let error = load_runtime_bundle(&dir).expect_err("truncated");
-        assert!(error.to_string().contains("w.ktx2"), "{error}");
-        let _ = std::fs::remove_dir_all(&dir);
+        assert!(error.to_string().contains(&manifest.w.file), "{error}");
+    }
+
+    /// A bundle in memory, with its manifest as JSON to edit.
+    fn bundle_in_memory() -> (HashMap<String, Vec<u8>>, serde_json::Value) {
+        let mut mesh = grid(2, 2, 1, 0.5);
+        crate::geometry::interior::place_interior(&mut mesh, None);
+        let files = runtime_bundle(&Document::new("grid", mesh), &RuntimeOptions::default())
+            .expect("export");
+        let manifest = serde_json::from_slice(&files[files.len() - 1].1).expect("json");
+        (files.into_iter().collect(), manifest)
+    }
+
+    fn load_with(edit: impl FnOnce(&mut serde_json::Value)) -> Result<RuntimeHair, BundleError> {
+        let (mut files, mut manifest) = bundle_in_memory();
+        edit(&mut manifest);
+        files.insert(
+            MANIFEST_FILE.into(),
+            serde_json::to_vec(&manifest).expect("json"),
+        );
+        load_runtime_bundle_from(&files, "memory")
+    }
+
+    #[test]
+    fn hostile_manifests_are_named_errors() {
+        load_with(|_| {}).expect("the unedited bundle loads");
+        let cases: Vec<(Box<dyn FnOnce(&mut serde_json::Value)>, &str)> = vec![
+            (
+                Box::new(|m| m["bundles"][0]["origin"] = serde_json::json!([u32::MAX, 0])),
+                "does not fit a 2x2 block",
+            ),
+            (
+                Box::new(|m| m["strands_per_bundle"] = 100_000.into()),
+                "strands_per_bundle 100000 is above the cap",
+            ),
+            (
+                Box::new(|m| m["max_layers"] = 20_000.into()),
+                "above the cap of 511 layers",
+            ),
+            (
+                Box::new(|m| m["hair_mesh"]["size"] = serde_json::json!([65536, 65536, 268435456])),
+                "above the cap of 16384 texels",
+            ),
+            (
+                Box::new(|m| m["lod"]["max_vertices_log2"] = 40.into()),
+                "max_vertices_log2 40",
+            ),
+            (
+                Box::new(|m| m["w"]["file"] = "../../etc/passwd".into()),
+                "\"../../etc/passwd\" is refused",
+            ),
+            (
+                Box::new(|m| m["body"] = "/etc/passwd".into()),
+                "\"/etc/passwd\" is refused",
+            ),
+            (
+                Box::new(|m| m["body"] = "missing.glb".into()),
+                "no such file",
+            ),
+        ];
+        for (edit, expected) in cases {
+            let error = load_with(edit).expect_err(expected).to_string();
+            assert!(error.contains(expected), "{expected}: {error}");
+        }
+    }
+
+    #[test]
+    fn folder_bundles_never_read_outside_their_folder() {
+        let temp = tempfile::tempdir().expect("temp dir");
+        let dir = temp.path().join("bundle");
+        let (files, mut manifest) = bundle_in_memory();
+        let mut ordered: Vec<(String, Vec<u8>)> = files
+            .into_iter()
+            .filter(|(n, _)| n != MANIFEST_FILE)
+            .collect();
+        std::fs::write(temp.path().join("outside.ktx2"), b"secret").expect("write");
+        for name in [
+            "../outside.ktx2".to_string(),
+            temp.path().join("outside.ktx2").display().to_string(),
+            "file:///etc/passwd".into(),
+        ] {
+            manifest["uv"]["file"] = name.clone().into();
+            ordered.push((
+                MANIFEST_FILE.into(),
+                serde_json::to_vec(&manifest).expect("json"),
+            ));
+            write_bundle_folder(&dir, &ordered, |_| {}).expect("write");
+            ordered.pop();
+            let error = load_runtime_bundle(&dir).expect_err(&name).to_string();
+            assert!(error.contains("refused"), "{name}: {error}");
+        }
+        // A plain name that is a link out of the folder.
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(temp.path().join("outside.ktx2"), dir.join("link.ktx2"))
+                .expect("link");
+            manifest["uv"]["file"] = "link.ktx2".into();
+            ordered.push((
+                MANIFEST_FILE.into(),
+                serde_json::to_vec(&manifest).expect("json"),
+            ));
+            write_bundle_folder(&dir, &ordered, |_| {}).expect("write");
+            let error = load_runtime_bundle(&dir).expect_err("link").to_string();
+            assert!(error.contains("outside the folder"), "{error}");
+        }
     }
 }

@@ -287,6 +287,16 @@ impl HairMesh {
                     format!("a bundle must have 3 or 4 corners, found {n}"),
                 ));
             }
+            let cap = crate::runtime::textures::MAX_LAYERS_PER_BUNDLE;
+            if bundle.layers > cap {
+                return Err(invalid(
+                    format!("bundles[{bi}].layers"),
+                    format!(
+                        "{} layers is above the cap of {cap} layers per bundle",
+                        bundle.layers
+                    ),
+                ));
+            }
             if bundle.uvs.len() != n {
                 return Err(invalid(
                     format!("bundles[{bi}].uvs"),

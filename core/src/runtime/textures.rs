@@ -28,6 +28,12 @@ use crate::runtime::half::round_to_f16;
 
 /// Slices of the hair-mesh texture per segment (3 intermediate + 1 layer).
 pub const SLICES_PER_SEGMENT: u32 = 4;
+/// Most extruded layers one bundle may have. The hair-mesh texture holds
+/// `1 + SLICES_PER_SEGMENT · layers` slices, and 2048 is the 3D-texture depth every wgpu
+/// adapter supports (the default `max_texture_dimension_3d`): 1 + 4 · 511 = 2045. Real hair
+/// meshes use 3-30 layers; a file asking for more is refused by name (a 20,000-layer bundle
+/// used to take 23 s and 2.5 GB to export).
+pub const MAX_LAYERS_PER_BUNDLE: u32 = 511;
 /// Largest region side in the atlas.
 pub const MAX_REGION_SIDE: usize = 64;
 
