@@ -53,7 +53,7 @@ pub fn measure_accuracy(
                 ..RuntimeOptions::default()
             },
         );
-        let gpu = generator.upload(context, &hair);
+        let gpu = generator.upload(context, &hair)?;
         let plan = full_detail_plan(gpu.root_count, vertex_count);
         let generated = generator
             .generate_positions(context, &gpu, &plan, filtering)

@@ -54,7 +54,7 @@ fn gpu_ribbon_tangents_match_the_cpu_mirror() {
         },
     );
     let generator = StrandGenRenderer::new(&context);
-    let gpu_hair = generator.upload(&context, &hair);
+    let gpu_hair = generator.upload(&context, &hair).expect("upload");
     // Two runs of different vertex counts (the second with an odd count's neighbour rule
     // at 2 vertices), as vertex LOD produces them.
     let half = (gpu_hair.root_count / 2) as u32;

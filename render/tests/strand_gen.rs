@@ -62,7 +62,7 @@ fn gpu_strands_match_the_cpu_mirror() {
             let textures = &runtime.textures;
             let roots = runtime.strand_roots();
             assert!(roots.iter().any(|r| r.styling == 1) && roots.iter().any(|r| r.styling == 0));
-            let hair = renderer.upload(&context, &runtime);
+            let hair = renderer.upload(&context, &runtime).expect("upload");
             assert_eq!(hair.root_count, roots.len());
             let vertex_count = 17u32;
             let plan = full_detail_plan(roots.len(), vertex_count);
@@ -124,7 +124,7 @@ fn generation_runs_in_batches_with_bounded_scratch() {
     // 288 bundles × 160 = 46,080 strands: 2 batches.
     let large = runtime.strand_roots();
     assert!(large.len() > BATCH_STRANDS);
-    let large_hair = renderer.upload(&context, &runtime);
+    let large_hair = renderer.upload(&context, &runtime).expect("upload");
     // A prefix of the same sample set: 4 per bundle.
     runtime.samples = RootSamples {
         quad: runtime.samples.quad[..4].to_vec(),
@@ -133,7 +133,7 @@ fn generation_runs_in_batches_with_bounded_scratch() {
     runtime.sample_seed = None;
     runtime.set_strands_per_bundle(4).expect("4 of the samples");
     let small = runtime.strand_roots();
-    let small_hair = renderer.upload(&context, &runtime);
+    let small_hair = renderer.upload(&context, &runtime).expect("upload");
     let textures = &runtime.textures;
     let vertex_count = 5;
     let small_plan = full_detail_plan(small.len(), vertex_count);
@@ -206,7 +206,7 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
     );
     let textures = &runtime.textures;
     let roots = runtime.strand_roots();
-    let hair = renderer.upload(&context, &runtime);
+    let hair = renderer.upload(&context, &runtime).expect("upload");
     // A camera far enough for partial strand counts, several vertex levels and morphing.
     let (lo, hi) = textures.hair_bounds().expect("hair");
     let centre = (lo + hi) * 0.5;
@@ -273,7 +273,7 @@ fn restyling_in_place_generates_what_a_fresh_upload_does() {
         ..RuntimeOptions::default()
     };
     let mut runtime = RuntimeHair::from_document(&document, &options);
-    let mut gpu = renderer.upload(&context, &runtime);
+    let mut gpu = renderer.upload(&context, &runtime).expect("upload");
     // Other parameters and a new group (a longer styling array than was uploaded).
     document.styling.global.curl.radius_m = 0.007;
     document.styling.groups.push(StylingGroup {
@@ -283,7 +283,9 @@ fn restyling_in_place_generates_what_a_fresh_upload_does() {
     });
     runtime.set_styling(&document.styling);
     renderer.update_styling(&context, &mut gpu, &runtime);
-    let fresh = renderer.upload(&context, &RuntimeHair::from_document(&document, &options));
+    let fresh = renderer
+        .upload(&context, &RuntimeHair::from_document(&document, &options))
+        .expect("upload");
     let plan = full_detail_plan(gpu.root_count, 9);
     let restyled = renderer
         .generate_positions(&context, &gpu, &plan, Filtering::Exact)
@@ -295,13 +297,60 @@ fn restyling_in_place_generates_what_a_fresh_upload_does() {
     let unstyled = renderer
         .generate_positions(
             &context,
-            &renderer.upload(
-                &context,
-                &RuntimeHair::from_document(&sample("head_curly"), &options),
-            ),
+            &renderer
+                .upload(
+                    &context,
+                    &RuntimeHair::from_document(&sample("head_curly"), &options),
+                )
+                .expect("upload"),
             &plan,
             Filtering::Exact,
         )
         .expect("unstyled");
     assert_ne!(restyled, unstyled, "the new styling must show");
+}
+
+/// Above the adapter's limits the upload is refused by name before wgpu sees a descriptor
+/// (wgpu would panic). Pure: runs without an adapter.
+#[test]
+fn hair_above_the_adapter_limits_is_refused_by_name() {
+    use hairloom_render::renderer::strand_gen::{StrandGenError, check_adapter_limits};
+    let hair = RuntimeHair::from_document(&sample("head_curly"), &RuntimeOptions::default());
+    let depth = hair.textures.hair_mesh.depth;
+    let layers = hair
+        .textures
+        .atlas
+        .blocks
+        .iter()
+        .map(|b| b.layers)
+        .max()
+        .expect("bundles");
+    let generous = wgpu::Limits::default();
+    check_adapter_limits(&generous, &hair).expect("fits the default limits");
+    let small = wgpu::Limits {
+        max_texture_dimension_3d: depth - 1,
+        ..wgpu::Limits::default()
+    };
+    let error = check_adapter_limits(&small, &hair).expect_err("one slice too many");
+    assert!(
+        matches!(error, StrandGenError::AdapterLimit { value, .. } if value == u64::from(depth))
+    );
+    let message = error.to_string();
+    assert!(
+        message.contains(&format!("hair_mesh texture's depth is {depth}"))
+            && message.contains(&format!("max_texture_dimension_3d of {}", depth - 1))
+            && message.contains(&format!("has {layers} layers")),
+        "{message}"
+    );
+    let tiny_buffers = wgpu::Limits {
+        max_storage_buffer_binding_size: 16,
+        ..wgpu::Limits::default()
+    };
+    let message = check_adapter_limits(&tiny_buffers, &hair)
+        .expect_err("buffers")
+        .to_string();
+    assert!(
+        message.contains("max_storage_buffer_binding_size"),
+        "{message}"
+    );
 }

@@ -125,3 +125,25 @@ impl GltfBuilder {
         hairloom_core::io::strand_files::glb_container(json, self.bin.clone())
     }
 }
+
+/// A small document whose runtime bundle differs per `variant` in geometry only (same
+/// sizes and formats): the case where a mixed bundle would render silently wrong.
+pub fn bundle_variant(variant: u32) -> hairloom_core::Document {
+    let mut mesh = grid_mesh(3, 3, 2, 0.1);
+    for column in &mut mesh.columns {
+        for p in &mut column.positions {
+            *p += DVec3::X * 0.05 * variant as f64;
+        }
+    }
+    hairloom_core::geometry::interior::place_interior(&mut mesh, None);
+    hairloom_core::Document::new("variant", mesh)
+}
+
+/// The runtime bundle files of [`bundle_variant`] `variant`, manifest last.
+pub fn bundle_variant_files(variant: u32) -> Vec<(String, Vec<u8>)> {
+    hairloom_core::io::runtime_bundle::runtime_bundle(
+        &bundle_variant(variant),
+        &hairloom_core::runtime::hair::RuntimeOptions::default(),
+    )
+    .expect("the variant exports")
+}

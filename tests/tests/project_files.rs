@@ -275,3 +275,69 @@ fn head_samples_keep_hair_outside_the_cranium() {
         );
     }
 }
+
+/// An export over an existing runtime bundle, killed after each file it writes (and once
+/// mid-way through its first file), always leaves a bundle that loads as wholly old or
+/// wholly new — never a mix of old and new textures.
+#[test]
+fn a_runtime_bundle_export_killed_at_any_point_loads_wholly_old_or_new() {
+    use hairloom_core::io::runtime_bundle::{load_runtime_bundle, write_bundle_folder};
+    let temp = tempfile::tempdir().expect("temp dir");
+    let dir = temp.path().join("bundle");
+    let old = hairloom_tests::bundle_variant_files(0);
+    let new = hairloom_tests::bundle_variant_files(1);
+    let textures = |files: &[(String, Vec<u8>)]| {
+        let memory: std::collections::HashMap<String, Vec<u8>> = files.iter().cloned().collect();
+        hairloom_core::io::runtime_bundle::load_runtime_bundle_from(&memory, "memory")
+            .expect("loads from memory")
+            .textures
+    };
+    let (old_textures, new_textures) = (textures(&old), textures(&new));
+    assert_ne!(old_textures.hair_mesh, new_textures.hair_mesh);
+    let (mut saw_old, mut saw_new) = (false, false);
+    // Kill after 0..=files announcements; 0 kills during the first file's write.
+    for kill_after in 0..=new.len() {
+        let _ = std::fs::remove_dir_all(&dir);
+        write_bundle_folder(&dir, &old, |_| {}).expect("old bundle");
+        let mut child = Command::new(env!("CARGO_BIN_EXE_slow_bundle"))
+            .arg(&dir)
+            .arg("1")
+            .arg("150")
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("spawn slow_bundle");
+        let stdout = child.stdout.take().expect("stdout");
+        let mut lines = BufReader::new(stdout).lines();
+        for _ in 0..kill_after {
+            let line = lines.next().expect("a line").expect("utf-8");
+            assert!(line.starts_with("wrote"), "{line}");
+        }
+        child.kill().expect("kill");
+        let _ = child.wait();
+        let loaded = load_runtime_bundle(&dir)
+            .unwrap_or_else(|e| panic!("killed after {kill_after} files: {e}"))
+            .textures;
+        let is_old = loaded.hair_mesh == old_textures.hair_mesh && loaded.u == old_textures.u;
+        let is_new = loaded.hair_mesh == new_textures.hair_mesh && loaded.u == new_textures.u;
+        assert!(
+            is_old || is_new,
+            "killed after {kill_after} files: a mixed bundle"
+        );
+        saw_old |= is_old;
+        saw_new |= is_new && kill_after == new.len();
+    }
+    assert!(
+        saw_old && saw_new,
+        "the kills covered before and after the commit"
+    );
+    // A finished export leaves exactly its own files (stale ones and temporaries gone).
+    write_bundle_folder(&dir, &new, |_| {}).expect("new bundle");
+    let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
+        .expect("list")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    on_disk.sort();
+    let mut expected: Vec<String> = new.iter().map(|(n, _)| n.clone()).collect();
+    expected.sort();
+    assert_eq!(on_disk, expected);
+}

@@ -288,7 +288,7 @@ fn gpu(
         };
         for &target in counts {
             renderable.set_strands_per_bundle(target.div_ceil(bundles) as u32)?;
-            let hair = generator.upload(&context, &renderable);
+            let hair = generator.upload(&context, &renderable)?;
             let full = full_detail_plan(hair.root_count, vertex_count);
             let stored_bytes = full.vertices as u64 * 16;
             let hair_mb = hair.bytes as f64 / 1e6;
@@ -463,7 +463,7 @@ fn edit_latency(
     };
     let vertex_count = (1u32 << super::render::PREVIEW_VERTICES_LOG2) + 1;
     let mut hair = RuntimeHair::from_document(&document, &options);
-    let mut gpu = generator.upload(&context, &hair);
+    let mut gpu = generator.upload(&context, &hair)?;
     let bounds = hair
         .textures
         .hair_bounds()
@@ -523,7 +523,7 @@ fn edit_latency(
     let rebuild = timed_both(Box::new(|run, draw| {
         styled.styling.global.curl.radius_m = curl(run);
         let hair = RuntimeHair::from_document(&styled, &options);
-        let gpu = generator.upload(&context, &hair);
+        let gpu = generator.upload(&context, &hair)?;
         let body = GpuBody::upload(&context, &hair.body);
         if draw { frame(&gpu, &body) } else { idle() }
     }))?;
@@ -560,7 +560,7 @@ fn edit_latency(
         dragged.hair_mesh = outcome.mesh;
         // A mesh edit leaves the body alone: it stays uploaded.
         let hair = RuntimeHair::from_document(&dragged, &options);
-        let gpu = generator.upload(&context, &hair);
+        let gpu = generator.upload(&context, &hair)?;
         if draw { frame(&gpu, &body) } else { idle() }
     }))?;
     println!(

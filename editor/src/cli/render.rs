@@ -120,7 +120,7 @@ pub fn render_pixels(
 ) -> anyhow::Result<(Vec<u8>, String)> {
     let (vertices_log2, filtering) = (settings.vertices_log2, settings.filtering);
     let generator = StrandGenRenderer::new(context);
-    let gpu_hair = generator.upload(context, hair);
+    let gpu_hair = generator.upload(context, hair)?;
     let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
     // Frame the hair (the head scan's shoulders would make it tiny), padded by a margin.
     let (lo, hi) = hair

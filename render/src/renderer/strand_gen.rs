@@ -34,6 +34,96 @@ pub enum StrandGenError {
     NoFloat32Filtering { adapter: String },
     #[error("reading generated positions back failed: {0}")]
     Readback(String),
+    /// A resource would exceed what the adapter allows; nothing was created.
+    #[error("{what} is {value}, above this adapter's {limit_name} of {limit}{hint}")]
+    AdapterLimit {
+        what: String,
+        value: u64,
+        limit_name: &'static str,
+        limit: u64,
+        hint: String,
+    },
+}
+
+/// Checks `hair` against the device's `limits` before any resource is made: every texture
+/// extent against `max_texture_dimension_3d` (all five are 3D textures), and every storage
+/// buffer against `max_storage_buffer_binding_size` and `max_buffer_size`. The error names
+/// the texture, the limit and, for depth, the bundle with the most layers. (wgpu panics on
+/// a descriptor above the limits, so this must come first.)
+pub fn check_adapter_limits(
+    limits: &wgpu::Limits,
+    hair: &RuntimeHair,
+) -> Result<(), StrandGenError> {
+    let textures = &hair.textures;
+    let tallest = textures
+        .atlas
+        .blocks
+        .iter()
+        .max_by_key(|b| b.layers)
+        .map(|b| (b.bundle, b.layers));
+    let max_3d = u64::from(limits.max_texture_dimension_3d);
+    for (name, texture) in [
+        ("hair_mesh", &textures.hair_mesh),
+        ("uv", &textures.uv),
+        ("w", &textures.w),
+        ("u", &textures.u),
+        ("v", &textures.v),
+    ] {
+        // Depth first: too many layers is the likelier cause, and its hint is the better one.
+        for (axis, value) in [
+            ("depth", texture.depth),
+            ("width", texture.width),
+            ("height", texture.height),
+        ] {
+            if u64::from(value) > max_3d {
+                let hint = match (axis, tallest) {
+                    ("depth", Some((bundle, layers))) => format!(
+                        " (bundle {bundle} has {layers} layers; fewer layers per bundle fit)"
+                    ),
+                    _ => format!(
+                        " ({} bundles need a {}x{} atlas; split the hair into smaller projects)",
+                        textures.atlas.blocks.len(),
+                        textures.atlas.width,
+                        textures.atlas.height
+                    ),
+                };
+                return Err(StrandGenError::AdapterLimit {
+                    what: format!("the {name} texture's {axis}"),
+                    value: value.into(),
+                    limit_name: "max_texture_dimension_3d",
+                    limit: max_3d,
+                    hint,
+                });
+            }
+        }
+    }
+    let blocks = textures.atlas.blocks.len() as u64;
+    let per_bundle = u64::from(hair.strands_per_bundle);
+    let sample_bytes = 2 * per_bundle.max(1) * 8;
+    let bundle_bytes = blocks * std::mem::size_of::<BundleGpu>() as u64;
+    for (what, bytes) in [
+        ("the bundle placement buffer", bundle_bytes),
+        ("the root sample buffer", sample_bytes),
+    ] {
+        for (limit_name, limit) in [
+            (
+                "max_storage_buffer_binding_size",
+                u64::from(limits.max_storage_buffer_binding_size),
+            ),
+            ("max_buffer_size", limits.max_buffer_size),
+        ] {
+            if bytes > limit {
+                return Err(StrandGenError::AdapterLimit {
+                    what: format!("{what} ({blocks} bundles, {per_bundle} strands each)"),
+                    value: bytes,
+                    limit_name,
+                    limit,
+                    hint: " bytes".into(),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Pipeline and bind-group layout of `strand_gen` (one per device).
@@ -307,7 +397,15 @@ impl StrandGenRenderer {
     /// domain and the styling array. Root `i` is then sample `i % strands_per_bundle` of
     /// block `i / strands_per_bundle`, as [`RuntimeHair::strand_roots`] lays roots out on the
     /// CPU.
-    pub fn upload(&self, context: &GpuContext, hair: &RuntimeHair) -> GpuHair {
+    ///
+    /// Refused, with nothing created, when a resource would exceed the adapter's limits
+    /// ([`check_adapter_limits`]).
+    pub fn upload(
+        &self,
+        context: &GpuContext,
+        hair: &RuntimeHair,
+    ) -> Result<GpuHair, StrandGenError> {
+        check_adapter_limits(&context.device.limits(), hair)?;
         let (textures, samples) = (&hair.textures, &hair.samples);
         let per_bundle = hair.strands_per_bundle as usize;
         let block_styling = &hair.block_styling;
@@ -346,7 +444,7 @@ impl StrandGenRenderer {
         let styling_bytes: &[u8] = bytemuck::cast_slice(&styling);
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
-        GpuHair {
+        Ok(GpuHair {
             position_offset: textures.position_offset.to_array(),
             hair_mesh,
             uv,
@@ -366,7 +464,7 @@ impl StrandGenRenderer {
                 + d
                 + e
                 + (bundle_bytes.len() + sample_bytes.len() + styling_bytes.len()) as u64,
-        }
+        })
     }
 
     /// Takes `hair`'s styling (parameters and group assignments) into `gpu` without touching

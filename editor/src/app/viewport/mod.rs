@@ -147,6 +147,8 @@ pub struct Viewport {
     frame_ms: Arc<std::sync::Mutex<Option<f64>>>,
     pub adapter: String,
     pub error: Option<String>,
+    /// Why the hair could not be uploaded (an adapter limit); the document is kept.
+    pub upload_error: Option<String>,
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
     pub rect: Option<egui::Rect>,
     transform: Option<ActiveTransform>,
@@ -248,6 +250,7 @@ impl Viewport {
             drawn_vertices: 0,
             frame_ms: Arc::default(),
             error: None,
+            upload_error: None,
             rect: None,
             transform: None,
             gizmo: GizmoAdapter::default(),

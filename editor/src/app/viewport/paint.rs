@@ -66,13 +66,26 @@ impl Viewport {
                         ..RuntimeOptions::default()
                     },
                 );
-                gpu.hair = hair.textures.hair_bounds().map(|bounds| UploadedHair {
-                    gpu: gpu.generator.upload(&gpu.context, &hair),
-                    body: GpuBody::upload(&gpu.context, &hair.body),
-                    bounds,
-                    hair,
-                    mesh: document.hair_mesh.clone(),
-                });
+                // Above the adapter's limits nothing is uploaded and the viewport says
+                // which limit; the document is untouched (undo the edit, or save it).
+                self.upload_error = None;
+                gpu.hair = match (
+                    hair.textures.hair_bounds(),
+                    gpu.generator.upload(&gpu.context, &hair),
+                ) {
+                    (Some(bounds), Ok(uploaded)) => Some(UploadedHair {
+                        gpu: uploaded,
+                        body: GpuBody::upload(&gpu.context, &hair.body),
+                        bounds,
+                        hair,
+                        mesh: document.hair_mesh.clone(),
+                    }),
+                    (_, Err(error)) => {
+                        self.upload_error = Some(format!("cannot draw this hair: {error}"));
+                        None
+                    }
+                    (None, Ok(_)) => None,
+                };
                 self.uploads.full += 1;
             }
             self.uploaded = Some(key);
@@ -153,7 +166,13 @@ impl Viewport {
                         Err(error) => self.error = Some(error.to_string()),
                     }
                 }
-                None => self.error = Some("no bundle grows hair".into()),
+                None => {
+                    self.error = Some(
+                        self.upload_error
+                            .clone()
+                            .unwrap_or_else(|| "no bundle grows hair".into()),
+                    )
+                }
             }
             self.drawn = Some(drawn);
         }
