@@ -21,7 +21,7 @@ DISPLAY_PACKAGES := xvfb x11-apps
 VALIDATE_VENV := target/validate-venv
 USD_CORE := usd-core==26.11
 
-.PHONY: run test deps gpu-deps toolchain lint samples bench
+.PHONY: run test deps gpu-deps toolchain lint samples bench fuzz
 
 toolchain:
 	@command -v $(CARGO) >/dev/null || { \
@@ -88,3 +88,11 @@ samples: toolchain
 bench: toolchain
 	$(CARGO) build --release -p hairloom-editor
 	./target/release/hairloom bench interior
+
+# Every fuzz target (project load, glTF import, runtime bundle, KTX2) for FUZZ_SECONDS each,
+# optimised with overflow checks on (profile `fuzz`). A panic saves its input under
+# fuzz/artifacts/ and fails. `make test` runs a bounded smoke pass of the same targets.
+FUZZ_SECONDS ?= 120
+fuzz: toolchain
+	$(CARGO) build --profile fuzz -p hairloom-fuzz
+	./target/fuzz/hairloom-fuzz run all --seconds $(FUZZ_SECONDS)

@@ -396,6 +396,11 @@ pub fn import_slice(
         let world: Vec<DVec3> = (0..vertex_count)
             .map(|i| transform.transform_point3(vec3(&local_positions, i)))
             .collect();
+        if let Some(i) = world.iter().position(|p| !p.is_finite()) {
+            return Err(primitive_error(format!(
+                "vertex {i} is not finite after the node transform and scale"
+            )));
+        }
         for triangle in indices.chunks_exact(3) {
             let mut t = [triangle[0], triangle[1], triangle[2]];
             if let Some(normals) = &normals {
@@ -929,7 +934,12 @@ fn weld(
         'search: for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    if let Some(list) = grid.get(&(x + dx, y + dy, z + dz)) {
+                    let cell = (
+                        x.saturating_add(dx),
+                        y.saturating_add(dy),
+                        z.saturating_add(dz),
+                    );
+                    if let Some(list) = grid.get(&cell) {
                         for &candidate in list {
                             if welded[candidate as usize].distance(p) <= tolerance {
                                 found = Some(candidate);

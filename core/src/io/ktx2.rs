@@ -31,6 +31,11 @@ impl TexelFormat {
         }
     }
 
+    /// The `VkFormat` number KTX2 headers store.
+    pub fn vk_number(self) -> u32 {
+        self.ktx2().value()
+    }
+
     fn ktx2(self) -> ktx2::Format {
         match self {
             Self::Rgba32Float => ktx2::Format::R32G32B32A32_SFLOAT,

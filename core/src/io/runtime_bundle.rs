@@ -772,7 +772,8 @@ mod tests {
     #[test]
     fn hostile_manifests_are_named_errors() {
         load_with(|_| {}).expect("the unedited bundle loads");
-        let cases: Vec<(Box<dyn FnOnce(&mut serde_json::Value)>, &str)> = vec![
+        type ManifestEdit = Box<dyn FnOnce(&mut serde_json::Value)>;
+        let cases: Vec<(ManifestEdit, &str)> = vec![
             (
                 Box::new(|m| m["bundles"][0]["origin"] = serde_json::json!([u32::MAX, 0])),
                 "does not fit a 2x2 block",

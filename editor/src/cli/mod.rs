@@ -57,6 +57,10 @@ enum Command {
         /// Replace the file's uv with a seamless generated projection.
         #[arg(long)]
         generate_uv: bool,
+        /// Raise the import cap on vertices (default 4,000,000; triangles may be twice as
+        /// many). See docs/resource-policy.md.
+        #[arg(long)]
+        max_vertices: Option<usize>,
     },
     /// Export the runtime bundle (manifest + KTX2 textures) and/or strands for other tools.
     Export {
@@ -67,8 +71,8 @@ enum Command {
         /// Strand file; the format follows the extension: .hair, .usda or .glb.
         #[arg(long)]
         strands: Vec<PathBuf>,
-        /// Strands per bundle.
-        #[arg(long, default_value_t = 64)]
+        /// Strands per bundle (at most 4096, the runtime bundle's cap).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
         strands_per_bundle: u32,
         /// Strands have 2^N + 1 vertices.
         #[arg(long, default_value_t = files::EXPORT_VERTICES_LOG2)]
@@ -87,8 +91,9 @@ enum Command {
         /// Image size, WIDTHxHEIGHT.
         #[arg(long, default_value = "960x960")]
         size: String,
-        /// Strands per bundle (default: the bundle's own count, or 64 for a project).
-        #[arg(long)]
+        /// Strands per bundle (default: the bundle's own count, or 64 for a project; at most
+        /// 4096).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
         strands_per_bundle: Option<u32>,
         /// Camera direction from the model: front, side, back, three-quarter, or x,y,z.
         #[arg(long, default_value = "three-quarter")]
@@ -168,7 +173,8 @@ pub fn main() -> ExitCode {
             mesh,
             scale,
             generate_uv,
-        }) => import(&scalp, &out, mesh, scale, generate_uv),
+            max_vertices,
+        }) => import(&scalp, &out, mesh, scale, generate_uv, max_vertices),
         Some(Command::Export {
             project,
             runtime,
@@ -347,10 +353,17 @@ fn import(
     mesh: Option<String>,
     scale: f64,
     generate_uv: bool,
+    max_vertices: Option<usize>,
 ) -> anyhow::Result<()> {
+    let mut limits = hairloom_core::io::import::ImportLimits::default();
+    if let Some(max_vertices) = max_vertices {
+        limits.max_vertices = max_vertices;
+        limits.max_triangles = limits.max_triangles.max(max_vertices.saturating_mul(2));
+    }
     let options = hairloom_core::io::import::ImportOptions {
         mesh_name: mesh,
         scale,
+        limits,
         ..hairloom_core::io::import::ImportOptions::default()
     };
     let (document, summary) = files::scalp_document(scalp, &options, generate_uv)?;

@@ -108,7 +108,7 @@ pub fn check_adapter_limits(
         for (limit_name, limit) in [
             (
                 "max_storage_buffer_binding_size",
-                u64::from(limits.max_storage_buffer_binding_size),
+                limits.max_storage_buffer_binding_size,
             ),
             ("max_buffer_size", limits.max_buffer_size),
         ] {

@@ -1,0 +1,201 @@
+//! The seed corpus: small valid inputs of every kind, and every crafted hostile case of the
+//! issue "Hostile and oversized input" (each was a panic, a read outside the input's folder
+//! or an unbounded cost before it was fixed). `hairloom-fuzz seed` writes them to
+//! `fuzz/corpus/<target>/`; the smoke test checks the committed corpus still holds them.
+
+use hairloom_core::io::runtime_bundle::runtime_bundle;
+use hairloom_core::runtime::hair::RuntimeOptions;
+use hairloom_core::{BodyMesh, Document, Project};
+use hairloom_tests::GltfBuilder;
+use serde_json::{Value, json};
+
+use crate::targets::{Target, bundle_input, manifest_of};
+
+/// `(file name, bytes)` seeds of `target`.
+pub fn seeds(target: Target) -> Vec<(String, Vec<u8>)> {
+    match target {
+        Target::ProjectLoad => project_seeds(),
+        Target::GltfImport => gltf_seeds(),
+        Target::RuntimeBundle => bundle_seeds(),
+        Target::Ktx2 => ktx2_seeds(),
+    }
+}
+
+fn project_seeds() -> Vec<(String, Vec<u8>)> {
+    use hairloom_core::edit::{ExtrudeDirection, extrude};
+    let mut project = Project::new(Document::new(
+        "grid",
+        hairloom_tests::grid_mesh(2, 2, 1, 0.1),
+    ));
+    let extruded = extrude(
+        &project.document.hair_mesh,
+        &[0, 1],
+        ExtrudeDirection::AlongNormal { distance: 0.1 },
+    )
+    .expect("extrude");
+    let mut after = project.document.clone();
+    after.hair_mesh = extruded.mesh;
+    project
+        .history
+        .commit(&mut project.document, "Extrude", after);
+    let mut curled = project.document.clone();
+    curled.styling.global.curl.radius_m = 0.01;
+    project
+        .history
+        .commit(&mut project.document, "Curl", curled);
+    let _ = project.history.undo(&mut project.document);
+    let valid = hairloom_core::io::project::to_bytes(&project);
+    let mut deep: Value = serde_json::from_slice(&valid).expect("json");
+    deep["document"]["hair_mesh"]["bundles"][0]["layers"] = json!(20_000);
+    let mut index: Value = serde_json::from_slice(&valid).expect("json");
+    index["document"]["hair_mesh"]["bundles"][0]["vertices"][0] = json!(4_294_967_295u64);
+    vec![
+        ("grid_with_history.hairloom".into(), valid),
+        (
+            "crafted_layers_20000.hairloom".into(),
+            serde_json::to_vec(&deep).expect("json"),
+        ),
+        (
+            "crafted_vertex_index_u32_max.hairloom".into(),
+            serde_json::to_vec(&index).expect("json"),
+        ),
+    ]
+}
+
+fn quad_builder() -> GltfBuilder {
+    let mut builder = GltfBuilder::default();
+    builder.add_quad_mesh("scalp");
+    builder
+}
+
+fn gltf_seeds() -> Vec<(String, Vec<u8>)> {
+    let builder = quad_builder();
+    let glb = |json: &Value| builder.glb(json);
+    let edited = |edit: &dyn Fn(&mut Value)| {
+        let mut json = builder.json();
+        edit(&mut json);
+        json
+    };
+    let mut seeds = vec![("quad.glb".to_string(), glb(&builder.json()))];
+    // The same quad as glTF JSON with its buffer in a data URI.
+    let data = {
+        use base64::Engine as _;
+        base64::engine::general_purpose::STANDARD.encode(&builder.bin)
+    };
+    let text = edited(&|json| {
+        json["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{data}"));
+    });
+    seeds.push((
+        "quad_data_uri.gltf".into(),
+        serde_json::to_vec(&text).expect("json"),
+    ));
+    // Crafted: each was a panic or an outside read.
+    seeds.push((
+        "crafted_accessor_index_9.glb".into(),
+        glb(&edited(&|json| {
+            json["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(9);
+        })),
+    ));
+    seeds.push((
+        "crafted_node_cycle.glb".into(),
+        glb(&edited(&|json| {
+            json["nodes"] = json!([{"children": [1], "mesh": 0}, {"children": [0, 42]}]);
+        })),
+    ));
+    let mut short = b"glTF".to_vec();
+    short.extend_from_slice(&2u32.to_le_bytes());
+    short.extend_from_slice(&4u32.to_le_bytes());
+    short.extend_from_slice(&[0; 12]);
+    seeds.push(("crafted_glb_length_4.glb".into(), short));
+    for (name, uri) in [
+        ("parent", "../../outside.bin"),
+        ("absolute", "/etc/passwd"),
+        ("file_scheme", "file:///etc/passwd"),
+        ("proc_environ", "/proc/self/environ"),
+        ("dev_zero", "/dev/zero"),
+    ] {
+        let json = edited(&|json| json["buffers"][0]["uri"] = json!(uri));
+        seeds.push((
+            format!("crafted_uri_{name}.gltf"),
+            serde_json::to_vec(&json).expect("json"),
+        ));
+    }
+    // 4,097 primitives sharing one accessor (past the primitive cap; 10,000 of them took
+    // 18 s and 2 GB before the cap and the accessor cache).
+    let mut many = builder.json();
+    let primitive = many["meshes"][0]["primitives"][0].clone();
+    many["meshes"][0]["primitives"] = Value::Array(vec![primitive; 4097]);
+    seeds.push(("crafted_primitives_4097.glb".into(), glb(&many)));
+    seeds
+}
+
+/// A small valid bundle with a body, so every file kind is present.
+pub fn bundle_with_body_files() -> Vec<(String, Vec<u8>)> {
+    let mut document = hairloom_tests::bundle_variant(0);
+    document.body = BodyMesh {
+        positions: vec![[0.0, 0.0, -0.1], [3.0, 0.0, -0.1], [0.0, 3.0, -0.1]],
+        triangles: vec![[0, 1, 2]],
+    };
+    runtime_bundle(&document, &RuntimeOptions::default()).expect("the base bundle exports")
+}
+
+fn bundle_seeds() -> Vec<(String, Vec<u8>)> {
+    let files = bundle_with_body_files();
+    let manifest_index = files.len() - 1;
+    let mut seeds: Vec<(String, Vec<u8>)> = files
+        .iter()
+        .enumerate()
+        .map(|(i, (name, bytes))| (format!("file_{i}_{name}"), bundle_input(i, bytes)))
+        .collect();
+    let manifest = serde_json::to_value(manifest_of(&files)).expect("json");
+    let crafted = |name: &str, edit: &dyn Fn(&mut Value)| {
+        let mut value = manifest.clone();
+        edit(&mut value);
+        (
+            format!("crafted_{name}.json"),
+            bundle_input(manifest_index, &serde_json::to_vec(&value).expect("json")),
+        )
+    };
+    seeds.extend([
+        crafted("origin_u32_max", &|m| {
+            m["bundles"][0]["origin"] = json!([4_294_967_295u64, 0]);
+        }),
+        crafted("strands_100000", &|m| {
+            m["strands_per_bundle"] = json!(100_000)
+        }),
+        crafted("max_layers_20000", &|m| m["max_layers"] = json!(20_000)),
+        crafted("texture_65536x65536x2e28", &|m| {
+            m["hair_mesh"]["size"] = json!([65536, 65536, 268_435_456]);
+        }),
+        crafted("texture_parent_path", &|m| {
+            m["w"]["file"] = json!("../../etc/passwd")
+        }),
+        crafted("body_absolute_path", &|m| m["body"] = json!("/etc/passwd")),
+        crafted("max_vertices_log2_40", &|m| {
+            m["lod"]["max_vertices_log2"] = json!(40)
+        }),
+    ]);
+    seeds
+}
+
+fn ktx2_seeds() -> Vec<(String, Vec<u8>)> {
+    let files = bundle_with_body_files();
+    let mut seeds: Vec<(String, Vec<u8>)> = files
+        .iter()
+        .filter(|(name, _)| name.ends_with(".ktx2"))
+        .map(|(name, bytes)| (name.clone(), bytes.clone()))
+        .collect();
+    let (_, base) = &files[0];
+    let dfd_offset = u32::from_le_bytes([base[48], base[49], base[50], base[51]]) as usize;
+    // A texel-block dimension byte of 255 panicked inside the ktx2 crate's DFD parser.
+    let mut dimension = base.clone();
+    dimension[dfd_offset + 4 + 12..dfd_offset + 4 + 16].fill(255);
+    seeds.push(("crafted_dfd_block_dimension_255.ktx2".into(), dimension));
+    // 65536 x 65536 x 2^28 texels: the byte count wrapped to 0 and passed the length check.
+    let mut huge = base.clone();
+    huge[20..24].copy_from_slice(&65536u32.to_le_bytes());
+    huge[24..28].copy_from_slice(&65536u32.to_le_bytes());
+    huge[28..32].copy_from_slice(&(1u32 << 28).to_le_bytes());
+    seeds.push(("crafted_size_65536x65536x2e28.ktx2".into(), huge));
+    seeds
+}

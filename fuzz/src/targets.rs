@@ -1,0 +1,133 @@
+//! The fuzz targets: one per reader of outside data. Each takes any bytes; a returned
+//! error is the expected outcome for most inputs, a panic is a bug.
+
+use std::collections::HashMap;
+use std::sync::OnceLock;
+
+use hairloom_core::io::import::{ImportOptions, import_slice};
+use hairloom_core::io::ktx2::{TexelFormat, read_texture};
+use hairloom_core::io::runtime_bundle::{MANIFEST_FILE, Manifest, load_runtime_bundle_from};
+use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// `io::project::from_bytes`: parse, validate, migrate and verify the history.
+    ProjectLoad,
+    /// `io::import::import_slice` (GLB or glTF JSON), then the scalp the editor builds.
+    GltfImport,
+    /// `io::runtime_bundle::load_runtime_bundle_from` with one file of a valid bundle
+    /// replaced by the input (see [`bundle_input`]), then strands generated from it.
+    RuntimeBundle,
+    /// `io::ktx2::read_texture` of a whole KTX2 file.
+    Ktx2,
+}
+
+impl Target {
+    pub const ALL: [Target; 4] = [
+        Target::ProjectLoad,
+        Target::GltfImport,
+        Target::RuntimeBundle,
+        Target::Ktx2,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::ProjectLoad => "project_load",
+            Target::GltfImport => "gltf_import",
+            Target::RuntimeBundle => "runtime_bundle",
+            Target::Ktx2 => "ktx2",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|t| t.name() == name)
+    }
+
+    pub fn run(self, input: &[u8]) {
+        match self {
+            Target::ProjectLoad => project_load(input),
+            Target::GltfImport => gltf_import(input),
+            Target::RuntimeBundle => runtime_bundle(input),
+            Target::Ktx2 => ktx2(input),
+        }
+    }
+}
+
+fn project_load(input: &[u8]) {
+    let _ = hairloom_core::io::project::from_bytes(input, std::path::Path::new("fuzz.hairloom"));
+}
+
+fn gltf_import(input: &[u8]) {
+    if let Ok(imported) = import_slice(input, None, "fuzz.glb", &ImportOptions::default()) {
+        let _ = imported.to_body().validate();
+        let _ = imported.to_hair_mesh(|_| true).validate();
+    }
+}
+
+/// The files of a valid runtime bundle (with a body), built once.
+fn base_bundle() -> &'static [(String, Vec<u8>)] {
+    static BASE: OnceLock<Vec<(String, Vec<u8>)>> = OnceLock::new();
+    BASE.get_or_init(crate::corpus::bundle_with_body_files)
+}
+
+/// A runtime-bundle fuzz input: the first byte picks the file of [`base_bundle`] that the
+/// rest replaces (modulo the file count; the manifest is last).
+pub fn bundle_input(file_index: usize, bytes: &[u8]) -> Vec<u8> {
+    let mut input = vec![file_index as u8];
+    input.extend_from_slice(bytes);
+    input
+}
+
+fn runtime_bundle(input: &[u8]) {
+    let Some((&selector, payload)) = input.split_first() else {
+        return;
+    };
+    let base = base_bundle();
+    let mut files: HashMap<String, Vec<u8>> = base.iter().cloned().collect();
+    let (name, _) = &base[selector as usize % base.len()];
+    files.insert(name.clone(), payload.to_vec());
+    let Ok(hair) = load_runtime_bundle_from(&files, "fuzz") else {
+        return;
+    };
+    // What a loaded bundle is used for: roots and strand positions.
+    let _ = hair.strand_roots();
+    let generator = StrandGen {
+        textures: &hair.textures,
+        filtering: Filtering::Exact,
+    };
+    for block in 0..hair.textures.atlas.blocks.len().min(64) {
+        let _ = generator.position(block, 0.3, 0.6, 0.7);
+    }
+}
+
+fn ktx2(input: &[u8]) {
+    // Read with the format and size the file itself declares, so the reader gets past its
+    // agreement checks and into the level data.
+    let word = |at: usize| {
+        input
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .unwrap_or(0)
+    };
+    let format = [
+        TexelFormat::Rgba32Float,
+        TexelFormat::Rg32Float,
+        TexelFormat::R32Float,
+        TexelFormat::Rgba16Float,
+        TexelFormat::Rg16Float,
+        TexelFormat::R16Float,
+    ]
+    .into_iter()
+    .find(|f| f.vk_number() == word(12))
+    .unwrap_or(TexelFormat::Rgba32Float);
+    let _ = read_texture(input, format, [word(20), word(24), word(28)]);
+}
+
+/// The manifest of a runtime bundle's files, for crafting cases.
+pub fn manifest_of(files: &[(String, Vec<u8>)]) -> Manifest {
+    let (_, bytes) = files
+        .iter()
+        .find(|(n, _)| n == MANIFEST_FILE)
+        .expect("a bundle has a manifest");
+    serde_json::from_slice(bytes).expect("our manifest parses")
+}
