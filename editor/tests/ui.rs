@@ -807,3 +807,167 @@ fn dragging_the_gizmo_moves_the_selection_as_one_step() {
     undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original);
 }
+
+/// Issue "The editor as artists use it": `G Z 0.02 Enter` moves the selection 2 cm up
+/// (Z-up convention), and while G runs, E and Ctrl+Z do nothing (the modal tool owns the
+/// keyboard until it is confirmed or cancelled).
+#[test]
+fn typing_g_z_a_value_enter_moves_up_and_the_modal_tool_owns_the_keyboard() {
+    let mut harness = harness();
+    click_bundle_in_outliner(&mut harness, 0);
+    let original = harness.state().state.document().clone();
+    let targets = harness.state().state.transform_targets();
+    assert!(!targets.is_empty());
+    let centre = viewport_rect(&harness).center();
+    harness.hover_at(centre);
+    harness.run();
+    harness.key_press(egui::Key::G);
+    harness.run();
+    assert_eq!(harness.state().viewport.modal_tool(), Some("Move"));
+    // Keys that would commit the move half-way and start something else.
+    harness.key_press(egui::Key::E);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().viewport.modal_tool(), Some("Move"));
+    assert!(harness.state().state.project.history.undo.is_empty());
+    assert!(harness.state().state.project.history.redo.is_empty());
+    for key in [
+        egui::Key::Z,
+        egui::Key::Num0,
+        egui::Key::Period,
+        egui::Key::Num0,
+        egui::Key::Num2,
+    ] {
+        harness.key_press(key);
+    }
+    harness.run();
+    assert!(
+        harness.state().state.message.contains("Z (up)"),
+        "{}",
+        harness.state().state.message
+    );
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    assert_eq!(harness.state().viewport.modal_tool(), None);
+    let history = &harness.state().state.project.history;
+    assert_eq!(history.undo.len(), 1);
+    assert_eq!(history.undo[0].label(), "Move");
+    let moved = harness.state().state.document();
+    for v in &targets {
+        let delta = moved.hair_mesh.position(*v).expect("moved")
+            - original.hair_mesh.position(*v).expect("original");
+        assert!(
+            (delta - glam::DVec3::new(0.0, 0.02, 0.0)).length() < 1e-9,
+            "{v:?} moved by {delta}"
+        );
+    }
+}
+
+/// "Save changes?" owns the keyboard: Ctrl+Z and E do nothing behind it, Esc is Cancel.
+#[test]
+fn dialogs_own_the_keyboard_and_escape_closes_them() {
+    let mut harness = harness();
+    make_unsaved_change(&mut harness);
+    let before = harness.state().state.project.clone();
+    file_menu(&mut harness, "Quit");
+    assert!(harness.state().confirm.is_some());
+    let centre = viewport_rect(&harness).center();
+    harness.hover_at(centre);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.key_press(egui::Key::E);
+    harness.run();
+    assert_eq!(
+        harness.state().state.project,
+        before,
+        "nothing acted behind the dialog"
+    );
+    assert!(harness.state().confirm.is_some());
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert!(harness.state().confirm.is_none(), "Esc cancels");
+    assert!(!harness.state().wants_to_quit());
+    assert_eq!(harness.state().state.project, before);
+}
+
+/// Quit ▸ Save on the unsaved sample goes through the typed-path prompt, saves, and then
+/// quits; the question names the project without the title's asterisk.
+#[test]
+fn quit_then_save_through_the_path_prompt_saves_and_quits() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("kept.hairloom");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Unavailable]),
+    );
+    make_unsaved_change(&mut harness);
+    file_menu(&mut harness, "Quit");
+    let name = harness.state().state.display_name();
+    assert!(!name.starts_with('*'));
+    harness.get_by_label(&format!(
+        "{name} has unsaved changes. They are lost if you do not save them."
+    ));
+    harness.get_by_label("Save").click();
+    harness.run();
+    harness.get_by_role(Role::TextInput).focus();
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness
+        .get_by_role(Role::TextInput)
+        .type_text(&path.display().to_string());
+    harness.run();
+    harness.get_by_label("OK").click();
+    harness.run();
+    assert!(path.exists(), "{}", harness.state().state.message);
+    assert!(harness.state().wants_to_quit(), "saved, then quit");
+}
+
+/// Three Ctrl+Z queued in one (slow) frame are three undos; Alt+A deselects; Tab toggles
+/// bundles / vertices without moving keyboard focus, and single keys still work after it.
+#[test]
+fn every_press_counts_alt_a_deselects_and_tab_toggles_the_mode() {
+    let mut harness = harness();
+    for (i, amplitude) in [0.011, 0.012, 0.013].into_iter().enumerate() {
+        harness
+            .get_by_role_and_label(Role::Slider, "Wave amplitude")
+            .set_value_accesskit(amplitude);
+        harness.run();
+        assert_eq!(harness.state().state.project.history.undo.len(), i + 1);
+    }
+    let centre = viewport_rect(&harness).center();
+    harness.hover_at(centre);
+    harness.run();
+    for _ in 0..3 {
+        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    }
+    harness.run();
+    assert_eq!(harness.state().state.project.history.undo.len(), 0);
+    assert_eq!(harness.state().state.project.history.redo.len(), 3);
+
+    harness.key_press(egui::Key::A);
+    harness.run();
+    assert!(!harness.state().state.selection.is_empty(), "A selects all");
+    harness.key_press_modifiers(egui::Modifiers::ALT, egui::Key::A);
+    harness.run();
+    assert!(
+        harness.state().state.selection.is_empty(),
+        "Alt+A selects none"
+    );
+
+    let mode = harness.state().state.tool.mode;
+    harness.key_press(egui::Key::Tab);
+    harness.run();
+    assert_ne!(harness.state().state.tool.mode, mode, "Tab toggles");
+    assert!(
+        harness.ctx.memory(|m| m.focused()).is_none(),
+        "Tab left keyboard focus on a widget"
+    );
+    harness.key_press(egui::Key::Tab);
+    harness.run();
+    assert_eq!(harness.state().state.tool.mode, mode);
+    harness.key_press(egui::Key::A);
+    harness.run();
+    assert!(
+        !harness.state().state.selection.is_empty(),
+        "keys work after Tab"
+    );
+}

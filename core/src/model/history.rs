@@ -494,6 +494,10 @@ impl Transaction {
         &self.start
     }
 
+    pub fn label(&self) -> &str {
+        &self.label
+    }
+
     /// Ends the gesture: one history entry, or none if the document is unchanged.
     pub fn commit(self, history: &mut History, document: &Document) -> bool {
         match Command::record(self.label, &self.start, document) {

@@ -135,6 +135,8 @@ pub struct HairloomApp {
     pub export: Option<ExportJob>,
     /// "Save changes?" is being asked before this action.
     pub confirm: Option<AfterConfirm>,
+    /// The action to run once the typed-path prompt's Save As succeeds.
+    after_save: Option<AfterConfirm>,
     /// The artist chose to quit; the next close request is let through.
     quitting: bool,
     close_sent: bool,
@@ -172,6 +174,7 @@ impl HairloomApp {
             prompt: None,
             export: None,
             confirm: None,
+            after_save: None,
             quitting: false,
             close_sent: false,
             title: String::new(),
@@ -251,8 +254,46 @@ impl HairloomApp {
         }
     }
 
+    /// Whether a modal window (recovery offer, "save changes?", path prompt, export
+    /// progress) is open: it owns the keyboard, and nothing behind it reacts.
+    pub fn dialog_open(&self) -> bool {
+        self.offer.is_some()
+            || self.confirm.is_some()
+            || self.prompt.is_some()
+            || self.export.is_some()
+    }
+
     fn shortcuts(&mut self, ui: &mut egui::Ui) {
         use egui::{Key, KeyboardShortcut, Modifiers};
+        // Blender's rule: a modal tool (G / R / S / E) owns the keyboard until it is
+        // confirmed or cancelled, and so does an open dialog. Their own keys are read by
+        // them; everything else waits.
+        if self.dialog_open() || self.viewport.modal_tool().is_some() {
+            return;
+        }
+        // Single-key commands only when no text field has the keyboard (a focused button
+        // or slider does not: letters mean nothing to it).
+        let typing = ui.ctx().text_edit_focused();
+        // Tab toggles bundles / vertices. egui moves keyboard focus on Tab at the start of
+        // the frame; take that back, so focus never lands on the menu bar.
+        let tabs = if typing {
+            0
+        } else {
+            ui.input_mut(|i| i.count_and_consume_key(Modifiers::NONE, Key::Tab))
+        };
+        if tabs > 0 {
+            ui.memory_mut(|m| {
+                // Cancel the pending focus move (widgets registered after this point would
+                // take it) and drop any focus already held.
+                m.move_focus(egui::FocusDirection::None);
+                if let Some(id) = m.focused() {
+                    m.surrender_focus(id);
+                }
+            });
+            if tabs % 2 == 1 {
+                self.state.toggle_select_mode();
+            }
+        }
         let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
         let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
         let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
@@ -261,11 +302,16 @@ impl HairloomApp {
         let open = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
         let new = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
         let quit = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
-        // The most specific shortcut first: Ctrl+Shift+Z would also match Ctrl+Z.
-        if ui.input_mut(|i| i.consume_shortcut(&redo_shift) || i.consume_shortcut(&redo_y)) {
+        // The most specific shortcut first: Ctrl+Shift+Z would also match Ctrl+Z. Every
+        // press counts, however slow the frame that collected them (egui queues them).
+        let count = |ui: &mut egui::Ui, shortcut: &KeyboardShortcut| {
+            ui.input_mut(|i| i.count_and_consume_key(shortcut.modifiers, shortcut.logical_key))
+        };
+        let redos = count(ui, &redo_shift) + count(ui, &redo_y);
+        for _ in 0..redos {
             self.state.redo();
         }
-        if ui.input_mut(|i| i.consume_shortcut(&undo)) {
+        for _ in 0..count(ui, &undo) {
             self.state.undo();
         }
         if ui.input_mut(|i| i.consume_shortcut(&save_as)) {
@@ -283,10 +329,7 @@ impl HairloomApp {
         if ui.input_mut(|i| i.consume_shortcut(&quit)) {
             self.request(AfterConfirm::Quit);
         }
-        // Single-key tools only when no text field has the keyboard.
-        if !ui.ctx().egui_wants_keyboard_input()
-            && ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::E))
-        {
+        if !typing && ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::E)) {
             // Over the viewport E is interactive (the pointer sets the distance, a click
             // confirms); elsewhere it extrudes by the Tools panel's distance at once.
             if self.viewport.is_hovered(ui) {
@@ -360,11 +403,16 @@ impl HairloomApp {
     fn answered(&mut self, request: FileRequest, path: PathBuf) {
         match request {
             FileRequest::OpenProject => self.request(AfterConfirm::Open(path)),
-            FileRequest::SaveProjectAs => {
-                if let Ok(path) = self.state.save_as(&path) {
+            FileRequest::SaveProjectAs => match self.state.save_as(&path) {
+                Ok(path) => {
                     self.saved_to(&path);
+                    // Quit / New / Open waiting on this save ("Save changes?" ▸ Save).
+                    if let Some(action) = self.after_save.take() {
+                        self.run_action(action);
+                    }
                 }
-            }
+                Err(_) => self.after_save = None,
+            },
             FileRequest::ImportScalp => self.import_scalp(&path),
             FileRequest::ExportRuntime => self.start_export(ExportTarget::Runtime {
                 dir: path,
@@ -557,29 +605,37 @@ impl HairloomApp {
         self.recovery_offer(ui);
         if let Some(action) = self.confirm.clone() {
             let mut choice = None;
-            egui::Modal::new(egui::Id::unique("hairloom save changes")).show(ui.ctx(), |ui| {
-                ui.heading("Save changes?");
-                ui.label(format!(
-                    "{} has unsaved changes. They are lost if you do not save them.",
-                    self.state.title().trim_end_matches(" — Hairloom")
-                ));
-                ui.horizontal(|ui| {
-                    if ui.button("Save").clicked() {
-                        choice = Some(Some(true));
-                    }
-                    if ui.button("Don't Save").clicked() {
-                        choice = Some(Some(false));
-                    }
-                    if ui.button("Cancel").clicked() {
-                        choice = Some(None);
-                    }
+            let modal =
+                egui::Modal::new(egui::Id::unique("hairloom save changes")).show(ui.ctx(), |ui| {
+                    ui.heading("Save changes?");
+                    ui.label(format!(
+                        "{} has unsaved changes. They are lost if you do not save them.",
+                        self.state.display_name()
+                    ));
+                    ui.horizontal(|ui| {
+                        if ui.button("Save").clicked() {
+                            choice = Some(Some(true));
+                        }
+                        if ui.button("Don't Save").clicked() {
+                            choice = Some(Some(false));
+                        }
+                        if ui.button("Cancel").clicked() {
+                            choice = Some(None);
+                        }
+                    });
                 });
-            });
+            // Esc (or a click beside the window) is Cancel.
+            if choice.is_none() && modal.should_close() {
+                choice = Some(None);
+            }
             match choice {
                 Some(Some(save)) => {
                     self.confirm = None;
                     if !save || self.save() {
                         self.run_action(action);
+                    } else if self.prompt.is_some() {
+                        // Save went to the typed-path prompt: its OK saves, then continues.
+                        self.after_save = Some(action);
                     }
                 }
                 Some(None) => self.confirm = None,
@@ -588,29 +644,35 @@ impl HairloomApp {
         }
         if let Some(prompt) = self.prompt.as_mut() {
             let mut answer = None;
-            egui::Modal::new(egui::Id::unique("hairloom path prompt")).show(ui.ctx(), |ui| {
-                ui.heading(prompt.request.title());
-                ui.label("No file dialog is available here: type the path.");
-                let field = ui.add(
-                    egui::TextEdit::singleline(&mut prompt.text)
-                        .desired_width(420.0)
-                        .hint_text("/path/to/file"),
-                );
-                let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-                ui.horizontal(|ui| {
-                    if ui.button("OK").clicked() || entered {
-                        answer = Some(Some(PathBuf::from(prompt.text.trim())));
-                    }
-                    if ui.button("Cancel").clicked() {
-                        answer = Some(None);
-                    }
+            let modal =
+                egui::Modal::new(egui::Id::unique("hairloom path prompt")).show(ui.ctx(), |ui| {
+                    ui.heading(prompt.request.title());
+                    ui.label("No file dialog is available here: type the path.");
+                    let field = ui.add(
+                        egui::TextEdit::singleline(&mut prompt.text)
+                            .desired_width(420.0)
+                            .hint_text("/path/to/file"),
+                    );
+                    let entered =
+                        field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+                    ui.horizontal(|ui| {
+                        if ui.button("OK").clicked() || entered {
+                            answer = Some(Some(PathBuf::from(prompt.text.trim())));
+                        }
+                        if ui.button("Cancel").clicked() {
+                            answer = Some(None);
+                        }
+                    });
                 });
-            });
+            if answer.is_none() && modal.should_close() {
+                answer = Some(None);
+            }
             if let Some(answer) = answer {
                 let request = prompt.request;
                 self.prompt = None;
-                if let Some(path) = answer.filter(|p| !p.as_os_str().is_empty()) {
-                    self.answered(request, path);
+                match answer.filter(|p| !p.as_os_str().is_empty()) {
+                    Some(path) => self.answered(request, path),
+                    None => self.after_save = None,
                 }
             }
         }
@@ -752,6 +814,7 @@ impl eframe::App for HairloomApp {
         }
         self.modals(ui);
         self.shortcuts(ui);
+        self.viewport.keyboard_blocked = self.dialog_open();
         let title = self.state.title();
         if title != self.title {
             ui.ctx()

@@ -65,9 +65,11 @@ impl Recovery {
             .map(|p| p.display().to_string())
             .unwrap_or_default();
         project::write_atomic(&self.origin_path(), origin.as_bytes(), |_| {})?;
+        // Never the document in the middle of an open gesture without its history step:
+        // that file would not verify, and Recover would lose the work.
         project::write_atomic(
             &self.project_path(),
-            &project::to_bytes(&state.project),
+            &project::to_bytes(&state.consistent_project()),
             |_| {},
         )
     }
@@ -86,13 +88,45 @@ impl Recovery {
         })
     }
 
-    /// Loads the recovered work: unsaved (dirty), saving to where it came from.
+    /// Loads the recovered work: unsaved (dirty), saving to where it came from. When the
+    /// history does not verify (an autosave from an older build, a damaged file) but the
+    /// document does, the document is recovered without its undo history and the message
+    /// says so: Recover never throws away a valid document. The recovery file is kept
+    /// until the work is saved.
     pub fn load(&self) -> Result<EditorState, String> {
         let path = self.project_path();
-        let mut state = EditorState::open(&path).map_err(|e| e.to_string())?;
+        let (mut state, message) = match EditorState::open(&path) {
+            Ok(state) => (
+                state,
+                format!("recovered unsaved work from {}", path.display()),
+            ),
+            Err(full_error) => {
+                let document_only =
+                    Self::document_without_history(&path).map_err(|_| full_error.to_string())?;
+                (
+                    document_only,
+                    format!(
+                        "recovered the document from {}, but not its undo history ({full_error})",
+                        path.display()
+                    ),
+                )
+            }
+        };
         state.path = self.pending().and_then(|p| p.origin);
-        state.mark_unsaved(format!("recovered unsaved work from {}", path.display()));
+        state.mark_unsaved(message);
         Ok(state)
+    }
+
+    /// The recovery file's document alone (its history dropped), if that is valid.
+    fn document_without_history(path: &Path) -> Result<EditorState, String> {
+        let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+        let mut value: serde_json::Value =
+            serde_json::from_slice(&bytes).map_err(|e| e.to_string())?;
+        let object = value.as_object_mut().ok_or("not a JSON object")?;
+        object.remove("history");
+        let bytes = serde_json::to_vec(&value).map_err(|e| e.to_string())?;
+        let project = project::from_bytes(&bytes, path).map_err(|e| e.to_string())?;
+        Ok(EditorState::from_project(project, None, String::new()))
     }
 
     /// Removes the recovery file (after a save, a clean quit, or Discard).
@@ -131,5 +165,67 @@ mod tests {
         assert!(recovered.path.is_none());
         recovery.discard();
         assert!(recovery.pending().is_none());
+    }
+
+    /// Issue "The editor as artists use it", bug 1: an autosave during an open gesture
+    /// (G held for minutes) was unloadable and Recover lost the work.
+    #[test]
+    fn an_autosave_during_an_open_gesture_recovers_it_whole() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let recovery = Recovery::in_dir(dir.path());
+        let mut state = EditorState::sample();
+        state.edit("curl").styling.global.curl.radius_m = 0.003;
+        state.commit_edit();
+        // The gesture is still open when the autosave runs.
+        if let Some(p) = state.edit("Move").hair_mesh.columns[25]
+            .positions
+            .last_mut()
+        {
+            p.x += 0.01;
+        }
+        let during = state.document().clone();
+        recovery.write(&state).expect("autosave");
+        hairloom_core::io::project::load(&recovery.project_path())
+            .expect("the autosave is a valid project (hairloom check accepts it)");
+        let mut recovered = recovery.load().expect("recovers");
+        assert_eq!(recovered.document(), &during, "the moved vertex survives");
+        assert!(recovered.message.starts_with("recovered unsaved work"));
+        // Undo takes back the gesture, then the curl, as two steps.
+        recovered.undo();
+        recovered.undo();
+        assert_eq!(recovered.document(), EditorState::sample().document());
+        // The live state's gesture is untouched by the autosave.
+        state.cancel_edit();
+        assert_eq!(state.document().styling.global.curl.radius_m, 0.003);
+    }
+
+    #[test]
+    fn a_recovery_file_whose_history_is_damaged_still_recovers_its_document() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let recovery = Recovery::in_dir(dir.path());
+        let mut state = EditorState::sample();
+        state.edit("curl").styling.global.curl.radius_m = 0.003;
+        state.commit_edit();
+        recovery.write(&state).expect("autosave");
+        // The old bug's file: the document moved on without its history step.
+        let mut value: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(recovery.project_path()).expect("read"))
+                .expect("json");
+        value["document"]["styling"]["global"]["curl"]["radius_m"] = serde_json::json!(0.007);
+        std::fs::write(
+            recovery.project_path(),
+            serde_json::to_vec(&value).expect("json"),
+        )
+        .expect("write");
+        assert!(hairloom_core::io::project::load(&recovery.project_path()).is_err());
+        let recovered = recovery.load().expect("the document is recovered");
+        assert_eq!(recovered.document().styling.global.curl.radius_m, 0.007);
+        assert!(recovered.is_dirty());
+        assert!(
+            recovered.message.contains("not its undo history"),
+            "{}",
+            recovered.message
+        );
+        assert!(!recovered.can_undo());
     }
 }

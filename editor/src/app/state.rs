@@ -51,6 +51,9 @@ pub struct ToolSettings {
     pub soft_radius_m: f64,
     /// The on-screen gizmo's handles.
     pub gizmo: super::gizmo::GizmoKind,
+    /// Axis keys and typed values during G / R / S follow Blender's Z-up convention (X
+    /// right, Y away from the front view, Z up) instead of the scene's Y-up axes.
+    pub z_up: bool,
 }
 
 impl Default for ToolSettings {
@@ -61,6 +64,7 @@ impl Default for ToolSettings {
             paint_radius_px: 24.0,
             soft_radius_m: 0.0,
             gizmo: super::gizmo::GizmoKind::Move,
+            z_up: true,
         }
     }
 }
@@ -87,7 +91,7 @@ pub struct EditorState {
 }
 
 impl EditorState {
-    fn with_project(project: Project, path: Option<PathBuf>, message: String) -> Self {
+    pub(super) fn from_project(project: Project, path: Option<PathBuf>, message: String) -> Self {
         Self {
             saved: project.document.clone(),
             project,
@@ -106,13 +110,13 @@ impl EditorState {
     pub fn sample() -> Self {
         let project = project::from_bytes(SAMPLE_PROJECT, Path::new(SAMPLE_NAME))
             .expect("the embedded sample is a valid project (checked by `make test`)");
-        Self::with_project(project, None, format!("opened {SAMPLE_NAME}"))
+        Self::from_project(project, None, format!("opened {SAMPLE_NAME}"))
     }
 
     /// A new, empty project (import a scalp to start).
     pub fn new_project() -> Self {
         let document = Document::new("untitled", HairMesh::empty());
-        Self::with_project(
+        Self::from_project(
             Project::new(document),
             None,
             "new project: import a scalp with File > Import scalp...".into(),
@@ -136,7 +140,7 @@ impl EditorState {
     /// Opens a project file; the error names the file and the problem.
     pub fn open(path: &Path) -> Result<Self, project::ProjectError> {
         let project = project::load(path)?;
-        Ok(Self::with_project(
+        Ok(Self::from_project(
             project,
             Some(path.to_path_buf()),
             format!("opened {}", path.display()),
@@ -147,17 +151,30 @@ impl EditorState {
         &self.project.document
     }
 
-    /// Title for the window and the status bar.
-    pub fn title(&self) -> String {
-        let name = match self.path.as_deref().and_then(Path::file_name) {
+    /// The project's name as the user knows it: its file name, "untitled", or the sample's.
+    pub fn display_name(&self) -> String {
+        match self.path.as_deref().and_then(Path::file_name) {
             Some(name) => name.to_string_lossy().into_owned(),
             None if self.project.document.name == "untitled" => "untitled".into(),
             None => SAMPLE_NAME.to_string(),
-        };
+        }
+    }
+
+    /// Title for the window and the status bar.
+    pub fn title(&self) -> String {
         format!(
-            "{}{name} — Hairloom",
-            if self.is_dirty() { "* " } else { "" }
+            "{}{} — Hairloom",
+            if self.is_dirty() { "* " } else { "" },
+            self.display_name()
         )
+    }
+
+    /// Tab: bundles ↔ vertices.
+    pub fn toggle_select_mode(&mut self) {
+        self.tool.mode = match self.tool.mode {
+            SelectMode::Bundles => SelectMode::Vertices,
+            SelectMode::Vertices => SelectMode::Bundles,
+        };
     }
 
     pub fn is_dirty(&self) -> bool {
@@ -177,6 +194,20 @@ impl EditorState {
         }
         self.revision = next_revision();
         &mut self.project.document
+    }
+
+    /// The project as a consistent, loadable whole, without disturbing a running edit: an
+    /// open gesture (a G drag, an extrude being sized) is folded in as its own history
+    /// step, so the history verifies against the document. What autosave writes.
+    pub fn consistent_project(&self) -> Project {
+        let mut project = self.project.clone();
+        if let Some(edit) = &self.edit
+            && let Some(command) =
+                hairloom_core::Command::record(edit.label(), edit.start(), &project.document)
+        {
+            project.history.push(command);
+        }
+        project
     }
 
     /// Ends the running edit: one command in the history if anything changed.

@@ -89,10 +89,15 @@ impl ToolsPanel {
             .labelled_by(label.id)
             .on_hover_text("Unselected vertices this close follow with a smooth falloff (wheel while transforming)");
         });
+        ui.checkbox(&mut state.tool.z_up, "Z up (Blender axes)")
+            .on_hover_text(
+                "Axis keys and typed values in G / R / S: on, Z is up and Y points away from \
+                 the front view (Blender); off, the scene's own axes (Y up, Z toward the front)",
+            );
         ui.label(
             egui::RichText::new(
                 "G move · R rotate · S scale in the viewport; X / Y / Z lock an axis; \
-                 click or Enter confirms, Esc or right-click cancels",
+                 type a value (G Z 0.02 Enter); click or Enter confirms, Esc or right-click cancels",
             )
             .small()
             .weak(),

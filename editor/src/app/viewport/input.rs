@@ -125,7 +125,7 @@ impl Viewport {
         state: &mut EditorState,
         response: &egui::Response,
     ) {
-        if !response.hovered() || ui.ctx().egui_wants_keyboard_input() {
+        if !response.hovered() || ui.ctx().text_edit_focused() || self.keyboard_blocked {
             return;
         }
         use egui::{Key, Modifiers};
@@ -140,25 +140,22 @@ impl Viewport {
                 return;
             }
         }
-        if pressed(Key::A) {
-            state.select_all(true);
-        }
+        // Alt+A first: egui's matching ignores an Alt the pattern does not name, so plain
+        // A would also take Alt+A.
         if ui.input_mut(|i| i.consume_key(Modifiers::ALT, Key::A)) {
             state.select_all(false);
         }
-        if pressed(Key::Tab) {
-            state.tool.mode = match state.tool.mode {
-                SelectMode::Bundles => SelectMode::Vertices,
-                SelectMode::Vertices => SelectMode::Bundles,
-            };
+        if pressed(Key::A) {
+            state.select_all(true);
         }
-        if ui.input_mut(|i| {
-            i.consume_key(Modifiers::COMMAND, Key::Plus)
-                || i.consume_key(Modifiers::COMMAND, Key::Equals)
-        }) {
+        let grows = ui.input_mut(|i| {
+            i.count_and_consume_key(Modifiers::COMMAND, Key::Plus)
+                + i.count_and_consume_key(Modifiers::COMMAND, Key::Equals)
+        });
+        for _ in 0..grows {
             state.grow_selection(true);
         }
-        if ui.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::Minus)) {
+        for _ in 0..ui.input_mut(|i| i.count_and_consume_key(Modifiers::COMMAND, Key::Minus)) {
             state.grow_selection(false);
         }
         if pressed(Key::F) {

@@ -149,6 +149,8 @@ pub struct Viewport {
     pub error: Option<String>,
     /// Why the hair could not be uploaded (an adapter limit); the document is kept.
     pub upload_error: Option<String>,
+    /// A dialog owns the keyboard this frame (set by the app): no single-key commands.
+    pub keyboard_blocked: bool,
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
     pub rect: Option<egui::Rect>,
     transform: Option<ActiveTransform>,
@@ -251,6 +253,7 @@ impl Viewport {
             frame_ms: Arc::default(),
             error: None,
             upload_error: None,
+            keyboard_blocked: false,
             rect: None,
             transform: None,
             gizmo: GizmoAdapter::default(),

@@ -167,7 +167,25 @@ impl Viewport {
         if let Some(active) = &self.transform {
             if let Some(pivot) = project(active.pivot) {
                 painter.circle_stroke(pivot, 5.0, egui::Stroke::new(1.5, orange));
-                if let Some(pointer) = active.applied.map(|(p, _, _)| p) {
+                // The locked axis as a line through the pivot, in Blender's axis colours
+                // (X red, Y green, Z blue) under the artist's convention.
+                if let Some(axis) = active.axis {
+                    let mut direction = DVec3::ZERO;
+                    direction[axis] = 1.0;
+                    let colour = match super::transform_tools::artist_axis(axis, state.tool.z_up) {
+                        0 => egui::Color32::from_rgb(230, 70, 70),
+                        1 => egui::Color32::from_rgb(110, 200, 80),
+                        _ => egui::Color32::from_rgb(80, 140, 240),
+                    };
+                    let reach = 2.0;
+                    if let (Some(a), Some(b)) = (
+                        project(active.pivot - direction * reach),
+                        project(active.pivot + direction * reach),
+                    ) {
+                        painter.line_segment([a, b], egui::Stroke::new(1.5, colour));
+                    }
+                }
+                if let Some(pointer) = active.applied.as_ref().map(|(p, ..)| *p) {
                     painter.line_segment(
                         [pivot, pointer],
                         egui::Stroke::new(1.0, egui::Color32::from_white_alpha(120)),

@@ -37,8 +37,86 @@ pub(super) struct ActiveTransform {
     pub(super) bundles: Vec<u32>,
     pub(super) direction: DVec3,
     pub(super) base_distance_m: f64,
-    /// The last pointer position applied (recomputed only when it or the settings change).
-    pub(super) applied: Option<(egui::Pos2, Option<usize>, u64)>,
+    /// Sign of the locked axis as the artist named it (Z-up's Y is the scene's −Z).
+    pub(super) axis_sign: f64,
+    /// A value typed during the gesture (`G Z 0.02 Enter`); it replaces the pointer.
+    pub(super) typed: String,
+    /// What was last applied (recomputed only when the pointer, axis, typed value or soft
+    /// radius change).
+    pub(super) applied: Option<(egui::Pos2, Option<usize>, u64, String)>,
+}
+
+/// The scene axis (0 = x, 1 = y, 2 = z) and sign an axis key names under the artist's
+/// convention. The scene is Y-up with +z toward the front view; Blender is Z-up with +y
+/// away from the front view.
+pub fn scene_axis(key_axis: usize, z_up: bool) -> (usize, f64) {
+    match (key_axis, z_up) {
+        (1, true) => (2, -1.0),
+        (2, true) => (1, 1.0),
+        (axis, _) => (axis, 1.0),
+    }
+}
+
+/// The axis (0 = X, 1 = Y, 2 = Z) the artist calls scene axis `axis`.
+pub(super) fn artist_axis(axis: usize, z_up: bool) -> usize {
+    match (axis, z_up) {
+        (1, true) => 2,
+        (2, true) => 1,
+        (axis, _) => axis,
+    }
+}
+
+/// The axis name the artist uses for scene axis `axis`.
+fn axis_name(axis: usize, z_up: bool) -> &'static str {
+    match (axis, z_up) {
+        (1, true) => "Z (up)",
+        (2, true) => "Y (depth)",
+        (1, false) => "Y (up)",
+        (2, false) => "Z (depth)",
+        _ => "X",
+    }
+}
+
+/// The transform a typed `value` asks for: metres along the locked axis (X when none) for
+/// Move, degrees about it (the view axis when none) for Rotate, a factor for Scale.
+pub(super) fn typed_transform(
+    active: &ActiveTransform,
+    value: f64,
+    projector: Projector,
+) -> VertexTransform {
+    let mut axis_vector = DVec3::ZERO;
+    axis_vector[active.axis.unwrap_or(0)] = active.axis_sign;
+    match active.kind {
+        TransformKind::Move | TransformKind::Extrude => VertexTransform::Translate {
+            offset: (axis_vector * value).to_array(),
+        },
+        TransformKind::Rotate => {
+            let axis = if active.axis.is_some() {
+                axis_vector
+            } else {
+                let pivot_screen = projector
+                    .project(active.pivot)
+                    .unwrap_or(active.start_pointer);
+                projector.ray(pivot_screen).1.normalize_or(DVec3::NEG_Z)
+            };
+            VertexTransform::Rotate {
+                axis: axis.to_array(),
+                angle_rad: value.to_radians(),
+                pivot: active.pivot.to_array(),
+            }
+        }
+        TransformKind::Scale => {
+            let mut factors = [value; 3];
+            if let Some(axis) = active.axis {
+                factors = [1.0; 3];
+                factors[axis] = value;
+            }
+            VertexTransform::Scale {
+                factors,
+                pivot: active.pivot.to_array(),
+            }
+        }
+    }
 }
 
 /// What the selection's transform targets depend on.
@@ -74,7 +152,7 @@ pub(super) fn preview_transform(
     match moved {
         Ok(outcome) => {
             state.edit(kind.label()).hair_mesh = outcome.mesh;
-            state.message = describe_transform(kind, axis, transform)
+            state.message = describe_transform(kind, axis, state.tool.z_up, transform)
                 + &format!(", soft radius {:.3} m", state.tool.soft_radius_m);
         }
         Err(error) => state.message = format!("{}: {error}", kind.label()),
@@ -144,9 +222,13 @@ pub(super) fn transform_for(
 pub(super) fn describe_transform(
     kind: TransformKind,
     axis: Option<usize>,
+    z_up: bool,
     transform: VertexTransform,
 ) -> String {
-    let axis = axis.map_or(String::new(), |a| format!(" along {}", ["x", "y", "z"][a]));
+    let convention = if z_up { "Z-up" } else { "Y-up" };
+    let axis = axis.map_or(format!(" [{convention}]"), |a| {
+        format!(" along {} [{convention}]", axis_name(a, z_up))
+    });
     match transform {
         VertexTransform::Translate { offset } => format!(
             "{}{axis}: ({:.4}, {:.4}, {:.4}) m",
@@ -174,6 +256,11 @@ pub(super) fn describe_transform(
 }
 
 impl Viewport {
+    /// The modal tool running (G / R / S / E), which owns the keyboard until it ends.
+    pub fn modal_tool(&self) -> Option<&'static str> {
+        self.transform.as_ref().map(|t| t.kind.label())
+    }
+
     pub(super) fn begin_transform(
         &mut self,
         ui: &egui::Ui,
@@ -201,11 +288,14 @@ impl Viewport {
             bundles: Vec::new(),
             direction: DVec3::ZERO,
             base_distance_m: 0.0,
+            axis_sign: 1.0,
+            typed: String::new(),
             applied: None,
         });
         state.message = format!(
-            "{}: move the pointer; click confirms, Esc cancels",
-            kind.label()
+            "{}: move the pointer or type a value; X / Y / Z lock an axis ({}); click or Enter confirms, Esc cancels",
+            kind.label(),
+            if state.tool.z_up { "Z-up" } else { "Y-up" }
         );
     }
 
@@ -323,6 +413,8 @@ impl Viewport {
             bundles,
             direction: direction.normalize_or(DVec3::Z),
             base_distance_m: distance_m,
+            axis_sign: 1.0,
+            typed: String::new(),
             applied: None,
         });
     }
@@ -347,15 +439,55 @@ impl Viewport {
             self.transform = None;
             return;
         }
-        for (key, axis) in [(Key::X, 0), (Key::Y, 1), (Key::Z, 2)] {
+        for (key, key_axis) in [(Key::X, 0), (Key::Y, 1), (Key::Z, 2)] {
             if ui.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
+                let (axis, sign) = scene_axis(key_axis, state.tool.z_up);
                 active.axis = if active.axis == Some(axis) {
                     None
                 } else {
                     Some(axis)
                 };
+                active.axis_sign = sign;
             }
         }
+        // Typed digits, in the order pressed (Blender's numeric input).
+        ui.input_mut(|i| {
+            i.events.retain(|event| {
+                let egui::Event::Key {
+                    key,
+                    pressed: true,
+                    modifiers,
+                    ..
+                } = event
+                else {
+                    return true;
+                };
+                if modifiers.command || modifiers.alt {
+                    return true;
+                }
+                let typed = &mut active.typed;
+                match key {
+                    Key::Backspace => {
+                        typed.pop();
+                    }
+                    Key::Minus => {
+                        if typed.starts_with('-') {
+                            typed.remove(0);
+                        } else {
+                            typed.insert(0, '-');
+                        }
+                    }
+                    Key::Period | Key::Comma if !typed.contains('.') => typed.push('.'),
+                    key => match key.name().parse::<u8>() {
+                        Ok(digit) if digit <= 9 && key.name().len() == 1 => {
+                            typed.push(char::from(b'0' + digit));
+                        }
+                        _ => return true,
+                    },
+                }
+                false
+            });
+        });
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
             let radius = &mut state.tool.soft_radius_m;
@@ -369,12 +501,15 @@ impl Viewport {
             .input(|i| i.pointer.hover_pos())
             .unwrap_or(active.start_pointer);
         let radius_bits = state.tool.soft_radius_m.to_bits();
-        if active.applied != Some((pointer, active.axis, radius_bits)) {
-            active.applied = Some((pointer, active.axis, radius_bits));
+        let applied = Some((pointer, active.axis, radius_bits, active.typed.clone()));
+        let typed_value = active.typed.parse::<f64>().ok().filter(|v| v.is_finite());
+        if active.applied != applied {
+            active.applied = applied;
             if active.kind == TransformKind::Extrude {
                 let moved = projector.unproject(pointer, active.pivot)
                     - projector.unproject(active.start_pointer, active.pivot);
-                let distance = active.base_distance_m + moved.dot(active.direction);
+                let distance =
+                    typed_value.unwrap_or(active.base_distance_m + moved.dot(active.direction));
                 let extruded = edit::extrude(
                     &state.edit_start().hair_mesh,
                     &active.bundles,
@@ -388,8 +523,14 @@ impl Viewport {
                     Err(error) => state.message = format!("Extrude: {error}"),
                 }
             } else {
-                let transform = transform_for(active, pointer, projector);
+                let transform = match typed_value {
+                    Some(value) => typed_transform(active, value, projector),
+                    None => transform_for(active, pointer, projector),
+                };
                 preview_transform(state, active.kind, active.axis, &active.vertices, transform);
+                if !active.typed.is_empty() {
+                    state.message = format!("typed {} · {}", active.typed, state.message);
+                }
             }
         }
         let confirm =
