@@ -971,3 +971,66 @@ fn every_press_counts_alt_a_deselects_and_tab_toggles_the_mode() {
         "keys work after Tab"
     );
 }
+
+/// The camera frames the document once: extrudes (which grow the bounds) leave it put.
+#[test]
+fn edits_never_move_the_camera() {
+    let mut harness = harness();
+    click_bundle_in_outliner(&mut harness, 0);
+    let framed = harness.state().viewport.camera_bounds().expect("framed");
+    let layers = harness.state().state.document().hair_mesh.bundles[0].layers;
+    for _ in 0..3 {
+        // Outside the viewport, E extrudes at once by the Tools panel's distance.
+        harness.hover_at(egui::pos2(3.0, 3.0));
+        harness.key_press(egui::Key::E);
+        harness.run();
+    }
+    assert_eq!(
+        harness.state().state.document().hair_mesh.bundles[0].layers,
+        layers + 3,
+        "{}",
+        harness.state().state.message
+    );
+    assert_eq!(harness.state().viewport.camera_bounds(), Some(framed));
+}
+
+/// A typed value beyond the valid range is refused with the field named and the old value
+/// kept; one past the slider's end but inside the range is taken.
+#[test]
+fn typed_styling_values_respect_the_valid_range() {
+    let mut harness = harness();
+    let before = harness
+        .state()
+        .state
+        .document()
+        .styling
+        .global
+        .curl
+        .radius_m;
+    harness
+        .get_by_role_and_label(Role::Slider, "Curl radius")
+        .set_value_accesskit(5.0);
+    harness.run();
+    let state = &harness.state().state;
+    assert_eq!(state.document().styling.global.curl.radius_m, before);
+    assert!(
+        state.message.contains("curl.radius_m") && state.message.contains("valid range"),
+        "{}",
+        state.message
+    );
+    harness
+        .get_by_role_and_label(Role::Slider, "Curl radius")
+        .set_value_accesskit(0.1);
+    harness.run();
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .document()
+            .styling
+            .global
+            .curl
+            .radius_m,
+        0.1
+    );
+}

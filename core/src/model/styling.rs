@@ -272,14 +272,12 @@ impl StylingSet {
                 if !value.is_finite() {
                     return Err(format!("{at}.{name}: not a finite number"));
                 }
-            }
-            for (name, value) in [
-                ("length.fraction", p.length.fraction),
-                ("frizz.fraction", p.frizz.fraction),
-                ("clump.strength", p.clump.strength),
-            ] {
-                if !(0.0..=1.0).contains(&value) {
-                    return Err(format!("{at}.{name}: {value} is outside [0, 1]"));
+                if let Some(&(_, lo, hi)) = HARD_RANGES.iter().find(|(n, ..)| *n == name)
+                    && !(lo..=hi).contains(&value)
+                {
+                    return Err(format!(
+                        "{at}.{name}: {value} is outside the valid range [{lo}, {hi}]"
+                    ));
                 }
             }
             if p.noise.octaves > 8 {
@@ -297,6 +295,40 @@ impl StylingSet {
         Ok(())
     }
 }
+
+/// The valid range of every styling parameter: what a file, a paste or a typed value may
+/// hold (refused by name outside it). The editor's sliders span a narrower, comfortable
+/// range; a typed value beyond the slider but inside this range is allowed. The limits are
+/// generous physical bounds (a 0.5 m curl radius is already a hoop, not hair) chosen so that
+/// no parameter can throw strands metres away or divide by zero: clumps per uv and
+/// variation cells per uv start at 1, fractions stay in [0, 1].
+pub const HARD_RANGES: &[(&str, f64, f64)] = &[
+    ("curl.radius_m", 0.0, 0.5),
+    ("curl.turns_per_m", 0.0, 1000.0),
+    ("curl.ramp_in_m", 0.0, 10.0),
+    ("curl.radius_jitter", 0.0, 1.0),
+    ("twist.turns_per_m", -1000.0, 1000.0),
+    ("noise.amplitude_m", 0.0, 0.5),
+    ("noise.frequency_per_m", 0.0, 10_000.0),
+    ("clump.strength", 0.0, 1.0),
+    ("clump.clumps_per_uv", 1.0, 10_000.0),
+    ("clump.radius_m", 0.0, 1.0),
+    ("clump.tightening", 0.0, 100.0),
+    ("frizz.amplitude_m", 0.0, 0.5),
+    ("frizz.frequency_per_m", 0.0, 10_000.0),
+    ("frizz.fraction", 0.0, 1.0),
+    ("wave.amplitude_m", 0.0, 0.5),
+    ("wave.frequency_per_m", 0.0, 1000.0),
+    (
+        "wave.direction_rad",
+        -std::f64::consts::TAU,
+        std::f64::consts::TAU,
+    ),
+    ("wave.phase_spread", 0.0, 1.0),
+    ("wave.ramp_in_m", 0.0, 10.0),
+    ("length.fraction", 0.0, 1.0),
+    ("variation_per_uv", 1.0, 10_000.0),
+];
 
 impl StylingParams {
     /// Every op on at moderate, hair-sized amplitudes: the set tests and benchmarks use when
@@ -334,6 +366,36 @@ impl StylingParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue "The editor as artists use it", bug 7: a 5 m or negative curl radius, 0 clumps
+    /// per uv and a 1e30 wave amplitude were accepted.
+    #[test]
+    fn values_outside_the_hard_ranges_are_refused_by_name() {
+        let refused = |edit: fn(&mut StylingParams), field: &str| {
+            let mut set = StylingSet::default();
+            edit(&mut set.global);
+            let error = set.validate().expect_err(field);
+            assert!(
+                error.starts_with(&format!("global.{field}:")) && error.contains("valid range"),
+                "{field}: {error}"
+            );
+        };
+        refused(|p| p.curl.radius_m = 5.0, "curl.radius_m");
+        refused(|p| p.curl.radius_m = -1.0, "curl.radius_m");
+        refused(|p| p.clump.clumps_per_uv = 0.0, "clump.clumps_per_uv");
+        refused(|p| p.wave.amplitude_m = 1e30, "wave.amplitude_m");
+        // Beyond the editor's slider (0.03 m) but inside the valid range: allowed.
+        let mut set = StylingSet::default();
+        set.global.curl.radius_m = 0.1;
+        set.validate()
+            .expect("a typed value past the slider is fine");
+        // Every default and the every-op set sit inside the ranges.
+        set.global = StylingParams::every_op();
+        set.validate().expect("every_op is valid");
+        for (name, lo, hi) in HARD_RANGES {
+            assert!(lo < hi, "{name}");
+        }
+    }
 
     #[test]
     fn assigning_moves_bundles_between_groups_and_back_to_global() {

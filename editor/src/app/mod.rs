@@ -238,6 +238,7 @@ impl HairloomApp {
             Some(true) => match self.recovery.load() {
                 Ok(state) => {
                     self.state = state;
+                    self.viewport.reframe();
                     self.offer = None;
                 }
                 Err(error) => {
@@ -471,6 +472,7 @@ impl HairloomApp {
 
     fn replace_state(&mut self, state: EditorState) {
         self.state = state;
+        self.viewport.reframe();
         self.recovery.discard();
         self.autosaved.1 = self.state.revision;
     }
@@ -478,7 +480,10 @@ impl HairloomApp {
     fn import_scalp(&mut self, path: &std::path::Path) {
         let options = hairloom_core::io::import::ImportOptions::default();
         match crate::files::scalp_document(path, &options, false) {
-            Ok((document, summary)) => self.state.import_scalp(document, &summary),
+            Ok((document, summary)) => {
+                self.state.import_scalp(document, &summary);
+                self.viewport.reframe();
+            }
             Err(error) => self.state.message = format!("import failed: {error:#}"),
         }
     }

@@ -149,7 +149,8 @@ impl Viewport {
         let size = (hi - lo).length().max(1e-6);
         let offset = centre.as_vec3() - camera.target;
         self.orbit.pan = [offset.dot(right) / size, offset.dot(up) / size];
-        self.orbit.zoom = ((extent as f32 * 2.5) / size).clamp(0.08, 1.0);
+        // Room around the selection: its diameter fills about half the view.
+        self.orbit.zoom = ((extent as f32 * 4.0) / size).clamp(0.08, 1.0);
     }
 
     pub(super) fn navigate(&mut self, ui: &egui::Ui, response: &egui::Response) {
@@ -172,20 +173,20 @@ impl Viewport {
             if scroll != 0.0 {
                 self.orbit.zoom = (self.orbit.zoom * (-scroll * 0.002).exp()).clamp(0.05, 20.0);
             }
+            // Front / side / top turn the view and keep its zoom and pan (Blender's numpad).
             ui.input(|i| {
-                let view = |yaw: f32, pitch: f32| Orbit {
-                    yaw_rad: yaw,
-                    pitch_rad: pitch,
-                    ..Orbit::default()
+                let mut view = |yaw: f32, pitch: f32| {
+                    self.orbit.yaw_rad = yaw;
+                    self.orbit.pitch_rad = pitch;
                 };
                 if i.key_pressed(egui::Key::Num1) {
-                    self.orbit = view(0.0, 0.05);
+                    view(0.0, 0.05);
                 }
                 if i.key_pressed(egui::Key::Num3) {
-                    self.orbit = view(std::f32::consts::FRAC_PI_2, 0.05);
+                    view(std::f32::consts::FRAC_PI_2, 0.05);
                 }
                 if i.key_pressed(egui::Key::Num7) {
-                    self.orbit = view(0.0, 1.5);
+                    view(0.0, 1.5);
                 }
             });
         }

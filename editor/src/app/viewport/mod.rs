@@ -174,7 +174,13 @@ pub struct Viewport {
     /// The pointer path of a region drag in progress.
     drag_path: Vec<egui::Pos2>,
     /// The box the camera frames (the drawn hair's), for picking with the same camera.
+    /// The box the camera frames. Fixed once a document is framed (the hair's box at the
+    /// first picture, the mesh's before it), so edits never move the view: a rotate
+    /// preview or fifteen extrudes leave the camera where the artist put it. Reset when
+    /// another document arrives ([`Self::reframe`]).
     camera_bounds: Option<(Vec3, Vec3)>,
+    /// Whether `camera_bounds` came from the generated hair (else from the mesh).
+    framed_from_hair: bool,
     /// Per column and layer, whether the vertex is interior, for the document revision it
     /// was computed at (the wireframe marks them; recomputed only when the document changes).
     interior: Option<(u64, Vec<Vec<bool>>)>,
@@ -265,15 +271,35 @@ impl Viewport {
             measuring: None,
             drag_path: Vec::new(),
             camera_bounds: None,
+            framed_from_hair: false,
             interior: None,
             frames: None,
         }
+    }
+
+    /// Frames the next document afresh (opened, new, recovered, imported).
+    pub fn reframe(&mut self) {
+        self.camera_bounds = None;
+        self.framed_from_hair = false;
+        self.orbit = Orbit::default();
+    }
+
+    /// The box the camera frames, once framed.
+    pub fn camera_bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.camera_bounds
     }
 
     pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
         let (rect, response) =
             ui.allocate_exact_size(ui.available_size(), egui::Sense::click_and_drag());
         self.rect = Some(rect);
+        if self.camera_bounds.is_none() {
+            self.camera_bounds = state
+                .document()
+                .hair_mesh
+                .bounds()
+                .map(|(lo, hi)| (lo.as_vec3(), hi.as_vec3()));
+        }
         if let Some(projector) = self.projector(state, rect) {
             if self.transform.is_some() {
                 self.drive_transform(ui, state, &response, projector);

@@ -106,8 +106,11 @@ impl Viewport {
             self.error = None;
             match gpu.hair.as_ref() {
                 Some(hair) => {
-                    let (lo, hi) = hair.bounds;
-                    self.camera_bounds = Some(hair.bounds);
+                    if !self.framed_from_hair {
+                        self.camera_bounds = Some(hair.bounds);
+                        self.framed_from_hair = true;
+                    }
+                    let (lo, hi) = self.camera_bounds.unwrap_or(hair.bounds);
                     let scene = default_scene(
                         &hair.body,
                         HairSource::Generated {
