@@ -265,7 +265,8 @@ impl HairloomApp {
     }
 
     fn shortcuts(&mut self, ui: &mut egui::Ui) {
-        use egui::{Key, KeyboardShortcut, Modifiers};
+        use egui::{Key, Modifiers};
+        use shortcut::*;
         // Blender's rule: a modal tool (G / R / S / E) owns the keyboard until it is
         // confirmed or cancelled, and so does an open dialog. Their own keys are read by
         // them; everything else waits.
@@ -295,17 +296,11 @@ impl HairloomApp {
                 self.state.toggle_select_mode();
             }
         }
-        let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
-        let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
-        let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
-        let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
-        let save_as = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::S);
-        let open = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
-        let new = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
-        let quit = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
+        let (redo_shift, redo_y, undo) = (REDO, REDO_Y, UNDO);
+        let (save, save_as, open, new, quit) = (SAVE, SAVE_AS, OPEN, NEW, QUIT);
         // The most specific shortcut first: Ctrl+Shift+Z would also match Ctrl+Z. Every
         // press counts, however slow the frame that collected them (egui queues them).
-        let count = |ui: &mut egui::Ui, shortcut: &KeyboardShortcut| {
+        let count = |ui: &mut egui::Ui, shortcut: &egui::KeyboardShortcut| {
             ui.input_mut(|i| i.count_and_consume_key(shortcut.modifiers, shortcut.logical_key))
         };
         let redos = count(ui, &redo_shift) + count(ui, &redo_y);
@@ -387,6 +382,17 @@ impl HairloomApp {
     /// Asks a dialog for a path; `None` when cancelled or when the typed-path prompt was
     /// opened instead (its OK continues the request).
     fn ask(&mut self, request: FileRequest, suggested: Option<PathBuf>) -> Option<PathBuf> {
+        // A bare suggested name lands next to the open project, not in the working folder.
+        let folder = self
+            .state
+            .path
+            .as_deref()
+            .and_then(std::path::Path::parent)
+            .filter(|p| !p.as_os_str().is_empty());
+        let suggested = suggested.map(|s| match folder {
+            Some(folder) if s.is_relative() => folder.join(s),
+            _ => s,
+        });
         match self.dialogs.ask(request, suggested.as_deref()) {
             DialogAnswer::Chosen(path) => Some(path),
             DialogAnswer::Cancelled => None,
@@ -514,11 +520,23 @@ impl HairloomApp {
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if ui.button("New").clicked() {
+                if ui
+                    .add(
+                        egui::Button::new("New")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::NEW)),
+                    )
+                    .clicked()
+                {
                     self.request(AfterConfirm::New);
                     ui.close();
                 }
-                if ui.button("Open…").clicked() {
+                if ui
+                    .add(
+                        egui::Button::new("Open…")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::OPEN)),
+                    )
+                    .clicked()
+                {
                     ui.close();
                     self.file_request(FileRequest::OpenProject);
                 }
@@ -534,11 +552,23 @@ impl HairloomApp {
                     }
                 });
                 ui.separator();
-                if ui.button("Save").clicked() {
+                if ui
+                    .add(
+                        egui::Button::new("Save")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::SAVE)),
+                    )
+                    .clicked()
+                {
                     ui.close();
                     self.save();
                 }
-                if ui.button("Save As…").clicked() {
+                if ui
+                    .add(
+                        egui::Button::new("Save As…")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::SAVE_AS)),
+                    )
+                    .clicked()
+                {
                     ui.close();
                     self.save_as();
                 }
@@ -563,21 +593,35 @@ impl HairloomApp {
                     self.file_request(FileRequest::ExportStrands);
                 }
                 ui.separator();
-                if ui.button("Quit").clicked() {
+                if ui
+                    .add(
+                        egui::Button::new("Quit")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::QUIT)),
+                    )
+                    .clicked()
+                {
                     ui.close();
                     self.request(AfterConfirm::Quit);
                 }
             });
             ui.menu_button("Edit", |ui| {
                 if ui
-                    .add_enabled(self.state.can_undo(), egui::Button::new("Undo"))
+                    .add_enabled(
+                        self.state.can_undo(),
+                        egui::Button::new("Undo")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::UNDO)),
+                    )
                     .clicked()
                 {
                     self.state.undo();
                     ui.close();
                 }
                 if ui
-                    .add_enabled(self.state.can_redo(), egui::Button::new("Redo"))
+                    .add_enabled(
+                        self.state.can_redo(),
+                        egui::Button::new("Redo")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::REDO)),
+                    )
                     .clicked()
                 {
                     self.state.redo();
@@ -841,4 +885,20 @@ impl eframe::App for HairloomApp {
             self.layout.ui(&mut panes, ui);
         });
     }
+}
+
+/// The editor's keyboard shortcuts, shared by the handler and the menus that show them.
+mod shortcut {
+    use egui::{Key, KeyboardShortcut, Modifiers};
+
+    pub const UNDO: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+    pub const REDO: KeyboardShortcut =
+        KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::Z);
+    pub const REDO_Y: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+    pub const SAVE: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
+    pub const SAVE_AS: KeyboardShortcut =
+        KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), Key::S);
+    pub const OPEN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
+    pub const NEW: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
+    pub const QUIT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
 }
