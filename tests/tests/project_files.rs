@@ -341,3 +341,29 @@ fn a_runtime_bundle_export_killed_at_any_point_loads_wholly_old_or_new() {
     expected.sort();
     assert_eq!(on_disk, expected);
 }
+
+/// Issue "Hostile and oversized input": a project is read only from a regular file, and its
+/// history is capped so verification stays bounded.
+#[test]
+fn special_files_and_oversized_histories_are_refused_by_name() {
+    #[cfg(unix)]
+    {
+        let error = project::load(Path::new("/dev/zero")).expect_err("a device");
+        assert!(
+            matches!(error, ProjectError::Input(_)) && error.to_string().contains("a device"),
+            "{error}"
+        );
+    }
+    let (json_path, message) = invalid_at(corrupt(|v| v["history"]["limit"] = 20_000.into()));
+    assert_eq!(json_path, "history.limit");
+    assert!(message.contains("cap of 10000"), "{message}");
+    // 20,001 (empty) redo entries: refused before any is verified.
+    let (json_path, message) = invalid_at(corrupt(|v| {
+        v["history"]["redo"] = serde_json::Value::Array(vec![
+            serde_json::json!({"kind": "group", "label": "x", "children": []});
+            20_001
+        ]);
+    }));
+    assert_eq!(json_path, "history", "{message}");
+    assert!(message.contains("20001 undo and redo entries"), "{message}");
+}

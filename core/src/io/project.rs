@@ -57,6 +57,9 @@ pub enum ProjectError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// Not a regular file, or above [`MAX_PROJECT_BYTES`].
+    #[error("{0}")]
+    Input(crate::io::input_files::InputFileError),
     #[error("{path}: not a Hairloom project: {message}")]
     NotAProject { path: PathBuf, message: String },
     #[error(
@@ -149,6 +152,27 @@ pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Project, ProjectError> {
             message: "the history limit must be at least 1".into(),
         });
     }
+    let history = &project.history;
+    if history.limit > MAX_HISTORY_ENTRIES {
+        return Err(ProjectError::Invalid {
+            path: path.to_path_buf(),
+            json_path: "history.limit".into(),
+            message: format!(
+                "{} is above the cap of {MAX_HISTORY_ENTRIES} entries",
+                history.limit
+            ),
+        });
+    }
+    let entries = history.undo.len() + history.redo.len();
+    if entries > MAX_HISTORY_ENTRIES {
+        return Err(ProjectError::Invalid {
+            path: path.to_path_buf(),
+            json_path: "history".into(),
+            message: format!(
+                "{entries} undo and redo entries are above the cap of {MAX_HISTORY_ENTRIES}"
+            ),
+        });
+    }
     project
         .history
         .verify(&project.document)
@@ -160,12 +184,26 @@ pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Project, ProjectError> {
     Ok(project)
 }
 
-/// Loads and validates a project file.
+/// The largest project file read (the head samples are about 1 MB).
+pub const MAX_PROJECT_BYTES: u64 = 1 << 30;
+
+/// The most history entries (and the largest history limit) a project file may hold, so
+/// verifying the history on load stays bounded (20,000 entries took 5 s).
+pub const MAX_HISTORY_ENTRIES: usize = 10_000;
+
+/// Loads and validates a project file (a regular file of at most [`MAX_PROJECT_BYTES`]).
 pub fn load(path: &Path) -> Result<Project, ProjectError> {
-    let bytes = std::fs::read(path).map_err(|source| ProjectError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    use crate::io::input_files::{InputFileError, read_regular_file};
+    let bytes =
+        read_regular_file(path, MAX_PROJECT_BYTES, "a project file").map_err(
+            |error| match error {
+                InputFileError::Io { source, .. } => ProjectError::Read {
+                    path: path.to_path_buf(),
+                    source,
+                },
+                other => ProjectError::Input(other),
+            },
+        )?;
     from_bytes(&bytes, path)
 }
 
