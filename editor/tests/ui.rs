@@ -178,8 +178,9 @@ fn click_at(harness: &mut Harness<'static, HairloomApp>, pos: egui::Pos2) {
 #[test]
 fn a_click_in_the_viewport_selects_the_bundle_under_it() {
     let mut harness = harness();
-    // The viewport fills the middle of the window; the hair covers its centre.
-    let centre = egui::pos2(620.0, 430.0);
+    // The viewport fills the middle of the window; hair covers the top of the head there
+    // (lower, at the centre, the face hides the hair behind it: no picking through it).
+    let centre = egui::pos2(600.0, 300.0);
     click_at(&mut harness, centre);
     let selection = harness.state().state.selection.clone();
     assert_eq!(selection.len(), 1, "{}", harness.state().state.message);
@@ -1054,5 +1055,34 @@ fn typed_styling_values_respect_the_valid_range() {
             .curl
             .radius_m,
         0.1
+    );
+}
+
+/// No selecting through the head: a box over the whole viewport takes only the bundles the
+/// body leaves in view, unless X-ray is on.
+#[test]
+fn region_selection_respects_depth_unless_x_ray_is_on() {
+    let mut harness = harness();
+    let rect = viewport_rect(&harness);
+    let select_everything_in_view = |harness: &mut Harness<'static, HairloomApp>| {
+        drag(
+            harness,
+            rect.left_top() + egui::vec2(8.0, 8.0),
+            rect.right_bottom() - egui::vec2(8.0, 8.0),
+        );
+        harness.state().state.selection.len()
+    };
+    let seen = select_everything_in_view(&mut harness);
+    harness.get_by_label("X-ray").click();
+    harness.run();
+    assert!(harness.state().state.tool.xray);
+    let all = select_everything_in_view(&mut harness);
+    assert!(
+        seen > 0,
+        "the front of the hair is selectable ({seen} of {all})"
+    );
+    assert!(
+        seen < all,
+        "{seen} bundles in view without X-ray, {all} with it: the head hides none?"
     );
 }

@@ -54,6 +54,8 @@ pub struct ToolSettings {
     /// Axis keys and typed values during G / R / S follow Blender's Z-up convention (X
     /// right, Y away from the front view, Z up) instead of the scene's Y-up axes.
     pub z_up: bool,
+    /// Pick and region-select through the body (and see hidden bundles' outlines).
+    pub xray: bool,
 }
 
 impl Default for ToolSettings {
@@ -65,6 +67,7 @@ impl Default for ToolSettings {
             soft_radius_m: 0.0,
             gizmo: super::gizmo::GizmoKind::Move,
             z_up: true,
+            xray: false,
         }
     }
 }

@@ -89,6 +89,8 @@ impl ToolsPanel {
             .labelled_by(label.id)
             .on_hover_text("Unselected vertices this close follow with a smooth falloff (wheel while transforming)");
         });
+        ui.checkbox(&mut state.tool.xray, "X-ray")
+            .on_hover_text("Select through the head: clicks and regions also take bundles and vertices the body hides");
         ui.checkbox(&mut state.tool.z_up, "Z up (Blender axes)")
             .on_hover_text(
                 "Axis keys and typed values in G / R / S: on, Z is up and Y points away from \

@@ -71,6 +71,19 @@ impl Projector {
         })
     }
 
+    /// Screen position relative to the viewport's corner, and view depth (clip w).
+    pub(super) fn project_local_depth(&self, p: DVec3) -> Option<[f64; 3]> {
+        let clip = self.view_projection * p.as_vec3().extend(1.0);
+        (clip.w > 1e-6).then(|| {
+            let ndc = clip.truncate() / clip.w;
+            [
+                ((ndc.x + 1.0) * 0.5 * self.rect.width()) as f64,
+                ((1.0 - ndc.y) * 0.5 * self.rect.height()) as f64,
+                clip.w as f64,
+            ]
+        })
+    }
+
     pub(super) fn project_xy(&self, p: DVec3) -> Option<[f64; 2]> {
         self.project(p).map(|q| [q.x as f64, q.y as f64])
     }

@@ -37,6 +37,31 @@ impl Viewport {
     ) {
         let modifiers = ui.input(|i| i.modifiers);
         let mesh = &state.document().hair_mesh;
+        // Without X-ray only what the body leaves in view is picked (no selecting through
+        // the head). The depth map is built only for a click or a finished region.
+        let gesture_ends =
+            response.clicked() || (response.drag_stopped() && self.drag_path.len() > 1);
+        let depth = (gesture_ends && !state.tool.xray).then(|| {
+            let body = &state.document().body;
+            select::DepthMap::rasterize(
+                &body.positions,
+                &body.triangles,
+                |p| projector.project_local_depth(p),
+                [
+                    projector.rect.width() as f64,
+                    projector.rect.height() as f64,
+                ],
+                2.0,
+            )
+        });
+        let seen = |p: DVec3| {
+            depth.as_ref().is_none_or(|depth| {
+                projector
+                    .project_local_depth(p)
+                    .is_some_and(|q| depth.visible(q))
+            })
+        };
+        let project_seen = |p: DVec3| seen(p).then(|| projector.project_xy(p)).flatten();
         if response.clicked()
             && let Some(pointer) = response.interact_pointer_pos()
         {
@@ -44,7 +69,8 @@ impl Viewport {
             match state.tool.mode {
                 SelectMode::Bundles => {
                     let (origin, direction) = projector.ray(pointer);
-                    let hit = hairloom_core::edit::pick::pick_bundle(mesh, origin, direction);
+                    let hit = hairloom_core::edit::pick::pick_bundle(mesh, origin, direction)
+                        .filter(|&(_, t)| seen(origin + direction * t));
                     if !add {
                         state.selection.clear();
                     }
@@ -60,7 +86,7 @@ impl Viewport {
                     let hit = select::nearest_vertex(
                         mesh,
                         &topology,
-                        |p| projector.project_xy(p),
+                        project_seen,
                         [pointer.x as f64, pointer.y as f64],
                         PICK_RADIUS_PX,
                     );
@@ -100,7 +126,7 @@ impl Viewport {
                     radius_px: state.tool.paint_radius_px as f64,
                 },
             };
-            let project = |p| projector.project_xy(p);
+            let project = project_seen;
             let replace = !modifiers.shift && !modifiers.command;
             let remove = modifiers.command;
             let count = match state.tool.mode {
