@@ -1086,3 +1086,21 @@ fn region_selection_respects_depth_unless_x_ray_is_on() {
         "{seen} bundles in view without X-ray, {all} with it: the head hides none?"
     );
 }
+
+/// A bundle picked elsewhere (here: set as the selection, as a viewport click does) is
+/// scrolled into view in the outliner.
+#[test]
+fn the_outliner_scrolls_to_a_bundle_picked_elsewhere() {
+    let mut harness = harness();
+    let last = harness.state().state.document().hair_mesh.bundles.len() - 1;
+    let layers = harness.state().state.document().hair_mesh.bundles[last].layers;
+    let label = format!("Bundle {last} · {layers} layers");
+    assert!(
+        harness.query_by_label(&label).is_none(),
+        "the last bundle starts out of view"
+    );
+    harness.state_mut().state.selection.insert(last as u32);
+    // The scroll area animates to the row over a few frames.
+    harness.run_steps(12);
+    harness.get_by_label(&label);
+}

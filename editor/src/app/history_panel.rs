@@ -4,7 +4,10 @@
 use super::state::EditorState;
 
 #[derive(Default)]
-pub struct HistoryPanel;
+pub struct HistoryPanel {
+    /// The step shown as current last frame: when it changes, the list scrolls to it.
+    shown_step: Option<usize>,
+}
 
 impl HistoryPanel {
     pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState) {
@@ -19,8 +22,13 @@ impl HistoryPanel {
             .collect();
         let mut jump = None;
         egui::ScrollArea::vertical().show(ui, |ui| {
-            if ui.selectable_label(applied == 0, "Original").clicked() {
+            let scroll = self.shown_step != Some(applied);
+            let original = ui.selectable_label(applied == 0, "Original");
+            if original.clicked() {
                 jump = Some(0);
+            }
+            if scroll && applied == 0 {
+                original.scroll_to_me(None);
             }
             for (i, label) in labels.iter().enumerate() {
                 let text = if i < applied {
@@ -28,11 +36,16 @@ impl HistoryPanel {
                 } else {
                     egui::RichText::new(label).weak()
                 };
-                if ui.selectable_label(applied == i + 1, text).clicked() {
+                let step = ui.selectable_label(applied == i + 1, text);
+                if step.clicked() {
                     jump = Some(i + 1);
+                }
+                if scroll && applied == i + 1 {
+                    step.scroll_to_me(None);
                 }
             }
         });
+        self.shown_step = Some(applied);
         if let Some(position) = jump.filter(|&p| p != applied) {
             state.jump_to(position);
         }
