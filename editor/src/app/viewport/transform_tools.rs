@@ -105,17 +105,7 @@ pub(super) fn typed_transform(
                 pivot: active.pivot.to_array(),
             }
         }
-        TransformKind::Scale => {
-            let mut factors = [value; 3];
-            if let Some(axis) = active.axis {
-                factors = [1.0; 3];
-                factors[axis] = value;
-            }
-            VertexTransform::Scale {
-                factors,
-                pivot: active.pivot.to_array(),
-            }
-        }
+        TransformKind::Scale => scale_about_pivot(active, value),
     }
 }
 
@@ -156,6 +146,19 @@ pub(super) fn preview_transform(
                 + &format!(", soft radius {:.3} m", state.tool.soft_radius_m);
         }
         Err(error) => state.message = format!("{}: {error}", kind.label()),
+    }
+}
+
+/// Scale by `factor` about the gesture's pivot: uniform, or along the locked axis only.
+fn scale_about_pivot(active: &ActiveTransform, factor: f64) -> VertexTransform {
+    let mut factors = [factor; 3];
+    if let Some(axis) = active.axis {
+        factors = [1.0; 3];
+        factors[axis] = factor;
+    }
+    VertexTransform::Scale {
+        factors,
+        pivot: active.pivot.to_array(),
     }
 }
 
@@ -204,16 +207,7 @@ pub(super) fn transform_for(
         TransformKind::Extrude => VertexTransform::Translate { offset: [0.0; 3] },
         TransformKind::Scale => {
             let start = active.start_pointer.distance(pivot_screen).max(1.0);
-            let factor = (pointer.distance(pivot_screen) / start) as f64;
-            let mut factors = [factor; 3];
-            if let Some(axis) = active.axis {
-                factors = [1.0; 3];
-                factors[axis] = factor;
-            }
-            VertexTransform::Scale {
-                factors,
-                pivot: active.pivot.to_array(),
-            }
+            scale_about_pivot(active, (pointer.distance(pivot_screen) / start) as f64)
         }
     }
 }
