@@ -1,145 +1,124 @@
-// preview_hair: camera-facing ribbons from strand vertices, Kajiya-Kay shading with a
-// root-to-tip colour and three lights. Vertices sit in `positions` as the batch's runs lay
-// them out (`run.vertex_offset + strand * run.vertex_count + k`, w = fraction along the
-// strand); each segment is two triangles (6 vertices). Tangents follow eq. 5-6 (ends mirror
-// their neighbour about the end segment), so shading holds when vertex LOD changes counts;
-// ribbon width grows by the run's thickness factor (eq. 8 compensation).
-// Structs: keep in sync with render/src/preview.rs (`HairUniforms`); `StrandRun` is in
-// shaders/shared/strand_run.wgsl.
-
-struct HairUniforms {
-    view_projection: mat4x4<f32>,
-    camera_position: vec4<f32>,
-    root_color: vec4<f32>,
-    tip_color: vec4<f32>,
-    // Ribbon width in model units (x); y, z, w unused.
-    width: vec4<f32>,
-    // The batch's runs: runs[first_run .. first_run + run_count] (x, y); z, w unused.
-    batch: vec4<u32>,
-}
-
-// struct StrandRun: shaders/shared/strand_run.wgsl, prepended by render/src/.
-
-@group(0) @binding(0) var<uniform> hair: HairUniforms;
-@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> runs: array<StrandRun>;
+// preview_hair: the hair's colour pass. Ribbons from shared/ribbon.wgsl, lit by the scene's
+// lights (shared/scene.wgsl) through `hair_radiance` — Kajiya-Kay, Marschner, or Marschner
+// with dual scattering (light/radiance_*.wgsl) — with the fibres in front of each point
+// from the opacity maps (`hairs_in_front`) and the body's shadow (`body_visibility`); the
+// renderer prepends the modules the scene's effects name and stubs for the rest.
+// `fs_main` draws opaque ribbons; with width-based coverage, strands narrower than a pixel
+// go to `fs_oit` instead, which accumulates weighted blended transparency (McGuire & Bavoil
+// 2013; composited by oit_composite.wgsl).
 
 struct VertexOutput {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the depth pre-pass and the colour pass must compute the same depth.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) tangent: vec3<f32>,
     @location(2) along: f32,
-}
-
-// The run holding batch segment `segment` (binary search).
-fn find_run(segment: u32) -> u32 {
-    var low = hair.batch.x;
-    var high = hair.batch.x + max(hair.batch.y, 1u) - 1u;
-    while low < high {
-        let middle = (low + high + 1u) / 2u;
-        if runs[middle].segment_offset <= segment {
-            low = middle;
-        } else {
-            high = middle - 1u;
-        }
-    }
-    return low;
-}
-
-fn safe_normalize(v: vec3<f32>) -> vec3<f32> {
-    let length_squared = dot(v, v);
-    if !(length_squared > 1e-24) {
-        return vec3<f32>(0.0);
-    }
-    return v * inverseSqrt(length_squared);
-}
-
-// Eq. 5-6 (mirror: core/src/runtime/preview_hair.rs; f64 definition: strands::lod::tangents): inner vertices use p[k+1] − p[k−1]; an end
-// reflects its neighbour's tangent about the end segment.
-fn strand_tangent(base: u32, k: u32, n: u32) -> vec3<f32> {
-    if n == 2u {
-        return safe_normalize(positions[base + 1u].xyz - positions[base].xyz);
-    }
-    if k > 0u && k + 1u < n {
-        return safe_normalize(positions[base + k + 1u].xyz - positions[base + k - 1u].xyz);
-    }
-    var inner = 1u;
-    var end_segment = positions[base + 1u].xyz - positions[base].xyz;
-    if k > 0u {
-        inner = n - 2u;
-        end_segment = positions[base + n - 1u].xyz - positions[base + n - 2u].xyz;
-    }
-    let t = safe_normalize(positions[base + inner + 1u].xyz - positions[base + inner - 1u].xyz);
-    let q = safe_normalize(end_segment);
-    if dot(q, q) == 0.0 {
-        return t;
-    }
-    if dot(t, t) == 0.0 {
-        return q;
-    }
-    return safe_normalize(2.0 * q * dot(t, q) - t);
+    // The incident offset across the fibre: −1 … 1 from one edge to the other.
+    @location(3) h: f32,
+    @location(4) coverage: f32,
+    @location(5) @interpolate(flat) root: u32,
+    @location(6) width_px: f32,
 }
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOutput {
-    let segment_index = vertex_index / 6u;
-    let run = runs[find_run(segment_index)];
-    let n = max(run.vertex_count, 2u);
-    let local = segment_index - run.segment_offset;
-    let strand = local / (n - 1u);
-    let segment = local % (n - 1u);
-    // Two triangles: (0,0) (1,0) (0,1) / (0,1) (1,0) (1,1) as (end, side).
-    var ends = array<u32, 6>(0u, 1u, 0u, 0u, 1u, 1u);
-    var sides = array<f32, 6>(-1.0, -1.0, 1.0, 1.0, -1.0, 1.0);
-    let corner = vertex_index % 6u;
-    let k = segment + ends[corner];
-    let base = run.vertex_offset + strand * n;
-    let vertex = positions[base + k];
-    let p = vertex.xyz;
-    var tangent = strand_tangent(base, k, n);
-    if dot(tangent, tangent) == 0.0 {
-        tangent = vec3<f32>(0.0, 1.0, 0.0);
-    }
-    let to_camera = hair.camera_position.xyz - p;
-    var side = cross(tangent, to_camera);
-    if dot(side, side) < 1e-20 {
-        side = cross(tangent, vec3<f32>(0.0, 0.0, 1.0));
-    }
-    let along = vertex.w;
-    // Taper toward the tip; thicker where strand LOD dropped strands.
-    let half_width = 0.5 * hair.width.x * run.thickness * (1.0 - 0.6 * along);
-    let world = p + normalize(side) * sides[corner] * half_width;
+    let ribbon = ribbon_vertex(vertex_index);
     var out: VertexOutput;
-    out.clip = hair.view_projection * vec4<f32>(world, 1.0);
-    out.world = world;
-    out.tangent = tangent;
-    out.along = along;
+    out.clip = ribbon.clip;
+    out.world = ribbon.world;
+    out.tangent = ribbon.tangent;
+    out.along = ribbon.along;
+    // The ribbon's side vector is cross(tangent, toward viewer) = −y of the fibre frame.
+    out.h = -ribbon.side;
+    out.coverage = ribbon.coverage;
+    out.root = ribbon.root;
+    out.width_px = ribbon.width_px;
     return out;
 }
 
-// Kajiya-Kay: diffuse sin(T, L), specular sin(T, H)^p (Kajiya & Kay 1989), plus a second,
-// shifted and tinted lobe for the colour-carrying secondary highlight.
-fn kajiya_kay(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, base: vec3<f32>) -> vec3<f32> {
-    let tl = dot(t, l);
-    let diffuse = sqrt(max(1.0 - tl * tl, 0.0));
-    let h = normalize(l + v);
-    let th = dot(t, h);
-    let sin_th = sqrt(max(1.0 - th * th, 0.0));
-    let primary = pow(sin_th, 80.0) * 0.35;
-    let secondary = pow(sin_th, 20.0) * 0.25;
-    return base * diffuse * 0.8 + vec3<f32>(primary) + base * secondary;
+// Single scattering of a fibre: a fibre a few pixels wide or more is shaded at the pixel's
+// own offset h; a thinner one covers every offset within its pixel, so it takes the average
+// over h (three-point Gauss-Legendre), which is also what a path tracer's pixel averages to.
+// Blended between 2 and 4 pixels so nothing pops as a strand's width changes. (Multiple
+// scattering does not depend on h: `hair_radiance` adds it once.)
+fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: vec3<f32>) -> vec3<f32> {
+    let averaged = clamp(2.0 - 0.5 * width_px, 0.0, 1.0);
+    var result = vec3<f32>(0.0);
+    if averaged < 1.0 {
+        result += (1.0 - averaged) * hair_single(wo, wi, clamp(h, -1.0, 1.0), sigma_a);
+    }
+    if averaged > 0.0 {
+        let outer = 0.7745967;
+        let average = (5.0 / 18.0) * hair_single(wo, wi, -outer, sigma_a)
+            + (8.0 / 18.0) * hair_single(wo, wi, 0.0, sigma_a)
+            + (5.0 / 18.0) * hair_single(wo, wi, outer, sigma_a);
+        result += averaged * average;
+    }
+    return result;
+}
+
+// Radiance leaving the fibre toward the viewer, tone-mapped.
+fn shade_hair(in: VertexOutput) -> vec3<f32> {
+    var x = safe_normalize(in.tangent);
+    if dot(x, x) == 0.0 {
+        x = vec3<f32>(0.0, 1.0, 0.0);
+    }
+    let wo = safe_normalize(toward_viewer(in.world));
+    var z = safe_normalize(wo - x * dot(wo, x));
+    if dot(z, z) == 0.0 {
+        z = safe_normalize(cross(x, vec3<f32>(0.0, 0.0, 1.0)));
+    }
+    let y = cross(z, x);
+    let sigma_a = strand_sigma_a(in.along, strand_shading_random(in.root));
+    let wo_local = vec3<f32>(dot(wo, x), dot(wo, y), dot(wo, z));
+    var radiance = scene.ambient.rgb * hair_color(sigma_a);
+    for (var i = 0u; i < scene.counts.x; i++) {
+        let wi = light_direction(i, in.world);
+        let slot = light_shadow_slot(i);
+        let n = hairs_in_front(in.world, slot);
+        let visible = body_visibility(in.world, slot);
+        let wi_local = vec3<f32>(dot(wi, x), dot(wi, y), dot(wi, z));
+        let single = fibre_single(wo_local, wi_local, in.h, in.width_px, sigma_a);
+        radiance += hair_radiance(wo_local, wi_local, single, n) * light_irradiance(i, in.world) * visible;
+    }
+    return tonemap(radiance);
+}
+
+// The depth pre-pass: only the nearest ribbon of each sample is then shaded (the colour pass
+// tests for equal depth), so the lighting runs once per visible fragment, not once per layer
+// of hair. With width-based coverage, thin strands stay out of it (they are blended later).
+@fragment
+fn fs_depth(in: VertexOutput) {
+    if scene.counts.w == 1u && in.coverage < 0.999 {
+        discard;
+    }
 }
 
 @fragment
 fn fs_main(in: VertexOutput) -> @location(0) vec4<f32> {
-    let base = mix(hair.root_color.rgb, hair.tip_color.rgb, in.along);
-    let v = normalize(hair.camera_position.xyz - in.world);
-    let t = normalize(in.tangent);
-    // Three-point lighting: key (front right, above), fill (left), rim (behind).
-    var color = kajiya_kay(t, normalize(vec3<f32>(0.6, 0.8, 0.9)), v, base) * 1.0;
-    color += kajiya_kay(t, normalize(vec3<f32>(-0.8, 0.3, 0.5)), v, base) * 0.35;
-    color += kajiya_kay(t, normalize(vec3<f32>(0.0, 0.5, -1.0)), v, base) * 0.5;
-    // Darker toward the root: a cheap stand-in for self-shadowing.
-    color *= 0.55 + 0.45 * in.along;
-    return vec4<f32>(color + base * 0.08, 1.0);
+    if scene.counts.w == 1u && in.coverage < 0.999 {
+        discard;
+    }
+    return vec4<f32>(shade_hair(in), 1.0);
+}
+
+struct OitOutput {
+    @location(0) accumulation: vec4<f32>,
+    @location(1) revealage: vec4<f32>,
+}
+
+@fragment
+fn fs_oit(in: VertexOutput) -> OitOutput {
+    if in.coverage >= 0.999 {
+        discard;
+    }
+    let alpha = clamp(in.coverage, 0.0, 1.0);
+    let color = shade_hair(in);
+    // McGuire & Bavoil 2013 eq. 9: nearer fragments weigh more.
+    let depth = clamp(in.clip.z, 0.0, 1.0);
+    let weight = alpha * max(1e-2, 3e3 * pow(1.0 - depth, 3.0));
+    var out: OitOutput;
+    out.accumulation = vec4<f32>(color * weight, weight);
+    out.revealage = vec4<f32>(alpha);
+    return out;
 }

@@ -8,6 +8,7 @@
 //! | [`edit`] | edits as pure functions (topology, transforms, coordinates, wisps), selection and picking |
 //! | [`geometry`] | derived f64 geometry: interior vertices, styling frames, column curves, uv |
 //! | [`strands`] | root samples, random numbers, styling ops, LOD formulas, the f64 reference strands |
+//! | [`light`] | the scene's light on the CPU: fibre material, the Marschner model, dual-scattering tables, opacity-map math, the reference path tracer |
 //! | [`runtime`] | the runtime asset ([`runtime::hair::RuntimeHair`]: textures, samples, placements, styling) and the CPU mirror of every shader |
 //! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) and strand exports |
 //! | [`samples`] | the bundled sample projects, built by code |
@@ -18,6 +19,7 @@
 pub mod edit;
 pub mod geometry;
 pub mod io;
+pub mod light;
 pub mod model;
 pub mod runtime;
 pub mod samples;

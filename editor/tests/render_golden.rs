@@ -98,23 +98,16 @@ fn a_runtime_bundle_renders_exactly_like_its_project() {
     }
 }
 
-#[test]
-fn samples_match_their_golden_images() {
+/// Renders each `(name, args)` and compares it with `editor/tests/golden/{name}.png`
+/// (or writes it there under `HAIRLOOM_UPDATE_GOLDEN=1`).
+fn match_golden_images(cases: &[(String, Vec<std::ffi::OsString>)]) {
     let update = std::env::var("HAIRLOOM_UPDATE_GOLDEN").as_deref() == Ok("1");
     let dir = tempfile::tempdir().expect("temp dir");
     let failures_dir = root().join("target/golden-failures");
     let mut failures = Vec::new();
-    for sample in samples() {
-        let name = sample
-            .file_stem()
-            .expect("file name")
-            .to_string_lossy()
-            .into_owned();
-        let args = [sample.as_os_str()]
-            .into_iter()
-            .chain(["--size", SIZE, "--strands-per-bundle", "16"].map(std::ffi::OsStr::new))
-            .collect::<Vec<_>>();
-        let out = dir.path().join(format!("{name}.png"));
+    for (name, args) in cases {
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let out = dir.path().join("render.png");
         let Some(image) = render(&args, &out) else {
             return;
         };
@@ -127,6 +120,7 @@ fn samples_match_their_golden_images() {
         );
         let golden_path = root().join(format!("editor/tests/golden/{name}.png"));
         if update {
+            std::fs::create_dir_all(golden_path.parent().expect("folder")).expect("golden folder");
             image.save(&golden_path).expect("write golden image");
             eprintln!("updated {}", golden_path.display());
             continue;
@@ -140,8 +134,8 @@ fn samples_match_their_golden_images() {
         };
         eprintln!("{name}: mean error {error:.3} (tolerance {MEAN_ERROR_TOLERANCE})");
         if error > MEAN_ERROR_TOLERANCE {
-            std::fs::create_dir_all(&failures_dir).expect("failure dir");
             let new_path = failures_dir.join(format!("{name}.png"));
+            std::fs::create_dir_all(new_path.parent().expect("folder")).expect("failure dir");
             image.save(&new_path).expect("write failed render");
             failures.push(format!(
                 "{name}: mean error {error:.3} > {MEAN_ERROR_TOLERANCE}; new image: {}",
@@ -154,6 +148,63 @@ fn samples_match_their_golden_images() {
         "{}\n(HAIRLOOM_UPDATE_GOLDEN=1 regenerates the golden images)",
         failures.join("\n")
     );
+}
+
+fn os_args(args: &[&str]) -> Vec<std::ffi::OsString> {
+    args.iter().map(std::ffi::OsString::from).collect()
+}
+
+#[test]
+fn samples_match_their_golden_images() {
+    let cases: Vec<_> = samples()
+        .into_iter()
+        .map(|sample| {
+            let name = sample
+                .file_stem()
+                .expect("file name")
+                .to_string_lossy()
+                .into_owned();
+            let mut args = vec![sample.into_os_string()];
+            args.extend(os_args(&["--size", SIZE, "--strands-per-bundle", "16"]));
+            (name, args)
+        })
+        .collect();
+    match_golden_images(&cases);
+}
+
+/// Every effect alone and the combinations the scene presets use, on one sample: a change to
+/// any effect's shader shows here.
+pub const EFFECT_COMBINATIONS: [&str; 8] = [
+    "none",
+    "marschner",
+    "marschner,opacity-shadow-maps",
+    "marschner,deep-opacity-maps",
+    "marschner,deep-opacity-maps,body-shadows",
+    "marschner,deep-opacity-maps,dual-scattering",
+    "kajiya-kay,deep-opacity-maps,body-shadows,width-oit",
+    "all",
+];
+
+#[test]
+fn effect_combinations_match_their_golden_images() {
+    let sample = root().join("assets/samples/head_curly.hairloom");
+    let cases: Vec<_> = EFFECT_COMBINATIONS
+        .iter()
+        .map(|effects| {
+            let name = format!("effects/{}", effects.replace(',', "+"));
+            let mut args = vec![sample.clone().into_os_string()];
+            args.extend(os_args(&[
+                "--size",
+                "160x160",
+                "--strands-per-bundle",
+                "16",
+                "--effects",
+                effects,
+            ]));
+            (name, args)
+        })
+        .collect();
+    match_golden_images(&cases);
 }
 
 #[test]

@@ -32,6 +32,8 @@ pub struct GpuContext {
     pub adapter_info: wgpu::AdapterInfo,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
+    /// Every labelled resource the renderers keep on this device (see [`crate::resources`]).
+    pub resources: std::sync::Arc<crate::resources::ResourceRegistry>,
 }
 
 impl GpuContext {
@@ -42,6 +44,7 @@ impl GpuContext {
             adapter,
             device,
             queue,
+            resources: Default::default(),
         }
     }
 
@@ -158,6 +161,7 @@ impl GpuContext {
             adapter_info,
             device,
             queue,
+            resources: Default::default(),
         })
     }
 }

@@ -1,7 +1,9 @@
 //! Hairloom's GPU side, in re_renderer's shape: device setup (`device`), one renderer per
-//! feature (`renderer/`: strand generation, hair ribbons, body — each named after its
-//! shader), a view that keeps its render targets (`view`), the frame that composes them
-//! (`preview`) and the measurements of the GPU path (`measure`). A runtime asset
+//! feature (`renderer/`: strand generation, hair ribbons, body, and the effects a scene asks
+//! for — shadow maps, body shadows, dual-scattering tables, order-independent coverage — each
+//! named after its shader), a view that keeps its render targets (`view`), the frame that
+//! composes them from the scene's effects (`preview`), the registry of every labelled GPU
+//! resource (`resources`) and the measurements of the GPU path (`measure`). A runtime asset
 //! (`hairloom_core::runtime::hair::RuntimeHair`) becomes GPU resources only here. Every GPU
 //! stage has a CPU mirror in `hairloom_core::runtime` that tests compare against.
 
@@ -9,4 +11,5 @@ pub mod device;
 pub mod measure;
 pub mod preview;
 pub mod renderer;
+pub mod resources;
 pub mod view;

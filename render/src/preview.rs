@@ -1,7 +1,13 @@
-//! The preview frame: the opaque body ([`crate::renderer::preview_body`]) and the hair as
-//! camera-facing ribbons with Kajiya-Kay shading ([`crate::renderer::preview_hair`]),
-//! depth-tested, 8× or 4× MSAA where the adapter supports it, into a kept [`View`] that is
-//! read back as RGBA8 pixels or sampled by the editor.
+//! The preview frame, built from the scene's effects: shadow passes for each shadow-casting
+//! light when the scene asks for self-shadowing or body shadows
+//! ([`crate::renderer::hair_shadow`], [`crate::renderer::body_shadow`]), the lit body
+//! ([`crate::renderer::preview_body`]), the hair as viewer-facing ribbons lit by Kajiya-Kay or
+//! the Marschner model, with dual scattering when asked ([`crate::renderer::preview_hair`]),
+//! and the thin strands' order-independent coverage when asked
+//! ([`crate::renderer::oit_composite`]); depth-tested, 8× or 4× MSAA where the adapter
+//! supports it, into a kept [`View`] that is read back as RGBA8 pixels or sampled by the
+//! editor. An effect the scene does not name has no pass and no resource (the registry,
+//! [`crate::resources`], lists what exists).
 //!
 //! Strand vertices arrive in a storage buffer, strand-major ([`HairSource`]): generated on
 //! the GPU from the runtime textures every frame, batch by batch into one bounded scratch
@@ -11,13 +17,18 @@
 use std::sync::Mutex;
 
 use glam::{Mat4, Vec3};
+use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere, shadow_views};
+use hairloom_core::model::scene::{Scene, SelfShadowing};
 use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
 use hairloom_core::runtime::strand_gen::Filtering;
-use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, PassTimer, submit_timed};
+use crate::renderer::body_shadow::BodyShadowRenderer;
+use crate::renderer::hair_shadow::HairShadowRenderer;
+use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody};
 use crate::renderer::preview_hair::{HairRenderer, HairUniforms};
+use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effect_entries};
 use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
 use crate::view::View;
 
@@ -87,19 +98,130 @@ pub struct PreviewScene<'a> {
     /// Vertices per strand at full detail (`2^e + 1`).
     pub vertex_count: u32,
     pub strand_width_m: f32,
-    pub root_color: [f32; 3],
-    pub tip_color: [f32; 3],
-    pub body_color: [f32; 3],
+    /// Lights, material, background and the effects that run (a document's scene, or a
+    /// render's override of it).
+    pub lighting: &'a Scene,
+    /// The hair's box: what shadow-casting lights frame.
+    pub hair_bounds: (Vec3, Vec3),
     pub camera: Camera,
 }
 
-/// The frame of a picture: the body, then per batch the hair's generation and its ribbons,
-/// into a kept [`View`]. Renderers are made once per device.
-pub struct PreviewRenderer {
-    body: BodyRenderer,
+/// Everything a frame keeps between frames: the view's targets and one renderer per feature.
+/// The effect renderers exist only while the scene asks for their effect.
+struct FrameState {
+    view: Option<View>,
+    lighting: SceneLighting,
     hair: HairRenderer,
-    /// The last view, kept while the size stays the same.
-    view: Mutex<Option<View>>,
+    body: BodyRenderer,
+    /// The group-2 layout of the lit shaders, for the effects that make it up.
+    effects_layout: Option<((SelfShadowing, bool, bool), Option<wgpu::BindGroupLayout>)>,
+    hair_shadow: Option<HairShadowRenderer>,
+    body_shadow: Option<BodyShadowRenderer>,
+    oit: Option<OitRenderer>,
+    lighting_sample_count: u32,
+}
+
+impl FrameState {
+    /// Makes what `active` needs and frees what it does not; returns the material's mean
+    /// forward transmittance per fibre.
+    fn sync(&mut self, context: &GpuContext, active: &ActiveEffects, scene: &Scene) -> [f32; 3] {
+        let mean_forward = self.lighting.sync(context, active, &scene.material);
+        let layout_key = (
+            active.opacity_maps,
+            active.body_shadows,
+            active.dual_scattering,
+        );
+        if self
+            .effects_layout
+            .as_ref()
+            .is_none_or(|(key, _)| *key != layout_key)
+        {
+            let entries = effect_entries(active);
+            let layout = (!entries.is_empty()).then(|| {
+                context
+                    .device
+                    .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                        label: Some("effects"),
+                        entries: &entries,
+                    })
+            });
+            self.effects_layout = Some((layout_key, layout));
+            // Pipelines made with the old layout go with it.
+            self.hair = HairRenderer::new(context, self.hair_sample_count());
+            self.body = BodyRenderer::new(context, self.hair_sample_count());
+        }
+        let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
+        self.hair
+            .ensure(context, active, &self.lighting.scene_layout, effects_layout);
+        self.body.ensure(
+            context,
+            active.shader_key(),
+            &self.lighting.scene_layout,
+            effects_layout,
+        );
+        let slots = active.shadow_slots;
+        if active.opacity_maps != SelfShadowing::None && slots > 0 {
+            let fits = self.hair_shadow.as_ref().is_some_and(|h| {
+                h.fits(
+                    active.opacity_maps,
+                    active.opacity_layers,
+                    active.shadow_resolution,
+                    slots,
+                )
+            });
+            if !fits {
+                self.hair_shadow = None;
+                self.hair_shadow = Some(HairShadowRenderer::new(
+                    context,
+                    &self.hair,
+                    &self.lighting.scene_layout,
+                    active.opacity_maps,
+                    active.opacity_layers,
+                    active.shadow_resolution,
+                    slots,
+                ));
+            }
+        } else {
+            self.hair_shadow = None;
+        }
+        if active.body_shadows && slots > 0 {
+            let fits = self
+                .body_shadow
+                .as_ref()
+                .is_some_and(|b| (b.resolution, b.slots) == (active.shadow_resolution, slots));
+            if !fits {
+                self.body_shadow = None;
+                self.body_shadow = Some(BodyShadowRenderer::new(
+                    context,
+                    &self.body,
+                    active.shadow_resolution,
+                    slots,
+                ));
+            }
+        } else {
+            self.body_shadow = None;
+        }
+        if active.width_oit {
+            if self.oit.is_none() {
+                self.oit = Some(OitRenderer::new(context, self.hair_sample_count()));
+            }
+        } else {
+            self.oit = None;
+        }
+        mean_forward
+    }
+
+    fn hair_sample_count(&self) -> u32 {
+        self.lighting_sample_count
+    }
+}
+
+/// The frame of a picture: shadow passes for the scene's shadow-casting lights (when it asks
+/// for shadows), the lit body, per batch the hair's generation and its lit ribbons, and the
+/// order-independent thin strands (when it asks for width-based coverage), into a kept
+/// [`View`]. Renderers are made once per device; effect renderers while their effect is on.
+pub struct PreviewRenderer {
+    state: Mutex<FrameState>,
     pub sample_count: u32,
 }
 
@@ -110,9 +232,17 @@ impl PreviewRenderer {
     pub fn new(context: &GpuContext) -> Self {
         let sample_count = crate::view::sample_count(context);
         Self {
-            body: BodyRenderer::new(context, sample_count),
-            hair: HairRenderer::new(context, sample_count),
-            view: Mutex::new(None),
+            state: Mutex::new(FrameState {
+                view: None,
+                lighting: SceneLighting::new(context),
+                hair: HairRenderer::new(context, sample_count),
+                body: BodyRenderer::new(context, sample_count),
+                effects_layout: None,
+                hair_shadow: None,
+                body_shadow: None,
+                oit: None,
+                lighting_sample_count: sample_count,
+            }),
             sample_count,
         }
     }
@@ -148,8 +278,8 @@ impl PreviewRenderer {
     }
 
     /// Renders one frame of `scene` without reading it back and measures it: GPU time of
-    /// every pass (generation and drawing) by timestamp queries where the adapter has them,
-    /// and wall time from submission to idle.
+    /// every pass (generation, shadows and drawing) by timestamp queries where the adapter
+    /// has them, and wall time from submission to idle.
     pub fn time_frame(
         &self,
         context: &GpuContext,
@@ -158,7 +288,8 @@ impl PreviewRenderer {
         height: u32,
     ) -> Result<FrameTiming, PreviewError> {
         let plan = self.plan(scene, width, height);
-        let passes = 1 + 2 * plan.batches.len().max(1);
+        // Generation and up to five passes (two per shadow-casting light) per batch.
+        let passes = 8 + 16 * (plan.batches.len() + 1);
         let timer = PassTimer::new(context, passes);
         let frame = self.encode_frame(context, scene, &plan, width, height, timer.as_ref())?;
         let (wall_ms, gpu_ms) =
@@ -203,8 +334,19 @@ impl PreviewRenderer {
         }
     }
 
-    /// Records a frame into the kept view: the body (clearing), then per batch of the plan
-    /// its generation (generated hair) and its ribbons; the last pass resolves MSAA.
+    /// What runs for `scene`, checked against the adapter's limits before anything is made.
+    pub fn active_effects(
+        &self,
+        context: &GpuContext,
+        scene: &PreviewScene,
+    ) -> Result<ActiveEffects, PreviewError> {
+        let active = ActiveEffects::new(scene.lighting, !scene.body.is_empty());
+        check_effect_limits(&context.device.limits(), &active)?;
+        Ok(active)
+    }
+
+    /// Records a frame into the kept view (see [`PreviewRenderer`]); the last pass resolves
+    /// MSAA.
     fn encode_frame(
         &self,
         context: &GpuContext,
@@ -215,22 +357,40 @@ impl PreviewRenderer {
         timer: Option<&PassTimer>,
     ) -> Result<EncodedFrame, PreviewError> {
         let device = &context.device;
-        let mut kept = self.view.lock().unwrap_or_else(|e| e.into_inner());
-        let view = View::ensure(&mut kept, context, width, height, self.sample_count);
-        let view_projection = scene
-            .camera
-            .view_projection(view.width as f32 / view.height as f32)
-            .to_cols_array_2d();
+        let active = self.active_effects(context, scene)?;
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let state = &mut *state;
+        let mean_forward = state.sync(context, &active, scene.lighting);
+        View::ensure(&mut state.view, context, width, height, self.sample_count);
+        let view = state.view.as_ref().expect("made above");
+        if let Some(oit) = &mut state.oit {
+            oit.ensure_targets(context, view.width, view.height);
+        }
+        let aspect = view.width as f32 / view.height as f32;
+        let view_projection = scene.camera.view_projection(aspect).to_cols_array_2d();
         let camera_position = scene.camera.eye.extend(1.0).to_array();
-        let rgba = |c: [f32; 3]| [c[0], c[1], c[2], 1.0];
-        self.body.prepare(
-            context,
-            &BodyUniforms {
-                view_projection,
-                camera_position,
-                color: rgba(scene.body_color),
-            },
+        // The scene as the shaders see it, with a view per shadow-casting light.
+        let (center, radius) = bounding_sphere(scene.hair_bounds.0, scene.hair_bounds.1);
+        let shadow_views: Vec<_> = if active.shadow_slots > 0 {
+            shadow_views(scene.lighting, center, radius)
+        } else {
+            Vec::new()
+        };
+        let tables = state.lighting.dual_scattering.as_ref().map(|ds| &ds.tables);
+        let uniforms = SceneUniforms::new(
+            scene.lighting,
+            &shadow_views,
+            tables,
+            mean_forward,
+            radius,
+            scene.strand_width_m,
         );
+        state.lighting.write(context, &uniforms);
+        let effects_group = state
+            .effects_layout
+            .as_ref()
+            .and_then(|(_, layout)| layout.as_ref())
+            .map(|layout| effects_bind_group(context, layout, state));
         let generator = match &scene.hair {
             HairSource::Generated {
                 generator,
@@ -245,12 +405,16 @@ impl PreviewRenderer {
             }
             _ => None,
         };
+        // Per-frame buffers (not kept, so not in the registry).
         let storage = |label: &str, contents: &[u8]| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
+            wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE,
+                },
+            )
         };
         let runs = match generator {
             Some((generator, ..)) => generator.upload_runs(context, plan),
@@ -264,7 +428,7 @@ impl PreviewRenderer {
         };
         // Where the hair's vertices live: uploaded now, already stored, or a scratch buffer
         // that each batch's generation overwrites.
-        let owned;
+        let (owned, scratch);
         let (strands, scratch_bytes): (&wgpu::Buffer, u64) = match &scene.hair {
             HairSource::Vertices(vertices) => {
                 let placeholder = [[0.0f32; 4]];
@@ -278,8 +442,8 @@ impl PreviewRenderer {
             }
             HairSource::Stored { buffer, .. } => (buffer, 0),
             HairSource::Generated { generator, .. } => {
-                owned = generator.scratch(context, plan);
-                (&owned, owned.size())
+                scratch = generator.scratch(context, plan);
+                (&scratch, scratch.size())
             }
         };
         // Each batch's runs: `runs[first_run..][..batch.len()]`.
@@ -292,24 +456,128 @@ impl PreviewRenderer {
                 Some(range)
             })
             .collect();
-        let hair = self.hair.prepare(
-            context,
-            &HairUniforms {
+        // The hair's views: the camera, then each shadow-casting light (ribbons at least a
+        // texel wide there, and a pixel wide for the camera with width-based coverage).
+        let pixel_at_unit = 2.0 * (scene.camera.fov_y_rad * 0.5).tan() / view.height as f32;
+        let mut hair_views = vec![HairUniforms {
+            view_projection,
+            eye: camera_position,
+            width: [
+                scene.strand_width_m,
+                pixel_at_unit,
+                if active.width_oit { 1.0 } else { 0.0 },
+                0.0,
+            ],
+            batch: [0; 4],
+        }];
+        let mut body_views = vec![BodyUniforms {
+            view_projection,
+            camera_position,
+        }];
+        for (slot, light_view) in shadow_views.iter().enumerate() {
+            let view_projection = light_view.view_projection.to_cols_array_2d();
+            hair_views.push(HairUniforms {
                 view_projection,
-                camera_position,
-                root_color: rgba(scene.root_color),
-                tip_color: rgba(scene.tip_color),
-                width: [scene.strand_width_m, 0.0, 0.0, 0.0],
-                batch: [0; 4],
-            },
-            &ranges,
-            strands,
-            &runs,
-        );
+                eye: light_view
+                    .eye
+                    .extend(if light_view.perspective { 1.0 } else { 0.0 })
+                    .to_array(),
+                width: [scene.strand_width_m, light_view.texel_size, 1.0, 0.0],
+                batch: [0, 0, slot as u32, 0],
+            });
+            body_views.push(BodyUniforms {
+                view_projection,
+                camera_position: light_view.eye.extend(1.0).to_array(),
+            });
+        }
+        let prepared_hair = state
+            .hair
+            .prepare(context, &hair_views, &ranges, strands, &runs);
+        let prepared_body = state.body.prepare(context, &body_views);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("preview"),
+        });
+        // Generation: once when the plan is one batch (every pass then reads the same
+        // vertices), else again before each pass that draws a batch.
+        let single_batch = plan.batches.len() == 1;
+        let mut generated = false;
+        let mut generate = |encoder: &mut wgpu::CommandEncoder, index: usize| {
+            let Some((generator, gpu_hair, filtering)) = generator else {
+                return;
+            };
+            if single_batch && generated {
+                return;
+            }
+            generated = true;
+            generator.encode(
+                context,
+                encoder,
+                gpu_hair,
+                &runs,
+                ranges[index][0] as usize,
+                &plan.batches[index],
+                filtering,
+                strands,
+                timer.and_then(|t| t.compute_pass()),
+            );
+        };
+        let segments = |index: usize| FramePlan::batch_segments(&plan.batches[index]) as u32;
+        let batch_count = plan.batches.len();
+        // 1. Shadow passes, per shadow-casting light.
+        for slot in 0..active.shadow_slots as usize {
+            if let Some(body_shadow) = &state.body_shadow {
+                body_shadow.encode(&mut encoder, &prepared_body, scene.body, slot);
+            }
+            if let Some(hair_shadow) = &state.hair_shadow {
+                if hair_shadow.kind == SelfShadowing::DeepOpacityMaps {
+                    for index in 0..batch_count.max(1) {
+                        if index < batch_count {
+                            generate(&mut encoder, index);
+                        }
+                        let count = if index < batch_count {
+                            segments(index)
+                        } else {
+                            0
+                        };
+                        hair_shadow.encode_depth(
+                            &mut encoder,
+                            &prepared_hair,
+                            slot,
+                            index,
+                            count,
+                            index == 0,
+                        );
+                    }
+                }
+                for index in 0..batch_count.max(1) {
+                    if index < batch_count {
+                        generate(&mut encoder, index);
+                    }
+                    let count = if index < batch_count {
+                        segments(index)
+                    } else {
+                        0
+                    };
+                    hair_shadow.encode_opacity(
+                        &mut encoder,
+                        &prepared_hair,
+                        &state.lighting.scene_group,
+                        slot,
+                        index,
+                        count,
+                        index == 0,
+                    );
+                }
+            }
+        }
+        // 2. The colour passes: the body (clearing), then each batch's ribbons; the last of
+        // them (or the OIT composite after them) resolves MSAA.
         let (target, resolve) = view.attachments();
-        // The body's pass, then one render pass per hair batch (after its generation pass).
-        let pass_count = 1 + plan.batches.len().max(1);
+        let background = scene.lighting.background;
+        let oit = state.oit.as_ref();
+        let pass_count = 1 + 2 * batch_count.max(1) + usize::from(oit.is_some());
         let mut pass_index = 0;
+        let depth_view = view.depth();
         let mut begin_pass = |encoder: &mut wgpu::CommandEncoder| {
             let (first, last) = (pass_index == 0, pass_index + 1 == pass_count);
             pass_index += 1;
@@ -323,9 +591,9 @@ impl PreviewRenderer {
                         ops: wgpu::Operations {
                             load: if first {
                                 wgpu::LoadOp::Clear(wgpu::Color {
-                                    r: 0.02,
-                                    g: 0.022,
-                                    b: 0.026,
+                                    r: background[0] as f64,
+                                    g: background[1] as f64,
+                                    b: background[2] as f64,
                                     a: 1.0,
                                 })
                             } else {
@@ -335,7 +603,7 @@ impl PreviewRenderer {
                         },
                     })],
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: view.depth(),
+                        view: depth_view,
                         depth_ops: Some(wgpu::Operations {
                             load: if first {
                                 wgpu::LoadOp::Clear(1.0)
@@ -357,35 +625,79 @@ impl PreviewRenderer {
                 // Each pass ends (drops) before the next is begun; wgpu checks this at run time.
                 .forget_lifetime()
         };
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("preview"),
-        });
+        let bind_lighting = |pass: &mut wgpu::RenderPass<'_>| {
+            pass.set_bind_group(1, &state.lighting.scene_group, &[]);
+            if let Some(group) = &effects_group {
+                pass.set_bind_group(2, group, &[]);
+            }
+        };
         {
             let mut pass = begin_pass(&mut encoder);
-            self.body.draw(&mut pass, scene.body);
+            bind_lighting(&mut pass);
+            state.body.draw(&mut pass, &prepared_body, scene.body);
         }
-        // The one batch loop: generation into the scratch, then the batch's ribbons.
-        for (index, (batch, &[first_run, _])) in plan.batches.iter().zip(&ranges).enumerate() {
-            if let Some((generator, gpu_hair, filtering)) = generator {
-                generator.encode(
-                    context,
-                    &mut encoder,
-                    gpu_hair,
-                    &runs,
-                    first_run as usize,
-                    batch,
-                    filtering,
-                    strands,
-                    timer.and_then(|t| t.compute_pass()),
-                );
+        // Every batch's depth first (a later batch may hide an earlier one), then the lit
+        // ribbons where they are nearest: each visible sample is shaded once.
+        for pipeline in [state.hair.depth_pipeline(), state.hair.main_pipeline()] {
+            for index in 0..batch_count {
+                generate(&mut encoder, index);
+                let mut pass = begin_pass(&mut encoder);
+                bind_lighting(&mut pass);
+                if let Some(pipeline) = pipeline {
+                    HairRenderer::draw_with(
+                        &mut pass,
+                        pipeline,
+                        &prepared_hair,
+                        0,
+                        index,
+                        segments(index),
+                    );
+                }
+            }
+            if batch_count == 0 {
+                // Nothing to draw: the pass still runs (it resolves when it is the last).
+                drop(begin_pass(&mut encoder));
+            }
+        }
+        // 3. Width-based coverage: the thin strands' weighted blended transparency, then its
+        // composite over the opaque picture.
+        if let (Some(oit), Some(pipeline)) = (oit, state.hair.oit_pipeline()) {
+            for index in 0..batch_count.max(1) {
+                if index < batch_count {
+                    generate(&mut encoder, index);
+                }
+                let Some(attachments) = oit.attachments(index == 0) else {
+                    break;
+                };
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("preview_hair_oit"),
+                    color_attachments: &attachments,
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: depth_view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: timer.and_then(|t| t.render_pass()),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                bind_lighting(&mut pass);
+                if index < batch_count {
+                    HairRenderer::draw_with(
+                        &mut pass,
+                        pipeline,
+                        &prepared_hair,
+                        0,
+                        index,
+                        segments(index),
+                    );
+                }
             }
             let mut pass = begin_pass(&mut encoder);
-            let segments = FramePlan::batch_segments(batch) as u32;
-            self.hair.draw(&mut pass, &hair, index, segments);
-        }
-        if plan.batches.is_empty() {
-            // Nothing to draw: the resolving pass still runs.
-            drop(begin_pass(&mut encoder));
+            oit.draw(&mut pass);
         }
         Ok(EncodedFrame {
             encoder,
@@ -393,6 +705,71 @@ impl PreviewRenderer {
             scratch_bytes,
         })
     }
+}
+
+/// The group-2 bind group of the lit shaders from the effect renderers that exist.
+fn effects_bind_group(
+    context: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    state: &FrameState,
+) -> wgpu::BindGroup {
+    let mut entries = Vec::new();
+    let view = |binding, view| wgpu::BindGroupEntry {
+        binding,
+        resource: wgpu::BindingResource::TextureView(view),
+    };
+    if let Some(hair_shadow) = &state.hair_shadow {
+        entries.push(view(binding::OPACITY_LAYERS, &hair_shadow.opacity_view));
+        if let Some(first_hair) = hair_shadow.first_hair_view() {
+            entries.push(view(binding::FIRST_HAIR_DEPTH, first_hair));
+        }
+    }
+    if let Some(body_shadow) = &state.body_shadow {
+        entries.push(view(binding::BODY_DEPTH, &body_shadow.array_view));
+        entries.push(wgpu::BindGroupEntry {
+            binding: binding::BODY_DEPTH_SAMPLER,
+            resource: wgpu::BindingResource::Sampler(&state.lighting.depth_sampler),
+        });
+    }
+    if let Some(ds) = &state.lighting.dual_scattering {
+        entries.push(wgpu::BindGroupEntry {
+            binding: binding::TABLE_SAMPLER,
+            resource: wgpu::BindingResource::Sampler(&state.lighting.table_sampler),
+        });
+        entries.push(view(binding::DS_PROFILE, &ds.profile_view));
+        entries.push(view(binding::DS_LOBES, &ds.lobes_view));
+    }
+    context
+        .device
+        .create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("effects"),
+            layout,
+            entries: &entries,
+        })
+}
+
+/// Refuses effect resources the adapter cannot hold, naming the scene's field and the limit.
+pub fn check_effect_limits(
+    limits: &wgpu::Limits,
+    active: &ActiveEffects,
+) -> Result<(), PreviewError> {
+    if active.shadow_slots == 0 {
+        return Ok(());
+    }
+    if active.shadow_resolution > limits.max_texture_dimension_2d {
+        return Err(PreviewError::EffectLimit(format!(
+            "scene.effects.shadow_resolution: {} texels is above this adapter's max_texture_dimension_2d of {}",
+            active.shadow_resolution, limits.max_texture_dimension_2d
+        )));
+    }
+    let layers = active.shadow_slots * (active.opacity_layers / 4).max(1);
+    if layers > limits.max_texture_array_layers {
+        return Err(PreviewError::EffectLimit(format!(
+            "scene.effects.opacity_layers: {} layers for {} lights need {layers} texture layers, above this adapter's max_texture_array_layers of {}",
+            active.opacity_layers, active.shadow_slots, limits.max_texture_array_layers
+        )));
+    }
+    Ok(())
 }
 
 struct EncodedFrame {
@@ -437,26 +814,34 @@ pub enum PreviewError {
     Generation(StrandGenError),
     #[error("reading the frame back failed: {0}")]
     Readback(String),
+    /// An effect's resource would exceed what the adapter allows; nothing was made.
+    #[error("{0}")]
+    EffectLimit(String),
 }
 
-/// The look every Hairloom picture shares (renders, the editor's viewport, benchmarks):
-/// brown strands a little over a thousandth of the hair's size wide, a skin-toned body.
+/// The picture of a document: its scene's lights, material and effects, strands a little
+/// over a thousandth of the hair's size wide.
 pub fn default_scene<'a>(
     body: &'a GpuBody,
     hair: HairSource<'a>,
     vertex_count: u32,
     (lo, hi): (Vec3, Vec3),
     camera: Camera,
+    lighting: &'a Scene,
 ) -> PreviewScene<'a> {
     PreviewScene {
         body,
         hair,
         vertex_count,
-        strand_width_m: (hi - lo).length() * 0.0012,
-        // Linear colours (the target is sRGB): dark brown roots, lighter tips.
-        root_color: [0.018, 0.008, 0.004],
-        tip_color: [0.16, 0.075, 0.03],
-        body_color: [0.55, 0.38, 0.30],
+        strand_width_m: default_strand_width_m(lo, hi),
+        lighting,
+        hair_bounds: (lo, hi),
         camera,
     }
+}
+
+/// Ribbon width at the root for hair whose box is `(lo, hi)`: a little over a thousandth of
+/// its size (what the CPU reference renderer's fibres use too).
+pub fn default_strand_width_m(lo: Vec3, hi: Vec3) -> f32 {
+    (hi - lo).length() * 0.0012
 }

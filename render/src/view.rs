@@ -2,6 +2,7 @@
 //! frames and made again only when the size changes, and the read-back of its pixels.
 
 use crate::device::{GpuContext, read_buffer};
+use crate::resources::Tracked;
 
 /// Colour target format; the picture is sRGB.
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -27,9 +28,11 @@ pub struct View {
     pub height: u32,
     pub sample_count: u32,
     /// Single-sampled colour: what is read back or sampled by a UI.
-    resolved: wgpu::Texture,
+    resolved: Tracked<wgpu::Texture>,
     resolved_view: wgpu::TextureView,
+    _msaa: Option<Tracked<wgpu::Texture>>,
     msaa_view: Option<wgpu::TextureView>,
+    _depth: Tracked<wgpu::Texture>,
     depth_view: wgpu::TextureView,
 }
 
@@ -45,20 +48,23 @@ impl View {
         let ui_view = [UI_VIEW_FORMAT];
         let target =
             |label: &str, format: wgpu::TextureFormat, samples: u32, usage: wgpu::TextureUsages| {
-                context.device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size,
-                    mip_level_count: 1,
-                    sample_count: samples,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: if format == COLOR_FORMAT && samples == 1 {
-                        &ui_view
-                    } else {
-                        &[]
+                context.resources.texture(
+                    &context.device,
+                    &wgpu::TextureDescriptor {
+                        label: Some(label),
+                        size,
+                        mip_level_count: 1,
+                        sample_count: samples,
+                        dimension: wgpu::TextureDimension::D2,
+                        format,
+                        usage,
+                        view_formats: if format == COLOR_FORMAT && samples == 1 {
+                            &ui_view
+                        } else {
+                            &[]
+                        },
                     },
-                })
+                )
             };
         let resolved = target(
             "view_color",
@@ -68,30 +74,30 @@ impl View {
                 | wgpu::TextureUsages::COPY_SRC
                 | wgpu::TextureUsages::TEXTURE_BINDING,
         );
-        let msaa_view = (sample_count > 1).then(|| {
+        let msaa = (sample_count > 1).then(|| {
             target(
                 "view_msaa",
                 COLOR_FORMAT,
                 sample_count,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
             )
-            .create_view(&Default::default())
         });
-        let depth_view = target(
+        let depth = target(
             "view_depth",
             DEPTH_FORMAT,
             sample_count,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
-        )
-        .create_view(&Default::default());
+        );
         Self {
             width,
             height,
             sample_count,
             resolved_view: resolved.create_view(&Default::default()),
             resolved,
-            msaa_view,
-            depth_view,
+            msaa_view: msaa.as_ref().map(|t| t.create_view(&Default::default())),
+            _msaa: msaa,
+            depth_view: depth.create_view(&Default::default()),
+            _depth: depth,
         }
     }
 

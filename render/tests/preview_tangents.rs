@@ -86,7 +86,7 @@ fn gpu_ribbon_tangents_match_the_cpu_mirror() {
     let device = &context.device;
     let source = format!(
         "{}\n{READBACK_ENTRY}",
-        hairloom_render::renderer::preview_hair::HAIR_SHADER
+        hairloom_render::renderer::preview_hair::default_hair_shader()
     );
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("preview_hair_tangent_readback"),

@@ -19,22 +19,35 @@ fn wgsl_files(dir: &Path) -> Vec<(String, String)> {
     out
 }
 
-/// The sources the renderer compiles: each shader with the shared files it includes.
-fn embedded() -> [(&'static str, &'static str); 3] {
-    [
-        (
-            "strand_gen",
-            hairloom_render::renderer::strand_gen::SHADER_SOURCE,
-        ),
-        (
-            "preview_hair",
-            hairloom_render::renderer::preview_hair::HAIR_SHADER,
-        ),
-        (
-            "preview_body",
-            hairloom_render::renderer::preview_body::BODY_SHADER,
-        ),
-    ]
+/// The sources the renderer compiles: each shader with the shared files it includes, in
+/// every combination of effect modules it can be composed of.
+fn embedded() -> Vec<(String, String)> {
+    use hairloom_core::model::scene::SelfShadowing;
+    use hairloom_render::renderer::oit_composite::oit_composite_shader;
+    use hairloom_render::renderer::scene_lighting::{
+        ShaderKey, body_shader, hair_shader, hair_shadow_shader,
+    };
+    let mut sources = vec![(
+        "strand_gen".to_string(),
+        hairloom_render::renderer::strand_gen::SHADER_SOURCE.to_string(),
+    )];
+    for key in ShaderKey::all() {
+        sources.push((format!("preview_hair {key:?}"), hair_shader(&key)));
+        sources.push((format!("preview_body {key:?}"), body_shader(&key)));
+    }
+    for kind in [
+        SelfShadowing::OpacityShadowMaps,
+        SelfShadowing::DeepOpacityMaps,
+    ] {
+        sources.push((format!("hair_shadow {kind:?}"), hair_shadow_shader(kind)));
+    }
+    for samples in [1, 4] {
+        sources.push((
+            format!("oit_composite {samples}×"),
+            oit_composite_shader(samples),
+        ));
+    }
+    sources
 }
 
 fn parse(name: &str, source: &str) -> naga::Module {
@@ -51,18 +64,17 @@ fn parse(name: &str, source: &str) -> naga::Module {
 
 #[test]
 fn every_shader_validates() {
-    for (name, source) in embedded() {
+    let sources = embedded();
+    for (name, source) in &sources {
         parse(name, source);
     }
-    // Every file on disk is what the renderer embeds: a shader (the tail of one embedded
-    // source) or a shared file (prepended to at least one); none is left out or stale.
+    // Every file on disk is part of what the renderer embeds (a shader, a shared file or an
+    // effect module of at least one composed source); none is left out or stale.
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
     let files = wgsl_files(&dir);
     assert!(files.len() >= 4, "{files:?}");
     for (path, source) in &files {
-        let used = embedded()
-            .iter()
-            .any(|(_, s)| s.ends_with(source.as_str()) || s.starts_with(source.as_str()));
+        let used = sources.iter().any(|(_, s)| s.contains(source.as_str()));
         assert!(
             used,
             "{path} is not part of any shader the renderer compiles"
@@ -83,12 +95,18 @@ fn wgsl_struct_size(module: &naga::Module, name: &str) -> Option<u32> {
 
 #[test]
 fn gpu_structs_match_their_wgsl() {
+    use hairloom_core::light::scene_uniforms::{GpuLight, GpuShadowView, SceneUniforms};
     use hairloom_core::runtime::gpu_types::{
         BundleGpu, StrandGenParams, StrandRoot, StrandRun, StylingGpu,
     };
-    use hairloom_render::renderer::preview_body::{BODY_SHADER, BodyUniforms};
-    use hairloom_render::renderer::preview_hair::{HAIR_SHADER, HairUniforms};
+    use hairloom_render::renderer::preview_body::BodyUniforms;
+    use hairloom_render::renderer::preview_hair::{HairUniforms, default_hair_shader};
     use hairloom_render::renderer::strand_gen::SHADER_SOURCE;
+    let hair_shader = default_hair_shader();
+    let body_shader = hairloom_render::renderer::scene_lighting::body_shader(
+        &hairloom_render::renderer::scene_lighting::ShaderKey::all()[0],
+    );
+    let (hair, body) = (hair_shader.as_str(), body_shader.as_str());
     for (source, name, rust_size) in [
         (
             SHADER_SOURCE,
@@ -99,13 +117,17 @@ fn gpu_structs_match_their_wgsl() {
         (SHADER_SOURCE, "Styling", size_of::<StylingGpu>()),
         (SHADER_SOURCE, "BundleGpu", size_of::<BundleGpu>()),
         (SHADER_SOURCE, "StrandRun", size_of::<StrandRun>()),
-        (HAIR_SHADER, "StrandRun", size_of::<StrandRun>()),
-        (HAIR_SHADER, "HairUniforms", size_of::<HairUniforms>()),
-        (BODY_SHADER, "BodyUniforms", size_of::<BodyUniforms>()),
+        (hair, "StrandRun", size_of::<StrandRun>()),
+        (hair, "HairUniforms", size_of::<HairUniforms>()),
+        (body, "BodyUniforms", size_of::<BodyUniforms>()),
+        (hair, "SceneUniforms", size_of::<SceneUniforms>()),
+        (hair, "SceneLight", size_of::<GpuLight>()),
+        (hair, "ShadowView", size_of::<GpuShadowView>()),
+        (body, "SceneUniforms", size_of::<SceneUniforms>()),
     ] {
         let module = parse(name, source);
         let wgsl_size = wgsl_struct_size(&module, name)
-            .unwrap_or_else(|| panic!("{name} missing from strand_gen.wgsl"));
+            .unwrap_or_else(|| panic!("{name} missing from its shader"));
         assert_eq!(
             wgsl_size as usize, rust_size,
             "{name}: WGSL {wgsl_size} bytes, Rust {rust_size}"

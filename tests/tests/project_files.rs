@@ -127,6 +127,39 @@ fn versions_and_garbage() {
 }
 
 #[test]
+fn a_version_1_file_loads_with_the_default_scene_and_saves_as_the_current_version() {
+    // A version-1 file: no scene anywhere, the format number 1.
+    let mesh = grid_mesh(3, 2, 2, 0.5);
+    let mut value: serde_json::Value = serde_json::from_slice(&project::to_bytes(&Project::new(
+        Document::new("old", mesh),
+    )))
+    .expect("json");
+    value["format_version"] = 1.into();
+    value["document"]
+        .as_object_mut()
+        .expect("document")
+        .remove("scene")
+        .expect("the current format writes a scene");
+    let bytes = serde_json::to_vec_pretty(&value).expect("json");
+    let loaded = project::from_bytes(&bytes, Path::new("old.hairloom")).expect("migrates");
+    assert_eq!(
+        loaded.document.scene,
+        hairloom_core::model::scene::Scene::default()
+    );
+    assert_eq!(loaded.format_version, project::FORMAT_VERSION);
+    let saved: serde_json::Value =
+        serde_json::from_slice(&project::to_bytes(&loaded)).expect("json");
+    assert_eq!(saved["format_version"], project::FORMAT_VERSION);
+    assert!(saved["document"]["scene"]["lights"].is_array());
+    // A scene problem in a file is named by its JSON path, and nothing is half-loaded.
+    let (path, message) = invalid_at(corrupt(|v| {
+        v["document"]["scene"]["material"]["longitudinal_roughness"] = (-0.5).into()
+    }));
+    assert_eq!(path, "document.scene.material.longitudinal_roughness");
+    assert!(message.contains("-0.5"), "{message}");
+}
+
+#[test]
 fn tampered_history_is_refused() {
     let mesh = grid_mesh(3, 2, 2, 0.5);
     let mut document = Document::new("grid", mesh);

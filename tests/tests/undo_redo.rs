@@ -442,7 +442,7 @@ fn every_document_field_is_recorded_and_undone() {
         .expect("sample")
         .document;
     type Change = fn(&mut hairloom_core::Document);
-    let changes: [(&str, Change); 4] = [
+    let changes: [(&str, Change); 5] = [
         ("name", |d| d.name.push_str(" copy")),
         ("source", |d| {
             d.source = "imported from elsewhere.glb".into()
@@ -450,8 +450,13 @@ fn every_document_field_is_recorded_and_undone() {
         ("body", |d| {
             d.body.positions.push([0.0, 0.0, 0.0]);
         }),
+        ("scene", |d| {
+            d.scene.material.longitudinal_roughness = 0.2;
+            d.scene.effects.body_shadows = false;
+        }),
         ("all", |d| {
             d.name = "other".into();
+            d.scene.lights.pop();
             d.source.clear();
             d.body = hairloom_core::model::document::BodyMesh::default();
             d.styling.global.seed += 1;

@@ -20,7 +20,11 @@ use crate::model::document::Document;
 use crate::model::history::History;
 
 /// The project file format this build writes and the newest it reads.
-pub const FORMAT_VERSION: u32 = 1;
+///
+/// History: 1, the document and its history; 2, the document gains its scene (lights,
+/// material, effects). A version-1 file loads with the default scene and is written back as
+/// version 2 ([`from_bytes`] migrates it).
+pub const FORMAT_VERSION: u32 = 2;
 /// File extension of project files.
 pub const EXTENSION: &str = "hairloom";
 
@@ -131,12 +135,15 @@ pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Project, ProjectError> {
         });
     }
     let deserializer = &mut serde_json::Deserializer::from_slice(bytes);
-    let project: Project =
+    let mut project: Project =
         serde_path_to_error::deserialize(deserializer).map_err(|e| ProjectError::Invalid {
             path: path.to_path_buf(),
             json_path: e.path().to_string(),
             message: e.inner().to_string(),
         })?;
+    // Migration: version 1 had no scene, and serde gave the document the default one; from
+    // here on the project is the current version and saves as such.
+    project.format_version = FORMAT_VERSION;
     project
         .document
         .validate()

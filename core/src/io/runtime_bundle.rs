@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::io::ktx2::{TexelFormat, ktx2_bytes, read_texture, texel_bytes};
 use crate::io::strand_files::glb_body;
 use crate::model::document::Document;
+use crate::model::scene::Scene;
 use crate::model::styling::StylingSet;
 use crate::runtime::atlas::Atlas;
 pub use crate::runtime::hair::LodEntry;
@@ -76,6 +77,10 @@ pub struct Manifest {
     pub strands_per_bundle: u32,
     pub lod: LodEntry,
     pub styling: StylingSet,
+    /// Lights, cameras, the fibre material and the effects the picture asks for (see
+    /// `docs/runtime-format.md`); bundles from before scenes existed get the default scene.
+    #[serde(default)]
+    pub scene: Scene,
     /// The opaque body mesh (GLB, triangles) hair is depth-tested against, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body: Option<String>,
@@ -273,6 +278,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         strands_per_bundle: hair.strands_per_bundle,
         lod: hair.lod.clone(),
         styling: hair.styling.clone(),
+        scene: hair.scene.clone(),
         body: body_glb
             .as_ref()
             .map(|bytes| content_addressed_name("body", "glb", bytes)),
@@ -479,6 +485,10 @@ pub fn load_runtime_bundle_from(
         .styling
         .validate()
         .map_err(|e| error("manifest.json", format!("styling.{e}")))?;
+    manifest
+        .scene
+        .validate()
+        .map_err(|e| error("manifest.json", format!("scene.{e}")))?;
     for (name, samples) in [
         ("quad_samples", &manifest.quad_samples),
         ("triangle_samples", &manifest.triangle_samples),
@@ -558,6 +568,7 @@ pub fn load_runtime_bundle_from(
             .map(|b| (b.styling_group + 1) as u32)
             .collect(),
         styling: manifest.styling,
+        scene: manifest.scene,
         lod: manifest.lod,
         body,
         source: manifest.source,

@@ -1,4 +1,4 @@
-//! The saved document: the hair mesh plus the body it grows on.
+//! The saved document: the hair mesh, the body it grows on, its styling and its scene.
 //!
 //! View state (camera, selection, GPU handles) never lives here: undo never moves the
 //! camera and project files hold only what the artist made.
@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::model::mesh::{HairMesh, InvalidMesh};
+use crate::model::scene::Scene;
 use crate::model::styling::StylingSet;
 
 /// A triangle mesh drawn under the hair (the head, the teapot) and used for depth testing.
@@ -57,6 +58,10 @@ pub struct Document {
     /// Styling parameters: global values with per-bundle-group overrides.
     #[serde(default)]
     pub styling: StylingSet,
+    /// Lights, cameras, the hair material and the effects the renderer runs. Files from
+    /// before scenes existed (format version 1) get the default scene.
+    #[serde(default)]
+    pub scene: Scene,
 }
 
 /// A validation problem anywhere in a document, with the JSON path of the value.
@@ -75,6 +80,7 @@ impl Document {
             hair_mesh,
             body: BodyMesh::default(),
             styling: StylingSet::default(),
+            scene: Scene::default(),
         }
     }
 
@@ -94,6 +100,10 @@ impl Document {
                 path: format!("styling.{path}"),
                 message: message.to_string(),
             }
+        })?;
+        self.scene.validate().map_err(|e| InvalidDocument {
+            path: format!("scene.{}", e.path),
+            message: e.message,
         })
     }
 }

@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::{Bundle, Column, WMode};
+use crate::model::scene::Scene;
 use crate::model::styling::StylingSet;
 
 /// Default number of undo steps kept.
@@ -198,6 +199,9 @@ pub struct DocumentDiff {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     /// Boxed: a styling set is large and most commands do not change it.
     pub styling: Option<Box<Swap<StylingSet>>>,
+    /// Boxed: only scene edits change it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene: Option<Box<Swap<Scene>>>,
 }
 
 impl DocumentDiff {
@@ -210,6 +214,7 @@ impl DocumentDiff {
             source: Swap::between(&before.source, &after.source),
             body: Swap::between(&before.body, &after.body).map(Box::new),
             styling: Swap::between(&before.styling, &after.styling).map(Box::new),
+            scene: Swap::between(&before.scene, &after.scene).map(Box::new),
         }
     }
 
@@ -221,6 +226,7 @@ impl DocumentDiff {
             && self.source.is_none()
             && self.body.is_none()
             && self.styling.is_none()
+            && self.scene.is_none()
     }
 
     fn write(&self, document: &mut Document, forward: bool) -> Result<(), HistoryMismatch> {
@@ -241,6 +247,9 @@ impl DocumentDiff {
         }
         if let Some(swap) = &self.styling {
             swap.check(&document.styling, forward, "styling")?;
+        }
+        if let Some(swap) = &self.scene {
+            swap.check(&document.scene, forward, "scene")?;
         }
         let mut bundles = document.hair_mesh.bundles.clone();
         self.bundles
@@ -265,6 +274,9 @@ impl DocumentDiff {
         }
         if let Some(swap) = &self.styling {
             swap.write(&mut document.styling, forward);
+        }
+        if let Some(swap) = &self.scene {
+            swap.write(&mut document.scene, forward);
         }
         Ok(())
     }

@@ -1,7 +1,8 @@
 //! What the artist makes and saves: the hair mesh, the body it grows on, the styling
-//! parameters, and the undo history of commands over them. Nothing here is view state.
+//! parameters, the scene (lights, material, effects), and the undo history of commands over them. Nothing here is view state.
 
 pub mod document;
 pub mod history;
 pub mod mesh;
+pub mod scene;
 pub mod styling;

@@ -9,6 +9,7 @@
 use glam::Vec2;
 
 use crate::model::document::{BodyMesh, Document};
+use crate::model::scene::Scene;
 use crate::model::styling::StylingSet;
 use crate::runtime::atlas::{Atlas, BundleBlock};
 use crate::runtime::gpu_types::StrandRoot;
@@ -73,6 +74,8 @@ pub struct RuntimeHair {
     /// Per atlas block: 0 = global styling, `g + 1` = group `g` of [`Self::styling`].
     pub block_styling: Vec<u32>,
     pub styling: StylingSet,
+    /// Lights, material and effects: how the hair is meant to be seen.
+    pub scene: Scene,
     pub lod: LodEntry,
     /// The opaque body the hair grows on (empty when there is none).
     pub body: BodyMesh,
@@ -100,6 +103,7 @@ impl RuntimeHair {
             samples: RootSamples::default(),
             strands_per_bundle: 0,
             styling: document.styling.clone(),
+            scene: document.scene.clone(),
             lod: options.lod.clone(),
             body: document.body.clone(),
             source: document.source.clone(),

@@ -20,6 +20,7 @@ use crate::io::import::{ImportError, ImportOptions, import_slice};
 use crate::io::project::Project;
 use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::HairMesh;
+use crate::model::scene::{HairMaterial, Pigment};
 use crate::model::styling::{Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Wave};
 
 /// The sample every tool opens when none is named (the editor embeds the same file).
@@ -289,6 +290,32 @@ pub fn head_style(name: &str) -> StylingParams {
     }
 }
 
+/// The fibre material of each head sample: three hair colours from melanin, so the samples
+/// show what the material does.
+pub fn head_material(name: &str) -> HairMaterial {
+    let base = HairMaterial::default();
+    match name {
+        // Auburn: little eumelanin, much pheomelanin.
+        "head_curly" => HairMaterial {
+            pigment: Pigment::Melanin {
+                eumelanin: 0.2,
+                pheomelanin: 0.9,
+            },
+            ..base
+        },
+        // Near black, a little smoother.
+        "head_short_straight" => HairMaterial {
+            pigment: Pigment::Melanin {
+                eumelanin: 2.5,
+                pheomelanin: 0.2,
+            },
+            longitudinal_roughness: 0.25,
+            ..base
+        },
+        _ => base,
+    }
+}
+
 /// Builds the head sample projects from the scan's GLB bytes.
 pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> {
     let (scalp, body) = head_scalp(glb)?;
@@ -299,6 +326,7 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
             let mesh = grow(&scalp, *growth, radii_m);
             let mut document = Document::new(*name, mesh);
             document.styling.global = head_style(name);
+            document.scene.material = head_material(name);
             document.source = HEAD_CREDIT.to_string();
             document.body = body.clone();
             (name.to_string(), Project::new(document))
@@ -353,6 +381,16 @@ pub fn teapot_project(teapot_text: &str) -> Result<Project, crate::samples::teap
         },
         length: LengthVariation { fraction: 0.4 },
         ..StylingParams::default()
+    };
+    // Light, rough fur.
+    document.scene.material = HairMaterial {
+        pigment: Pigment::Melanin {
+            eumelanin: 0.12,
+            pheomelanin: 0.15,
+        },
+        longitudinal_roughness: 0.4,
+        azimuthal_roughness: 0.5,
+        ..HairMaterial::default()
     };
     document.source = TEAPOT_CREDIT.to_string();
     document.body = body;

@@ -70,6 +70,21 @@ pub enum Which {
         #[arg(long)]
         project: Option<std::path::PathBuf>,
     },
+    /// What each lighting effect costs: the frame with none, each alone, the scene's own
+    /// combination and everything, at 10K and 100K strands (time and GPU memory).
+    Effects {
+        #[arg(long)]
+        project: Option<std::path::PathBuf>,
+        /// Strand counts to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 100_000])]
+        strands: Vec<usize>,
+        /// Frame size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "960x960")]
+        size: String,
+        /// Measured runs per row after one warm-up (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+    },
 }
 
 pub fn run(which: Which) -> anyhow::Result<()> {
@@ -81,6 +96,12 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             strands,
         } => super::accuracy::run(project, &out, strands.max(1)),
         Which::Cpu { project } => super::accuracy::cpu(project),
+        Which::Effects {
+            project,
+            strands,
+            size,
+            runs,
+        } => super::bench_effects::run(project, &strands, &size, runs.max(1)),
         Which::Edit {
             project,
             size,
@@ -193,7 +214,7 @@ fn interior(repeat: usize) -> anyhow::Result<()> {
 }
 
 /// Median of `runs` measurements by wall time (after one warm-up), or the first error.
-fn median_timing<T: Copy, E>(
+pub(super) fn median_timing<T: Copy, E>(
     mut measure: impl FnMut() -> Result<T, E>,
     runs: usize,
     wall_ms: impl Fn(&T) -> f64,
@@ -238,6 +259,12 @@ fn gpu(
     let generator = StrandGenRenderer::new(&context);
     let preview = PreviewRenderer::new(&context);
     let body = hairloom_render::renderer::preview_body::GpuBody::upload(&context, &document.body);
+    // The method's own cost (generation against stored vertices): no optional effect, so the
+    // rows compare with earlier runs; `hairloom bench effects` measures the effects.
+    let unlit = hairloom_core::model::scene::Scene {
+        effects: document.scene.effects.none(),
+        ..document.scene.clone()
+    };
     let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
     let max_binding = context.device.limits().max_storage_buffer_binding_size;
     let trust = !context.is_cpu();
@@ -348,6 +375,7 @@ fn gpu(
                         vertex_count,
                         (lo, hi),
                         camera,
+                        &unlit,
                     )
                 };
                 let frame = |source, camera| {
@@ -486,6 +514,7 @@ fn edit_latency(
             vertex_count,
             bounds,
             camera,
+            &document.scene,
         );
         let plan = preview.plan(&scene, width, height);
         preview.render(&context, &scene, &plan, width, height)?;

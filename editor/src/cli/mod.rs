@@ -13,6 +13,7 @@ use hairloom_core::runtime::textures::Precision;
 
 mod accuracy;
 mod bench;
+mod bench_effects;
 mod render;
 
 use hairloom_editor::files;
@@ -82,7 +83,8 @@ enum Command {
         precision: PrecisionArg,
     },
     /// Render a project, or an exported runtime bundle folder, headless to a PNG: strands
-    /// generated on the GPU from the runtime textures, body, Kajiya-Kay shading, MSAA.
+    /// generated on the GPU from the runtime textures, lit by the scene (its lights,
+    /// material and effects: shadows, Marschner shading, dual scattering, coverage), MSAA.
     Render {
         /// A .hairloom project or a runtime bundle folder.
         input: PathBuf,
@@ -95,9 +97,15 @@ enum Command {
         /// 4096).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
         strands_per_bundle: Option<u32>,
-        /// Camera direction from the model: front, side, back, three-quarter, or x,y,z.
+        /// Camera direction from the model: a camera preset of the scene (front, side, back,
+        /// three-quarter, top by default), or x,y,z.
         #[arg(long, default_value = "three-quarter")]
         view: String,
+        /// Override the scene's optional effects for this render: none, all, or a list of
+        /// marschner, opacity-shadow-maps, deep-opacity-maps, body-shadows, dual-scattering,
+        /// width-oit (those on, the rest off).
+        #[arg(long)]
+        effects: Option<String>,
         /// Strands have 2^N + 1 vertices.
         #[arg(long, default_value_t = render::PREVIEW_VERTICES_LOG2)]
         vertices_log2: u32,
@@ -196,6 +204,7 @@ pub fn main() -> ExitCode {
             size,
             strands_per_bundle,
             view,
+            effects,
             vertices_log2,
             precision,
             filtering,
@@ -219,6 +228,7 @@ pub fn main() -> ExitCode {
                 size,
                 strands_per_bundle,
                 view,
+                effects,
                 vertices_log2,
                 precision: precision.into(),
                 filtering: filtering.into(),

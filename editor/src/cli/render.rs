@@ -9,6 +9,7 @@ use std::path::Path;
 use anyhow::{Context, bail};
 use glam::Vec3;
 use hairloom_core::io::runtime_bundle::load_runtime_bundle;
+use hairloom_core::model::scene::Scene;
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{DEFAULT_STRANDS_PER_BUNDLE, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
@@ -28,6 +29,9 @@ pub struct RenderSettings {
     /// `None`: the runtime bundle's own count, or [`DEFAULT_STRANDS_PER_BUNDLE`].
     pub strands_per_bundle: Option<u32>,
     pub view: String,
+    /// `--effects`: none, all or a list overriding the scene's effects (see
+    /// [`hairloom_core::model::scene::Effects::parse_list`]).
+    pub effects: Option<String>,
     pub vertices_log2: u32,
     /// Texture precision of a project render (a runtime bundle has its own).
     pub precision: Precision,
@@ -41,6 +45,7 @@ impl Default for RenderSettings {
             size: "960x960".into(),
             strands_per_bundle: None,
             view: "three-quarter".into(),
+            effects: None,
             vertices_log2: PREVIEW_VERTICES_LOG2,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -60,12 +65,12 @@ pub fn parse_size(size: &str) -> anyhow::Result<(u32, u32)> {
     Ok((w, h))
 }
 
-pub fn parse_view(view: &str) -> anyhow::Result<Vec3> {
+/// A camera direction: one of the scene's presets by name, or `x,y,z`.
+pub fn parse_view(view: &str, scene: &Scene) -> anyhow::Result<Vec3> {
+    if let Some(preset) = scene.camera(view) {
+        return Ok(Vec3::from(preset.direction));
+    }
     Ok(match view {
-        "front" => Vec3::new(0.0, 0.1, 1.0),
-        "side" => Vec3::new(1.0, 0.1, 0.0),
-        "back" => Vec3::new(0.0, 0.2, -1.0),
-        "three-quarter" => Vec3::new(0.75, 0.25, 1.0),
         custom => {
             let parts: Vec<f32> = custom
                 .split(',')
@@ -73,7 +78,11 @@ pub fn parse_view(view: &str) -> anyhow::Result<Vec3> {
                 .collect::<Result<_, _>>()
                 .with_context(|| format!("--view {custom:?}"))?;
             let [x, y, z] = parts[..] else {
-                bail!("--view takes front, side, back, three-quarter or x,y,z")
+                let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+                bail!(
+                    "--view takes a camera of the scene ({}) or x,y,z",
+                    names.join(", ")
+                )
             };
             let direction = Vec3::new(x, y, z);
             if !direction.is_finite() || direction.length() == 0.0 {
@@ -131,6 +140,7 @@ pub fn render_pixels(
     let camera = Camera::framing(lo - pad, hi + pad, direction);
     let renderer = PreviewRenderer::new(context);
     let body = GpuBody::upload(context, &hair.body);
+    let lighting = scene_for(hair, settings)?;
     let scene = default_scene(
         &body,
         HairSource::Generated {
@@ -142,17 +152,24 @@ pub fn render_pixels(
         vertex_count,
         (lo, hi),
         camera,
+        &lighting,
     );
     let plan = renderer.plan(&scene, width, height);
     let pixels = renderer.render(context, &scene, &plan, width, height)?;
+    let names = lighting.effects.names();
     let summary = format!(
-        "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), {}× MSAA, on {}",
+        "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), effects: {}, {}× MSAA, on {}",
         plan.strands,
         gpu_hair.root_count,
         plan.vertices,
         if settings.lod.enabled { "on" } else { "off" },
         filtering,
         hair.textures.precision,
+        if names.is_empty() {
+            "none (Kajiya-Kay)".to_string()
+        } else {
+            names.join(", ")
+        },
         renderer.sample_count,
         describe(&context.adapter_info)
     );
@@ -178,10 +195,20 @@ pub fn write_png(out: &Path, pixels: &[u8], width: u32, height: u32) -> anyhow::
         .with_context(|| format!("writing {}", out.display()))
 }
 
+/// The asset's scene with `--effects` applied.
+pub fn scene_for(hair: &RuntimeHair, settings: &RenderSettings) -> anyhow::Result<Scene> {
+    let mut scene = hair.scene.clone();
+    if let Some(list) = &settings.effects {
+        scene.effects = scene.effects.parse_list(list).map_err(anyhow::Error::msg)?;
+    }
+    Ok(scene)
+}
+
 pub fn run(input: &Path, out: &Path, settings: &RenderSettings) -> anyhow::Result<()> {
     let (width, height) = parse_size(&settings.size)?;
-    let direction = parse_view(&settings.view)?;
     let hair = load_hair(input, settings)?;
+    let direction = parse_view(&settings.view, &hair.scene)?;
+    scene_for(&hair, settings)?;
     let context = GpuContext::new_headless()?;
     let (pixels, summary) = render_pixels(&context, &hair, width, height, direction, settings)?;
     write_png(out, &pixels, width, height)?;

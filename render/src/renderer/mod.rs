@@ -1,69 +1,106 @@
-//! One renderer per feature (re_renderer's shape): each owns the pipeline and bind-group
-//! layout of its shader, made once per device, and records its work into a frame that
-//! [`crate::preview`] composes. Each is named after its shader: `shaders/X.wgsl` ↔
-//! `renderer/X.rs` ↔ `hairloom_core::runtime::X` (the CPU mirror tests compare against).
+//! One renderer per feature (re_renderer's shape): each owns the pipelines and bind-group
+//! layouts of its shader, and records its work into a frame that [`crate::preview`] composes
+//! from the scene's effects. Each is named after its shader: `shaders/X.wgsl` ↔
+//! `renderer/X.rs` ↔ `hairloom_core::runtime::X` or `hairloom_core::light::X` (the CPU mirror
+//! tests compare against).
+//!
+//! | renderer | shader | when |
+//! |---|---|---|
+//! | [`strand_gen`] | `strand_gen.wgsl` | every frame with generated hair |
+//! | [`preview_hair`] | `preview_hair.wgsl` + `light/*` | always (the lit ribbons; OIT entry with width-based coverage) |
+//! | [`preview_body`] | `preview_body.wgsl` + `light/*` | always |
+//! | [`hair_shadow`] | `hair_shadow.wgsl` | opacity shadow maps or deep opacity maps |
+//! | [`body_shadow`] | `preview_body.wgsl` (`vs_shadow`) | body shadows |
+//! | [`oit_composite`] | `oit_composite.wgsl` | width-based coverage |
+//! | [`scene_lighting`] | `shared/scene.wgsl`, `light/dual_scattering.wgsl` | always (tables: dual scattering) |
 
+pub mod body_shadow;
+pub mod hair_shadow;
+pub mod oit_composite;
 pub mod preview_body;
 pub mod preview_hair;
+pub mod scene_lighting;
 pub mod strand_gen;
 
 use crate::device::GpuContext;
+use crate::resources::Tracked;
 use crate::view::{COLOR_FORMAT, DEPTH_FORMAT};
 
-/// A depth-tested, multisampled triangle pipeline into the view's targets, entry points
-/// `vs_main` and `fs_main`: what the body and the hair ribbons share.
-pub(crate) fn view_pipeline(
-    context: &GpuContext,
-    label: &str,
-    source: &str,
-    layout: &wgpu::BindGroupLayout,
-    buffers: &[Option<wgpu::VertexBufferLayout>],
-    sample_count: u32,
-) -> wgpu::RenderPipeline {
+/// What differs between the renderers' pipelines; the rest (triangle lists, no culling) is
+/// shared.
+pub(crate) struct PipelineSpec<'a> {
+    pub label: &'a str,
+    pub source: &'a str,
+    pub groups: &'a [&'a wgpu::BindGroupLayout],
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    pub vertex_entry: &'a str,
+    /// `None`: a depth-only pipeline.
+    pub fragment_entry: Option<&'a str>,
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+    pub depth: Option<wgpu::DepthStencilState>,
+    pub sample_count: u32,
+}
+
+pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgpu::RenderPipeline> {
     let device = &context.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
+        label: Some(spec.label),
+        source: wgpu::ShaderSource::Wgsl(spec.source.into()),
     });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(layout)],
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> =
+        spec.groups.iter().map(|g| Some(*g)).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(spec.label),
+        bind_group_layouts: &groups,
         immediate_size: 0,
     });
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers,
+    context.resources.render_pipeline(
+        device,
+        &wgpu::RenderPipelineDescriptor {
+            label: Some(spec.label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some(spec.vertex_entry),
+                compilation_options: Default::default(),
+                buffers: spec.buffers,
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: spec.depth.clone(),
+            multisample: wgpu::MultisampleState {
+                count: spec.sample_count,
+                ..Default::default()
+            },
+            fragment: spec.fragment_entry.map(|entry| wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: spec.targets,
+            }),
+            multiview_mask: None,
+            cache: None,
         },
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
-        }),
-        multisample: wgpu::MultisampleState {
-            count: sample_count,
-            ..Default::default()
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(COLOR_FORMAT.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+    )
+}
+
+/// The view's depth test: nearer wins, written when `write`.
+pub(crate) fn view_depth(write: bool) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(write),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+/// The view's colour target, opaque.
+pub(crate) fn view_color_target() -> [Option<wgpu::ColorTargetState>; 1] {
+    [Some(COLOR_FORMAT.into())]
 }
 
 /// A uniform-buffer layout entry at `binding`, read by both stages.

@@ -1,14 +1,14 @@
-//! The opaque body (`shaders/preview_body.wgsl`): the scalp and head the hair is
-//! depth-tested against. Its mesh is uploaded once per document ([`GpuBody`]); a frame only
-//! writes the camera into the renderer's uniform buffer.
+//! The opaque body (`shaders/preview_body.wgsl`): the scalp and head the hair is depth-tested
+//! against, lit by the scene with the hair's shadow and its own. Its mesh is uploaded once
+//! per document ([`GpuBody`]); a frame writes the camera (and each shadow-casting light's
+//! view, for [`crate::renderer::body_shadow`]) into one uniform buffer.
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 use crate::device::GpuContext;
-use crate::renderer::{uniform_entry, view_pipeline};
-
-pub const BODY_SHADER: &str = include_str!("../../../shaders/preview_body.wgsl");
+use crate::renderer::scene_lighting::{ShaderKey, body_shader};
+use crate::renderer::{PipelineSpec, pipeline, uniform_entry, view_color_target, view_depth};
+use crate::resources::Tracked;
 
 /// Keep in sync with `shaders/preview_body.wgsl` (`BodyUniforms`).
 #[repr(C)]
@@ -16,12 +16,11 @@ pub const BODY_SHADER: &str = include_str!("../../../shaders/preview_body.wgsl")
 pub struct BodyUniforms {
     pub view_projection: [[f32; 4]; 4],
     pub camera_position: [f32; 4],
-    pub color: [f32; 4],
 }
 
 /// The body mesh on the GPU: vertex and index buffers, made once per document.
 pub struct GpuBody {
-    buffers: Option<(wgpu::Buffer, wgpu::Buffer)>,
+    buffers: Option<(Tracked<wgpu::Buffer>, Tracked<wgpu::Buffer>)>,
     index_count: u32,
 }
 
@@ -31,13 +30,14 @@ impl GpuBody {
             return Self::empty();
         }
         let buffer = |label: &str, contents: &[u8], usage| {
-            context
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            context.resources.buffer_init(
+                &context.device,
+                &wgpu::util::BufferInitDescriptor {
                     label: Some(label),
                     contents,
                     usage,
-                })
+                },
+            )
         };
         Self {
             buffers: Some((
@@ -63,13 +63,41 @@ impl GpuBody {
             index_count: 0,
         }
     }
+
+    pub fn is_empty(&self) -> bool {
+        self.buffers.is_none()
+    }
+
+    /// Binds the mesh and draws it (pipeline and groups set by the caller).
+    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if let Some((vertices, indices)) = &self.buffers {
+            pass.set_vertex_buffer(0, vertices.slice(..));
+            pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..self.index_count, 0, 0..1);
+        }
+    }
 }
 
-/// Pipeline, layout and per-frame uniforms of the body.
+/// The body's vertex layout (positions only).
+pub(crate) const BODY_VERTEX_LAYOUT: [Option<wgpu::VertexBufferLayout<'static>>; 1] =
+    [Some(wgpu::VertexBufferLayout {
+        array_stride: 12,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+    })];
+
+/// The body's bindings (group 0) and its lit pipeline for the current effects.
 pub struct BodyRenderer {
-    pipeline: wgpu::RenderPipeline,
-    uniforms: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
+    uniform_stride: u64,
+    sample_count: u32,
+    pipeline: Option<(ShaderKey, Tracked<wgpu::RenderPipeline>)>,
+}
+
+/// One frame's body bindings: the camera's uniforms and each shadow view's.
+pub struct PreparedBody {
     group: wgpu::BindGroup,
+    stride: u64,
 }
 
 impl BodyRenderer {
@@ -77,59 +105,111 @@ impl BodyRenderer {
         let device = &context.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("preview_body"),
-            entries: &[uniform_entry(0, size_of::<BodyUniforms>(), false)],
+            entries: &[uniform_entry(0, size_of::<BodyUniforms>(), true)],
         });
-        let buffers = [Some(wgpu::VertexBufferLayout {
-            array_stride: 12,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-        })];
-        let pipeline = view_pipeline(
-            context,
-            "preview_body",
-            BODY_SHADER,
-            &layout,
-            &buffers,
-            sample_count,
-        );
-        // One uniform buffer for the renderer's life: each frame is encoded and submitted
-        // before the next writes it.
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("preview_body_uniforms"),
-            size: size_of::<BodyUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("preview_body"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniforms.as_entire_binding(),
-            }],
-        });
+        let alignment = device.limits().min_uniform_buffer_offset_alignment as u64;
         Self {
-            pipeline,
-            uniforms,
-            group,
+            layout,
+            uniform_stride: (size_of::<BodyUniforms>() as u64).div_ceil(alignment) * alignment,
+            sample_count,
+            pipeline: None,
         }
     }
 
-    /// Writes this frame's uniforms (before the frame is submitted).
-    pub fn prepare(&self, context: &GpuContext, uniforms: &BodyUniforms) {
-        context
-            .queue
-            .write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+    /// Group 0 of every pipeline that draws the body.
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
     }
 
-    /// Draws `body` into `pass`.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, body: &GpuBody) {
-        if let Some((vertices, indices)) = &body.buffers {
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.group, &[]);
-            pass.set_vertex_buffer(0, vertices.slice(..));
-            pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..body.index_count, 0, 0..1);
+    /// Makes the lit pipeline for `key` unless it exists (the previous one is freed).
+    pub fn ensure(
+        &mut self,
+        context: &GpuContext,
+        key: ShaderKey,
+        scene_layout: &wgpu::BindGroupLayout,
+        effects_layout: Option<&wgpu::BindGroupLayout>,
+    ) {
+        // The body's shader does not depend on the shading model or dual scattering.
+        let key = ShaderKey {
+            shading: hairloom_core::model::scene::Shading::KajiyaKay,
+            dual_scattering: false,
+            ..key
+        };
+        if self.pipeline.as_ref().is_some_and(|(k, _)| *k == key) {
+            return;
+        }
+        self.pipeline = None;
+        let source = body_shader(&key);
+        let mut groups = vec![&self.layout, scene_layout];
+        groups.extend(effects_layout);
+        let made = pipeline(
+            context,
+            &PipelineSpec {
+                label: "preview_body",
+                source: &source,
+                groups: &groups,
+                buffers: &BODY_VERTEX_LAYOUT,
+                vertex_entry: "vs_main",
+                fragment_entry: Some("fs_main"),
+                targets: &view_color_target(),
+                depth: Some(view_depth(true)),
+                sample_count: self.sample_count,
+            },
+        );
+        self.pipeline = Some((key, made));
+    }
+
+    /// This frame's uniforms: `views[0]` the camera, then one per shadow-casting light.
+    pub fn prepare(&self, context: &GpuContext, views: &[BodyUniforms]) -> PreparedBody {
+        let stride = self.uniform_stride as usize;
+        let mut bytes = vec![0u8; stride * views.len().max(1)];
+        for (i, view) in views.iter().enumerate() {
+            bytes[i * stride..][..size_of::<BodyUniforms>()]
+                .copy_from_slice(bytemuck::bytes_of(view));
+        }
+        let uniforms = context.resources.buffer_init(
+            &context.device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("preview_body_uniforms"),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            },
+        );
+        let group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview_body"),
+                layout: &self.layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &uniforms,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(size_of::<BodyUniforms>() as u64),
+                    }),
+                }],
+            });
+        PreparedBody {
+            group,
+            stride: self.uniform_stride,
+        }
+    }
+
+    /// Sets view `view`'s uniforms as group 0.
+    pub(crate) fn bind(pass: &mut wgpu::RenderPass<'_>, prepared: &PreparedBody, view: usize) {
+        pass.set_bind_group(
+            0,
+            &prepared.group,
+            &[(view as u64 * prepared.stride) as u32],
+        );
+    }
+
+    /// Draws `body` lit, seen by the camera (`views[0]`); groups 1 and 2 are set by the caller.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, prepared: &PreparedBody, body: &GpuBody) {
+        if let (Some((_, pipeline)), false) = (&self.pipeline, body.is_empty()) {
+            pass.set_pipeline(pipeline);
+            Self::bind(pass, prepared, 0);
+            body.draw(pass);
         }
     }
 }

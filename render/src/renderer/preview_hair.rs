@@ -1,44 +1,71 @@
-//! Hair ribbons (`shaders/preview_hair.wgsl`): every strand segment a camera-facing quad
-//! with eq. 5-6 tangents (CPU mirror: `hairloom_core::runtime::preview_hair`), Kajiya-Kay
-//! shading and a root-to-tip colour, read from the strand vertices of one batch.
+//! Hair ribbons (`shaders/preview_hair.wgsl`, with `shared/ribbon.wgsl`): every strand
+//! segment a viewer-facing quad with eq. 5-6 tangents (CPU mirror:
+//! `hairloom_core::runtime::preview_hair`), lit by the scene through the modules its effects
+//! name ([`crate::renderer::scene_lighting::hair_shader`]). The same draw bindings (group 0)
+//! serve the shadow passes ([`crate::renderer::hair_shadow`]): one uniform buffer holds every
+//! view (the camera, then each shadow-casting light) of every batch of a frame.
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 use crate::device::GpuContext;
-use crate::renderer::{uniform_entry, view_pipeline};
+use crate::renderer::scene_lighting::{ActiveEffects, ShaderKey, hair_shader};
+use crate::renderer::{PipelineSpec, pipeline, uniform_entry, view_color_target, view_depth};
+use crate::resources::Tracked;
 
-pub const HAIR_SHADER: &str = concat!(
-    include_str!("../../../shaders/shared/strand_run.wgsl"),
-    include_str!("../../../shaders/preview_hair.wgsl")
-);
+/// The default variant's source (Marschner, deep opacity maps, body shadows, dual
+/// scattering): what tests that append an entry point to the hair shader compile.
+pub fn default_hair_shader() -> String {
+    hair_shader(&ShaderKey {
+        shading: hairloom_core::model::scene::Shading::Marschner,
+        opacity_maps: hairloom_core::model::scene::SelfShadowing::DeepOpacityMaps,
+        body_shadows: true,
+        dual_scattering: true,
+    })
+}
 
-/// Keep in sync with `shaders/preview_hair.wgsl` (`HairUniforms`).
+/// Keep in sync with `shaders/shared/ribbon.wgsl` (`HairUniforms`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct HairUniforms {
     pub view_projection: [[f32; 4]; 4],
-    pub camera_position: [f32; 4],
-    pub root_color: [f32; 4],
-    pub tip_color: [f32; 4],
-    /// Ribbon width in model units (x); y, z, w unused.
+    /// xyz: the viewer's position (w = 1) or the unit direction toward an orthographic viewer
+    /// (w = 0).
+    pub eye: [f32; 4],
+    /// x: ribbon width at the root (m); y: world size of a pixel at unit distance
+    /// (perspective) or everywhere (orthographic); z: narrowest ribbon drawn, in pixels; w: 0.
     pub width: [f32; 4],
-    /// The batch's runs: first run (x) and run count (y); z, w unused.
+    /// x, y: the batch's runs (first, count); z: shadow slot; w: 0.
     pub batch: [u32; 4],
 }
 
-/// Pipeline and layout of the ribbons.
-pub struct HairRenderer {
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
-    /// Bytes between two batches' uniforms (the adapter's dynamic-offset alignment).
-    uniform_stride: u64,
+/// Formats of the weighted blended transparency targets.
+pub const OIT_ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const OIT_REVEALAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
+
+struct HairPipelines {
+    key: (ShaderKey, bool),
+    /// Depth only: the nearest ribbon per sample, so the lit pass shades each once.
+    depth: Tracked<wgpu::RenderPipeline>,
+    /// Lit, where the depth pre-pass left this ribbon nearest.
+    main: Tracked<wgpu::RenderPipeline>,
+    /// Width-based coverage: the strands narrower than a pixel, into the OIT targets.
+    oit: Option<Tracked<wgpu::RenderPipeline>>,
 }
 
-/// One frame's ribbon resources: every batch's uniforms in one buffer, one bind group.
+/// The ribbons' bindings and the lit pipelines of the current effects.
+pub struct HairRenderer {
+    draw_layout: wgpu::BindGroupLayout,
+    /// Bytes between two uniform entries (the adapter's dynamic-offset alignment).
+    uniform_stride: u64,
+    sample_count: u32,
+    pipelines: Option<HairPipelines>,
+}
+
+/// One frame's ribbon bindings: every view's uniforms for every batch, one bind group.
 pub struct PreparedHair {
     group: wgpu::BindGroup,
     stride: u64,
+    batch_count: usize,
 }
 
 impl HairRenderer {
@@ -54,10 +81,10 @@ impl HairRenderer {
             },
             count: None,
         };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("preview_hair"),
             entries: &[
-                // Dynamic offset: one uniform buffer holds every batch of a frame.
+                // Dynamic offset: one uniform buffer holds every view and batch of a frame.
                 uniform_entry(0, size_of::<HairUniforms>(), true),
                 storage(1, 16),
                 storage(
@@ -66,54 +93,162 @@ impl HairRenderer {
                 ),
             ],
         });
-        let pipeline = view_pipeline(
-            context,
-            "preview_hair",
-            HAIR_SHADER,
-            &layout,
-            &[],
-            sample_count,
-        );
         let alignment = device.limits().min_uniform_buffer_offset_alignment as u64;
         Self {
-            pipeline,
-            layout,
+            draw_layout,
             uniform_stride: (size_of::<HairUniforms>() as u64).div_ceil(alignment) * alignment,
+            sample_count,
+            pipelines: None,
         }
     }
 
-    /// The uniforms of `batch_count` batches (`base` with each batch's run range, from
-    /// `batches`) and one bind group over them, the strand vertices and the runs.
+    /// Group 0 of every pipeline that draws ribbons.
+    pub fn draw_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.draw_layout
+    }
+
+    /// Makes the lit pipelines for `effects` unless they exist (the previous ones are freed).
+    pub fn ensure(
+        &mut self,
+        context: &GpuContext,
+        effects: &ActiveEffects,
+        scene_layout: &wgpu::BindGroupLayout,
+        effects_layout: Option<&wgpu::BindGroupLayout>,
+    ) {
+        let key = (effects.shader_key(), effects.width_oit);
+        if self.pipelines.as_ref().is_some_and(|p| p.key == key) {
+            return;
+        }
+        self.pipelines = None;
+        let source = hair_shader(&key.0);
+        let mut groups = vec![&self.draw_layout, scene_layout];
+        groups.extend(effects_layout);
+        let depth = pipeline(
+            context,
+            &PipelineSpec {
+                label: "preview_hair_depth",
+                source: &source,
+                groups: &groups,
+                buffers: &[],
+                vertex_entry: "vs_main",
+                fragment_entry: Some("fs_depth"),
+                // The view's colour target, untouched (the pass has it attached).
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: crate::view::COLOR_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::empty(),
+                })],
+                depth: Some(view_depth(true)),
+                sample_count: self.sample_count,
+            },
+        );
+        let main = pipeline(
+            context,
+            &PipelineSpec {
+                label: "preview_hair",
+                source: &source,
+                groups: &groups,
+                buffers: &[],
+                vertex_entry: "vs_main",
+                fragment_entry: Some("fs_main"),
+                targets: &view_color_target(),
+                depth: Some(wgpu::DepthStencilState {
+                    depth_compare: Some(wgpu::CompareFunction::Equal),
+                    ..view_depth(false)
+                }),
+                sample_count: self.sample_count,
+            },
+        );
+        let oit = key.1.then(|| {
+            let add = wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            };
+            let reveal = wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::Zero,
+                dst_factor: wgpu::BlendFactor::OneMinusSrc,
+                operation: wgpu::BlendOperation::Add,
+            };
+            pipeline(
+                context,
+                &PipelineSpec {
+                    label: "preview_hair_oit",
+                    source: &source,
+                    groups: &groups,
+                    buffers: &[],
+                    vertex_entry: "vs_main",
+                    fragment_entry: Some("fs_oit"),
+                    targets: &[
+                        Some(wgpu::ColorTargetState {
+                            format: OIT_ACCUMULATION_FORMAT,
+                            blend: Some(wgpu::BlendState {
+                                color: add,
+                                alpha: add,
+                            }),
+                            write_mask: wgpu::ColorWrites::ALL,
+                        }),
+                        Some(wgpu::ColorTargetState {
+                            format: OIT_REVEALAGE_FORMAT,
+                            blend: Some(wgpu::BlendState {
+                                color: reveal,
+                                alpha: reveal,
+                            }),
+                            write_mask: wgpu::ColorWrites::ALL,
+                        }),
+                    ],
+                    // Behind opaque strands and the body; transparent strands do not hide
+                    // each other.
+                    depth: Some(view_depth(false)),
+                    sample_count: self.sample_count,
+                },
+            )
+        });
+        self.pipelines = Some(HairPipelines {
+            key,
+            depth,
+            main,
+            oit,
+        });
+    }
+
+    /// The uniforms of every view in `views` (each with its own view, eye and width) for
+    /// every batch of `batches` (their run ranges), and one bind group over them, the strand
+    /// vertices and the runs.
     pub fn prepare(
         &self,
         context: &GpuContext,
-        base: &HairUniforms,
+        views: &[HairUniforms],
         batches: &[[u32; 2]],
         strands: &wgpu::Buffer,
         runs: &wgpu::Buffer,
     ) -> PreparedHair {
         let stride = self.uniform_stride as usize;
-        let mut bytes = vec![0u8; stride * batches.len().max(1)];
-        for (i, &[first_run, run_count]) in batches.iter().enumerate() {
-            let uniforms = HairUniforms {
-                batch: [first_run, run_count, 0, 0],
-                ..*base
-            };
-            bytes[i * stride..][..size_of::<HairUniforms>()]
-                .copy_from_slice(bytemuck::bytes_of(&uniforms));
+        let batch_count = batches.len().max(1);
+        let mut bytes = vec![0u8; stride * batch_count * views.len().max(1)];
+        for (v, view) in views.iter().enumerate() {
+            for (b, &[first_run, run_count]) in batches.iter().enumerate() {
+                let uniforms = HairUniforms {
+                    batch: [first_run, run_count, view.batch[2], 0],
+                    ..*view
+                };
+                bytes[(v * batch_count + b) * stride..][..size_of::<HairUniforms>()]
+                    .copy_from_slice(bytemuck::bytes_of(&uniforms));
+            }
         }
-        let uniforms = context
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let uniforms = context.resources.buffer_init(
+            &context.device,
+            &wgpu::util::BufferInitDescriptor {
                 label: Some("preview_hair_uniforms"),
                 contents: &bytes,
                 usage: wgpu::BufferUsages::UNIFORM,
-            });
+            },
+        );
         let group = context
             .device
             .create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview_hair"),
-                layout: &self.layout,
+                layout: &self.draw_layout,
                 entries: &[
                     wgpu::BindGroupEntry {
                         binding: 0,
@@ -136,25 +271,40 @@ impl HairRenderer {
         PreparedHair {
             group,
             stride: self.uniform_stride,
+            batch_count,
         }
     }
 
-    /// Draws batch `batch` (its `segments` segments) into `pass`.
-    pub fn draw(
-        &self,
+    /// Draws batch `batch` (its `segments` segments) of view `view` with `pipeline`; groups
+    /// 1 and 2, when the pipeline has them, are set by the caller.
+    pub fn draw_with(
         pass: &mut wgpu::RenderPass<'_>,
+        pipeline: &wgpu::RenderPipeline,
         prepared: &PreparedHair,
+        view: usize,
         batch: usize,
         segments: u32,
     ) {
         if segments > 0 {
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(
-                0,
-                &prepared.group,
-                &[(batch as u64 * prepared.stride) as u32],
-            );
+            pass.set_pipeline(pipeline);
+            let index = (view * prepared.batch_count + batch) as u64;
+            pass.set_bind_group(0, &prepared.group, &[(index * prepared.stride) as u32]);
             pass.draw(0..segments * 6, 0..1);
         }
+    }
+
+    /// The depth pre-pass pipeline (after [`Self::ensure`]).
+    pub fn depth_pipeline(&self) -> Option<&wgpu::RenderPipeline> {
+        self.pipelines.as_ref().map(|p| &*p.depth)
+    }
+
+    /// The opaque lit pipeline (after [`Self::ensure`]).
+    pub fn main_pipeline(&self) -> Option<&wgpu::RenderPipeline> {
+        self.pipelines.as_ref().map(|p| &*p.main)
+    }
+
+    /// The OIT pipeline, when width-based coverage is on.
+    pub fn oit_pipeline(&self) -> Option<&wgpu::RenderPipeline> {
+        self.pipelines.as_ref().and_then(|p| p.oit.as_deref())
     }
 }

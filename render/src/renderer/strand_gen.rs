@@ -17,6 +17,7 @@ use hairloom_core::runtime::textures::{Precision, RuntimeTextures, Texture3d};
 use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, read_buffer};
+use crate::resources::Tracked;
 
 /// The WGSL source: `shaders/shared/strand_run.wgsl` then `shaders/strand_gen.wgsl`
 /// (validated by naga in `cargo test`).
@@ -128,7 +129,7 @@ pub fn check_adapter_limits(
 
 /// Pipeline and bind-group layout of `strand_gen` (one per device).
 pub struct StrandGenRenderer {
-    pipeline: wgpu::ComputePipeline,
+    pipeline: Tracked<wgpu::ComputePipeline>,
     bind_group_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     float32_filterable: bool,
@@ -194,17 +195,19 @@ pub struct GenerationTiming {
 /// is stored per strand.
 pub struct GpuHair {
     pub position_offset: [f32; 3],
+    /// The five textures, kept so the registry lists them while the hair lives.
+    _textures: Vec<Tracked<wgpu::Texture>>,
     hair_mesh: wgpu::TextureView,
     uv: wgpu::TextureView,
     w: wgpu::TextureView,
     u: wgpu::TextureView,
     v: wgpu::TextureView,
-    bundle_buffer: wgpu::Buffer,
-    samples: wgpu::Buffer,
+    bundle_buffer: Tracked<wgpu::Buffer>,
+    samples: Tracked<wgpu::Buffer>,
     sample_set: u32,
     /// Strands at full detail: bundles × `per_bundle`.
     pub root_count: usize,
-    styling: wgpu::Buffer,
+    styling: Tracked<wgpu::Buffer>,
     /// Bounds of every bundle (block order) for LOD and culling.
     pub bundles: Vec<BundleBounds>,
     /// Roots per bundle (roots are bundle-major).
@@ -219,7 +222,7 @@ fn upload_texture(
     texture: &Texture3d,
     precision: Precision,
     channels: usize,
-) -> (wgpu::TextureView, u64) {
+) -> (Tracked<wgpu::Texture>, wgpu::TextureView, u64) {
     let export_format = TexelFormat::for_precision(precision, channels);
     let format = match export_format {
         TexelFormat::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
@@ -235,16 +238,19 @@ fn upload_texture(
         height: texture.height,
         depth_or_array_layers: texture.depth,
     };
-    let gpu_texture = context.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D3,
-        format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let gpu_texture = context.resources.texture(
+        &context.device,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+    );
     let texel_size = (channels * export_format.bytes_per_channel()) as u32;
     context.queue.write_texture(
         wgpu::TexelCopyTextureInfo {
@@ -261,10 +267,8 @@ fn upload_texture(
         },
         size,
     );
-    (
-        gpu_texture.create_view(&wgpu::TextureViewDescriptor::default()),
-        bytes.len() as u64,
-    )
+    let view = gpu_texture.create_view(&wgpu::TextureViewDescriptor::default());
+    (gpu_texture, view, bytes.len() as u64)
 }
 
 /// One placement per atlas block with its styling index (never empty: a storage buffer
@@ -362,14 +366,17 @@ impl StrandGenRenderer {
             bind_group_layouts: &[Some(&bind_group_layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("strand_gen"),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = context.resources.compute_pipeline(
+            device,
+            &wgpu::ComputePipelineDescriptor {
+                label: Some("strand_gen"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            },
+        );
         let filter = if float32_filterable {
             wgpu::FilterMode::Linear
         } else {
@@ -410,21 +417,22 @@ impl StrandGenRenderer {
         let per_bundle = hair.strands_per_bundle as usize;
         let block_styling = &hair.block_styling;
         let precision = textures.precision;
-        let (hair_mesh, a) =
+        let (t0, hair_mesh, a) =
             upload_texture(context, "hair_mesh", &textures.hair_mesh, precision, 4);
-        let (uv, b) = upload_texture(context, "uv", &textures.uv, precision, 2);
-        let (w, c) = upload_texture(context, "w", &textures.w, precision, 1);
-        let (u, d) = upload_texture(context, "u", &textures.u, precision, 4);
-        let (v, e) = upload_texture(context, "v", &textures.v, precision, 4);
+        let (t1, uv, b) = upload_texture(context, "uv", &textures.uv, precision, 2);
+        let (t2, w, c) = upload_texture(context, "w", &textures.w, precision, 1);
+        let (t3, u, d) = upload_texture(context, "u", &textures.u, precision, 4);
+        let (t4, v, e) = upload_texture(context, "v", &textures.v, precision, 4);
         let buffer = |label: &str, contents: &[u8]| {
-            context
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            context.resources.buffer_init(
+                &context.device,
+                &wgpu::util::BufferInitDescriptor {
                     label: Some(label),
                     contents,
                     // COPY_DST: styling edits rewrite the bundle and styling buffers in place.
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                })
+                },
+            )
         };
         let per_bundle = per_bundle
             .min(samples.quad.len())
@@ -446,6 +454,7 @@ impl StrandGenRenderer {
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         Ok(GpuHair {
             position_offset: textures.position_offset.to_array(),
+            _textures: vec![t0, t1, t2, t3, t4],
             hair_mesh,
             uv,
             w,
@@ -482,13 +491,14 @@ impl StrandGenRenderer {
             context.queue.write_buffer(&gpu.styling, 0, bytes);
         } else {
             gpu.bytes += bytes.len() as u64 - gpu.styling.size();
-            gpu.styling = context
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            gpu.styling = context.resources.buffer_init(
+                &context.device,
+                &wgpu::util::BufferInitDescriptor {
                     label: Some("strand_gen_styling"),
                     contents: bytes,
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                });
+                },
+            );
         }
     }
 
@@ -619,13 +629,16 @@ impl StrandGenRenderer {
     }
 
     /// A scratch buffer for the largest batch of `plan`.
-    pub fn scratch(&self, context: &GpuContext, plan: &FramePlan) -> wgpu::Buffer {
-        context.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("strand_gen_scratch"),
-            size: scratch_bytes(plan),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        })
+    pub fn scratch(&self, context: &GpuContext, plan: &FramePlan) -> Tracked<wgpu::Buffer> {
+        context.resources.buffer(
+            &context.device,
+            &wgpu::BufferDescriptor {
+                label: Some("strand_gen_scratch"),
+                size: scratch_bytes(plan),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            },
+        )
     }
 
     /// Generates every batch of `plan` into one reused scratch buffer and measures the GPU

@@ -122,6 +122,7 @@ impl Viewport {
                         17,
                         hair.bounds,
                         self.orbit.camera(lo, hi),
+                        &state.document().scene,
                     );
                     let plan = gpu.preview.plan(&scene, size[0], size[1]);
                     self.drawn_strands = plan.strands;

@@ -1,0 +1,184 @@
+//! The fibre material resolved for shading: absorption from melanin or colour, and the
+//! per-strand, root-to-tip variation every renderer applies the same way.
+//!
+//! Conversions follow Chiang et al. 2016 ("A Practical and Controllable Hair and Fur Model
+//! for Production Path Tracing") as pbrt-v4 and Blender's Principled Hair use them:
+//! - melanin: `σ_a = c_eu (0.419, 0.697, 1.37) + c_pheo (0.187, 0.4, 1.05)` (d'Eon et al. 2011);
+//! - colour: `σ_a = (ln c / P(β_n))²` with `P(β) = 5.969 − 0.215β + 2.532β² − 10.73β³ +
+//!   5.574β⁴ + 0.245β⁵` (Chiang eq. 9, fitted so that a thick mass of hair shows colour `c`),
+//!   and its exact inverse `c = exp(−√σ_a · P(β_n))`.
+
+use crate::model::scene::{HairMaterial, Pigment};
+
+/// Eumelanin absorption per unit concentration (per unit fibre radius).
+pub const EUMELANIN_SIGMA_A: [f64; 3] = [0.419, 0.697, 1.37];
+/// Pheomelanin absorption per unit concentration.
+pub const PHEOMELANIN_SIGMA_A: [f64; 3] = [0.187, 0.4, 1.05];
+
+/// Colours are clamped into `[MIN_COLOR, MAX_COLOR]` before the logarithm: 0 would be infinite
+/// absorption and 1 no absorption at all (the fit is undefined at both).
+pub const MIN_COLOR: f64 = 1e-4;
+pub const MAX_COLOR: f64 = 0.9999;
+
+/// Chiang et al. 2016 eq. 9's polynomial in the azimuthal roughness.
+pub fn color_polynomial(beta_n: f64) -> f64 {
+    let b = beta_n;
+    5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b.powi(3) + 5.574 * b.powi(4) + 0.245 * b.powi(5)
+}
+
+pub fn sigma_a_from_melanin(eumelanin: f64, pheomelanin: f64) -> [f64; 3] {
+    std::array::from_fn(|c| {
+        eumelanin.max(0.0) * EUMELANIN_SIGMA_A[c] + pheomelanin.max(0.0) * PHEOMELANIN_SIGMA_A[c]
+    })
+}
+
+/// The absorption that shows `rgb` on a thick mass of hair with azimuthal roughness `beta_n`.
+pub fn sigma_a_from_color(rgb: [f64; 3], beta_n: f64) -> [f64; 3] {
+    let p = color_polynomial(beta_n);
+    rgb.map(|c| {
+        let c = if c.is_finite() { c } else { MIN_COLOR };
+        (c.clamp(MIN_COLOR, MAX_COLOR).ln() / p).powi(2)
+    })
+}
+
+/// The inverse of [`sigma_a_from_color`]: the colour a thick mass of hair with this
+/// absorption shows. Used for ambient light and for Kajiya-Kay's base colour.
+pub fn color_from_sigma_a(sigma_a: [f64; 3], beta_n: f64) -> [f64; 3] {
+    let p = color_polynomial(beta_n);
+    sigma_a.map(|s| (-s.max(0.0).sqrt() * p).exp())
+}
+
+/// A material ready for shading, in the numbers both renderers use.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fibre {
+    /// Absorption at the root, per unit fibre radius.
+    pub sigma_a_root: [f64; 3],
+    pub tip_absorption_factor: f64,
+    pub strand_absorption_variation: f64,
+    /// Roughness clamped into the model's stable range (see [`MIN_ROUGHNESS`]).
+    pub beta_m: f64,
+    pub beta_n: f64,
+    pub alpha_rad: f64,
+    pub eta: f64,
+}
+
+/// Roughness below this is raised to it: the longitudinal lobe's variance goes as β², and
+/// below about 0.02 it would need more than f32's range in the shader (a perfectly smooth
+/// fibre is a delta, which no rasteriser or path tracer can sample from a light).
+pub const MIN_ROUGHNESS: f64 = 0.02;
+/// Index of refraction below this is raised to it (η = 1 makes Fresnel 0 and γ_t
+/// undefined at grazing angles).
+pub const MIN_IOR: f64 = 1.001;
+
+impl Fibre {
+    pub fn new(material: &HairMaterial) -> Self {
+        let beta_n = (material.azimuthal_roughness as f64).clamp(MIN_ROUGHNESS, 1.0);
+        let sigma_a_root = match &material.pigment {
+            Pigment::Melanin {
+                eumelanin,
+                pheomelanin,
+            } => sigma_a_from_melanin(*eumelanin as f64, *pheomelanin as f64),
+            Pigment::Color { rgb } => sigma_a_from_color(rgb.map(f64::from), beta_n),
+            Pigment::Absorption { sigma_a } => sigma_a.map(|s| (s as f64).max(0.0)),
+        };
+        Self {
+            sigma_a_root,
+            tip_absorption_factor: (material.tip_absorption_factor as f64).max(0.0),
+            strand_absorption_variation: (material.strand_absorption_variation as f64)
+                .clamp(0.0, 1.0),
+            beta_m: (material.longitudinal_roughness as f64).clamp(MIN_ROUGHNESS, 1.0),
+            beta_n,
+            alpha_rad: (material.cuticle_tilt_deg as f64).to_radians(),
+            eta: (material.ior as f64).max(MIN_IOR),
+        }
+    }
+
+    /// Absorption at fraction `along` of a strand (0 root, 1 tip) for a strand whose random
+    /// value is `xi` in `[0, 1)`: `σ_a,root · lerp(1, tip, along) · (1 + variation (2ξ − 1))`.
+    pub fn sigma_a(&self, along: f64, xi: f64) -> [f64; 3] {
+        let along = along.clamp(0.0, 1.0);
+        let scale = (1.0 + (self.tip_absorption_factor - 1.0) * along)
+            * (1.0 + self.strand_absorption_variation * (2.0 * xi - 1.0));
+        self.sigma_a_root.map(|s| s * scale.max(0.0))
+    }
+
+    /// The absorption of an average strand at mid-length: what precomputed tables (dual
+    /// scattering, forward transmittance) are made from.
+    pub fn sigma_a_mean(&self) -> [f64; 3] {
+        self.sigma_a(0.5, 0.5)
+    }
+
+    /// The colour a thick mass of this hair shows at `sigma_a`.
+    pub fn color(&self, sigma_a: [f64; 3]) -> [f64; 3] {
+        color_from_sigma_a(sigma_a, self.beta_n)
+    }
+}
+
+/// The random value of a strand's absorption variation, from its root index (bundle ×
+/// roots per bundle + sample: stable when LOD drops strands). The shaders' `strand_shading_random`.
+pub fn strand_shading_random(root: u32) -> f64 {
+    use crate::strands::random::{hash_to_unit, pcg_hash};
+    hash_to_unit(pcg_hash(SHADING_SALT ^ root))
+}
+
+/// Keeps the shading random values apart from the styling ones drawn from the same roots.
+pub const SHADING_SALT: u32 = 0x5A3D_1E77;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colour_and_absorption_round_trip() {
+        for beta_n in [0.02, 0.1, 0.3, 0.6, 1.0] {
+            for rgb in [
+                [0.5, 0.3, 0.1],
+                [0.9, 0.8, 0.6],
+                [0.02, 0.015, 0.01],
+                [0.2, 0.2, 0.2],
+            ] {
+                let sigma_a = sigma_a_from_color(rgb, beta_n);
+                let back = color_from_sigma_a(sigma_a, beta_n);
+                for c in 0..3 {
+                    assert!(
+                        (back[c] - rgb[c]).abs() < 1e-12,
+                        "β_n {beta_n} {rgb:?} -> {sigma_a:?} -> {back:?}"
+                    );
+                }
+                // Darker colours absorb more.
+                assert!(
+                    sigma_a[0] < sigma_a[2] || rgb[0] <= rgb[2],
+                    "{rgb:?} {sigma_a:?}"
+                );
+            }
+        }
+        // The extremes are clamped, never infinite or NaN.
+        for rgb in [[0.0; 3], [1.0; 3], [f64::NAN, -1.0, 2.0]] {
+            let sigma_a = sigma_a_from_color(rgb, 0.3);
+            assert!(
+                sigma_a.iter().all(|s| s.is_finite() && *s >= 0.0),
+                "{sigma_a:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn melanin_darkens_and_tips_follow_the_factor() {
+        let blond = sigma_a_from_melanin(0.3, 0.0);
+        let black = sigma_a_from_melanin(8.0, 0.0);
+        assert!((0..3).all(|c| blond[c] < black[c]));
+        let fibre = Fibre::new(&HairMaterial {
+            tip_absorption_factor: 0.5,
+            strand_absorption_variation: 0.0,
+            ..HairMaterial::default()
+        });
+        let root = fibre.sigma_a(0.0, 0.3);
+        let tip = fibre.sigma_a(1.0, 0.3);
+        for c in 0..3 {
+            assert!((tip[c] - 0.5 * root[c]).abs() < 1e-12);
+        }
+        // Brown hair is reddish: it absorbs blue most.
+        let color = fibre.color(root);
+        assert!(color[0] > color[1] && color[1] > color[2], "{color:?}");
+    }
+}

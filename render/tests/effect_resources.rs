@@ -1,0 +1,222 @@
+//! Effects on demand: per scene, exactly the GPU resources its effects need exist — an effect
+//! the scene does not name has no pipeline, texture or buffer — and taking an effect away
+//! frees its resources (the registry of `hairloom_render::resources` lists what is alive).
+
+use std::collections::BTreeSet;
+
+use glam::Vec3;
+use hairloom_core::model::scene::{
+    Coverage, Effects, MultipleScattering, Scene, SelfShadowing, Shading,
+};
+use hairloom_core::runtime::frame_plan::LodSettings;
+use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_render::device::headless_for_test;
+use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
+use hairloom_render::renderer::preview_body::GpuBody;
+use hairloom_render::renderer::strand_gen::StrandGenRenderer;
+
+/// Every label an optional effect may own, by effect.
+const OPACITY_SHADOW_MAPS: &[&str] = &["opacity_layers", "hair_shadow_opacity"];
+const DEEP_OPACITY_MAPS: &[&str] = &[
+    "opacity_layers",
+    "hair_shadow_opacity",
+    "first_hair_depth",
+    "hair_shadow_depth",
+];
+const BODY_SHADOWS: &[&str] = &["body_shadow_depth", "body_shadow"];
+const DUAL_SCATTERING: &[&str] = &["dual_scattering_profile", "dual_scattering_lobes"];
+const WIDTH_OIT: &[&str] = &[
+    "oit_accumulation",
+    "oit_revealage",
+    "oit_composite",
+    "preview_hair_oit",
+];
+
+fn effect_labels() -> BTreeSet<&'static str> {
+    [
+        OPACITY_SHADOW_MAPS,
+        DEEP_OPACITY_MAPS,
+        BODY_SHADOWS,
+        DUAL_SCATTERING,
+        WIDTH_OIT,
+    ]
+    .concat()
+    .into_iter()
+    .collect()
+}
+
+/// The effect labels `effects` must have alive (the default scene has shadow-casting lights
+/// and the sample has a body).
+fn expected(effects: &Effects) -> BTreeSet<&'static str> {
+    let mut labels = BTreeSet::new();
+    match effects.self_shadowing {
+        SelfShadowing::None => {}
+        SelfShadowing::OpacityShadowMaps => labels.extend(OPACITY_SHADOW_MAPS),
+        SelfShadowing::DeepOpacityMaps => labels.extend(DEEP_OPACITY_MAPS),
+    }
+    if effects.body_shadows {
+        labels.extend(BODY_SHADOWS);
+    }
+    if effects.multiple_scattering == MultipleScattering::DualScattering
+        && effects.shading == Shading::Marschner
+    {
+        labels.extend(DUAL_SCATTERING);
+    }
+    if effects.coverage == Coverage::WidthOit {
+        labels.extend(WIDTH_OIT);
+    }
+    labels
+}
+
+#[test]
+fn each_scene_has_exactly_the_resources_its_effects_need() {
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/samples/head_curly.hairloom");
+    let document = hairloom_core::io::project::load(&path)
+        .expect("sample")
+        .document;
+    let hair = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 4,
+            ..RuntimeOptions::default()
+        },
+    );
+    let generator = StrandGenRenderer::new(&context);
+    let gpu_hair = generator.upload(&context, &hair).expect("upload");
+    let body = GpuBody::upload(&context, &hair.body);
+    let renderer = PreviewRenderer::new(&context);
+    let (lo, hi) = hair.textures.hair_bounds().expect("hair");
+    let camera = Camera::framing(lo, hi, Vec3::new(0.75, 0.25, 1.0));
+    let base = Scene {
+        effects: Effects {
+            shadow_resolution: 128,
+            ..Effects::default()
+        },
+        ..Scene::default()
+    };
+    let none = base.effects.none();
+    let alone = |f: fn(&mut Effects)| {
+        let mut effects = none.clone();
+        f(&mut effects);
+        effects
+    };
+    let scenes = [
+        none.clone(),
+        alone(|e| e.shading = Shading::Marschner),
+        alone(|e| e.self_shadowing = SelfShadowing::OpacityShadowMaps),
+        alone(|e| e.self_shadowing = SelfShadowing::DeepOpacityMaps),
+        alone(|e| e.body_shadows = true),
+        // Dual scattering extends the Marschner model: alone (with Kajiya-Kay) it runs nothing.
+        alone(|e| e.multiple_scattering = MultipleScattering::DualScattering),
+        alone(|e| {
+            e.shading = Shading::Marschner;
+            e.multiple_scattering = MultipleScattering::DualScattering;
+        }),
+        alone(|e| e.coverage = Coverage::WidthOit),
+        base.effects.all(),
+        Effects {
+            opacity_layers: 16,
+            ..base.effects.all()
+        },
+        none.clone(),
+    ];
+    let mut bytes_by_scene = Vec::new();
+    for effects in scenes {
+        let lighting = Scene {
+            effects: effects.clone(),
+            ..base.clone()
+        };
+        let scene = default_scene(
+            &body,
+            HairSource::Generated {
+                generator: &generator,
+                hair: &gpu_hair,
+                filtering: Filtering::Exact,
+                lod: LodSettings::default(),
+            },
+            17,
+            (lo, hi),
+            camera,
+            &lighting,
+        );
+        let plan = renderer.plan(&scene, 48, 48);
+        let pixels = renderer
+            .render(&context, &scene, &plan, 48, 48)
+            .unwrap_or_else(|e| panic!("{:?}: {e}", effects.names()));
+        assert_eq!(pixels.len(), 48 * 48 * 4);
+        let live = context.resources.live_labels();
+        let present: BTreeSet<&str> = effect_labels()
+            .into_iter()
+            .filter(|label| live.contains_key(*label))
+            .collect();
+        assert_eq!(
+            present,
+            expected(&effects),
+            "effects {:?}: live {:?}",
+            effects.names(),
+            live
+        );
+        // Always there: the frame's own renderers and the hair.
+        for label in [
+            "preview_hair",
+            "preview_body",
+            "strand_gen",
+            "hair_mesh",
+            "view_color",
+        ] {
+            assert!(live.contains_key(label), "{label} missing: {live:?}");
+        }
+        bytes_by_scene.push(context.resources.live_bytes());
+    }
+    // All effects with 16 layers hold more than none; back to none frees it all again.
+    let (first, last) = (bytes_by_scene[0], *bytes_by_scene.last().expect("scenes"));
+    assert!(bytes_by_scene[9] > bytes_by_scene[8] && bytes_by_scene[8] > first);
+    assert_eq!(first, last, "turning every effect off frees what they made");
+}
+
+#[test]
+fn a_shadow_map_above_the_adapter_limit_is_refused_by_name() {
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let body = GpuBody::empty();
+    let renderer = PreviewRenderer::new(&context);
+    let limit = context.device.limits().max_texture_dimension_2d;
+    let lighting = Scene {
+        effects: Effects {
+            shadow_resolution: limit + 1,
+            ..Effects::default()
+        },
+        ..Scene::default()
+    };
+    let scene = default_scene(
+        &body,
+        HairSource::Vertices(&[[0.0, 0.0, 0.0, 0.0], [0.0, 0.1, 0.0, 1.0]]),
+        2,
+        (Vec3::splat(-0.1), Vec3::splat(0.1)),
+        Camera::framing(Vec3::splat(-0.1), Vec3::splat(0.1), Vec3::Z),
+        &lighting,
+    );
+    let plan = renderer.plan(&scene, 16, 16);
+    let error = renderer
+        .render(&context, &scene, &plan, 16, 16)
+        .expect_err("above the limit");
+    let message = error.to_string();
+    assert!(
+        message.contains("scene.effects.shadow_resolution")
+            && message.contains("max_texture_dimension_2d"),
+        "{message}"
+    );
+    assert!(
+        !context
+            .resources
+            .live_labels()
+            .contains_key("opacity_layers"),
+        "nothing was made"
+    );
+}

@@ -1,0 +1,9 @@
+// Marschner shading without multiple scattering: single scattering (`hair_single`),
+// attenuated by the forward transmittance of the `n` fibres between the point and the light.
+fn hair_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, sigma_a: vec3<f32>) -> vec3<f32> {
+    return hair_bsdf(wo, wi, h, sigma_a);
+}
+
+fn hair_radiance(wo: vec3<f32>, wi: vec3<f32>, single: vec3<f32>, n: f32) -> vec3<f32> {
+    return single * pow(scene.forward_transmittance.rgb, vec3<f32>(n));
+}

@@ -1,0 +1,94 @@
+// The scene every lit shader receives (group 1): lights, shadow views, the fibre model's
+// constants, dual-scattering constants, the body's colour. WGSL has no #include:
+// render/src/renderer/scene_lighting.rs prepends this file to each lit shader.
+// Keep in sync with core/src/light/scene_uniforms.rs (`SceneUniforms`, `GpuLight`,
+// `GpuShadowView`); CPU mirror of tonemap: core/src/light/mod.rs.
+
+struct SceneLight {
+    // xyz: unit direction toward the light (w = 0) or its position in metres (w = 1).
+    vector: vec4<f32>,
+    // rgb: colour × intensity; w: the light's shadow slot, or −1 when it casts none.
+    radiance: vec4<f32>,
+}
+
+struct ShadowView {
+    view_projection: mat4x4<f32>,
+    // x: near, y: far (distances from the light), z: 1 for a perspective view, w: texel size.
+    params: vec4<f32>,
+    // x: the depth the opacity layers span, y: the lookup bias (metres), z, w: unused.
+    layers: vec4<f32>,
+}
+
+struct SceneUniforms {
+    lights: array<SceneLight, 8>,
+    shadows: array<ShadowView, 2>,
+    // x: light count, y: opacity layers, z: self-shadowing (0 none, 1 OSM, 2 DOM), w: coverage.
+    counts: vec4<u32>,
+    // rgb: ambient radiance; w: exposure.
+    ambient: vec4<f32>,
+    background: vec4<f32>,
+    // rgb: absorption at the root; w: tip factor.
+    sigma_a: vec4<f32>,
+    // x: per-strand variation, y: η, z: azimuthal logistic scale s, w: β_n.
+    fibre: vec4<f32>,
+    lobe_variance: vec4<f32>,
+    tilt_sin: vec4<f32>,
+    tilt_cos: vec4<f32>,
+    forward_transmittance: vec4<f32>,
+    ds_lobe_shift: vec4<f32>,
+    ds_lobe_variance: vec4<f32>,
+    body_color: vec4<f32>,
+}
+
+@group(1) @binding(0) var<uniform> scene: SceneUniforms;
+
+// Unit direction from `world` toward light `i`.
+fn light_direction(i: u32, world: vec3<f32>) -> vec3<f32> {
+    let light = scene.lights[i];
+    if light.vector.w == 0.0 {
+        return light.vector.xyz;
+    }
+    let offset = light.vector.xyz - world;
+    let length_squared = dot(offset, offset);
+    if !(length_squared > 1e-18) {
+        return vec3<f32>(0.0, 1.0, 0.0);
+    }
+    return offset * inverseSqrt(length_squared);
+}
+
+// Irradiance of light `i` at `world` (point lights fall off with the squared distance).
+fn light_irradiance(i: u32, world: vec3<f32>) -> vec3<f32> {
+    let light = scene.lights[i];
+    if light.vector.w == 0.0 {
+        return light.radiance.rgb;
+    }
+    let offset = light.vector.xyz - world;
+    return light.radiance.rgb / max(dot(offset, offset), 1e-12);
+}
+
+fn light_shadow_slot(i: u32) -> i32 {
+    return i32(scene.lights[i].radiance.w);
+}
+
+// The ACES filmic fit (Narkowicz 2015) of radiance × exposure.
+fn tonemap(radiance: vec3<f32>) -> vec3<f32> {
+    let x = max(radiance * scene.ambient.w, vec3<f32>(0.0));
+    return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// The colour a thick mass of hair with absorption `sigma_a` shows (Chiang et al. 2016,
+// inverse of eq. 9; mirror: core/src/light/material.rs `color_from_sigma_a`).
+fn hair_color(sigma_a: vec3<f32>) -> vec3<f32> {
+    let b = scene.fibre.w;
+    let p = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b * b * b + 5.574 * b * b * b * b
+        + 0.245 * b * b * b * b * b;
+    return exp(-sqrt(max(sigma_a, vec3<f32>(0.0))) * p);
+}
+
+// Absorption at fraction `along` of a strand with random value `xi`
+// (mirror: core/src/light/material.rs `Fibre::sigma_a`).
+fn strand_sigma_a(along: f32, xi: f32) -> vec3<f32> {
+    let t = clamp(along, 0.0, 1.0);
+    let scale = (1.0 + (scene.sigma_a.w - 1.0) * t) * (1.0 + scene.fibre.x * (2.0 * xi - 1.0));
+    return scene.sigma_a.rgb * max(scale, 0.0);
+}
