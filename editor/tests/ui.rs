@@ -1104,3 +1104,144 @@ fn the_outliner_scrolls_to_a_bundle_picked_elsewhere() {
     harness.run_steps(12);
     harness.get_by_label(&label);
 }
+
+#[test]
+fn scene_panel_switches_effects_and_edits_the_material_with_undo() {
+    use hairloom_core::model::scene::{MultipleScattering, SelfShadowing, Shading};
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    assert_eq!(original.scene.effects.shading, Shading::Marschner);
+    harness.get_by_label("Scene").click();
+    harness.run();
+    // Body shadows off: one step, named; the document's scene changed and nothing else.
+    harness.get_by_label("Body shadows").click();
+    harness.run();
+    let changed = harness.state().state.document().clone();
+    assert!(!changed.scene.effects.body_shadows);
+    assert_eq!(changed.hair_mesh, original.hair_mesh);
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .project
+            .history
+            .undo
+            .last()
+            .map(|c| c.label()),
+        Some("Scene: body shadows")
+    );
+    // Dual scattering (on with Marschner shading) switches off.
+    harness.get_by_label("Dual scattering").click();
+    harness.run();
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .document()
+            .scene
+            .effects
+            .multiple_scattering,
+        MultipleScattering::None
+    );
+    // A material slider: one step per change.
+    harness
+        .get_by_role_and_label(Role::Slider, "Longitudinal roughness")
+        .set_value_accesskit(0.45);
+    harness.run();
+    assert!(
+        (harness
+            .state()
+            .state
+            .document()
+            .scene
+            .material
+            .longitudinal_roughness
+            - 0.45)
+            .abs()
+            < 1e-6
+    );
+    // A typed value outside the valid range is refused with the field named.
+    harness
+        .get_by_role_and_label(Role::Slider, "Longitudinal roughness")
+        .set_value_accesskit(-0.5);
+    harness.run();
+    assert!(
+        (harness
+            .state()
+            .state
+            .document()
+            .scene
+            .material
+            .longitudinal_roughness
+            - 0.45)
+            .abs()
+            < 1e-6
+    );
+    assert!(
+        harness
+            .state()
+            .state
+            .message
+            .contains("scene.material.longitudinal_roughness"),
+        "{}",
+        harness.state().state.message
+    );
+    assert_eq!(harness.state().state.project.history.undo.len(), 3);
+    // Undo walks back through the scene edits to the original scene.
+    for _ in 0..3 {
+        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+        harness.run();
+    }
+    assert_eq!(harness.state().state.document().scene, original.scene);
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .document()
+            .scene
+            .effects
+            .self_shadowing,
+        SelfShadowing::DeepOpacityMaps
+    );
+    // The costs are not measured without a GPU, and the panel says so.
+    harness.get_by_label("costs not measured yet");
+}
+
+#[test]
+fn scene_panel_adds_aims_and_removes_lights() {
+    let mut harness = harness();
+    harness.get_by_label("Scene").click();
+    harness.run();
+    let lights = harness.state().state.document().scene.lights.len();
+    harness.get_by_label("Add light").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().scene.lights.len(),
+        lights + 1
+    );
+    // The first light (open by default) aims by its elevation slider.
+    harness
+        .get_all_by_role_and_label(Role::Slider, "Elevation")
+        .next()
+        .expect("an elevation slider")
+        .set_value_accesskit(80.0);
+    harness.run();
+    let scene = harness.state().state.document().scene.clone();
+    let hairloom_core::model::scene::LightSource::Directional { to_light } = scene.lights[0].source
+    else {
+        panic!("the key light is directional");
+    };
+    let length = to_light.iter().map(|c| c * c).sum::<f32>().sqrt();
+    assert!(
+        (to_light[1] / length - 80f32.to_radians().sin()).abs() < 1e-3,
+        "{to_light:?}"
+    );
+    harness
+        .get_all_by_label("Remove light")
+        .next()
+        .expect("a remove button")
+        .click();
+    harness.run();
+    assert_eq!(harness.state().state.document().scene.lights.len(), lights);
+    scene.validate().expect("every edit leaves a valid scene");
+}

@@ -101,3 +101,127 @@ pub fn measure_accuracy(
     }
     Ok(rows)
 }
+
+/// What one effect configuration costs, measured on a frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EffectCost {
+    pub name: &'static str,
+    pub effects: hairloom_core::model::scene::Effects,
+    /// Median wall time of the frame, submission to idle (after a warm-up that makes the
+    /// effect's maps, tables and pipelines).
+    pub frame_ms: f64,
+    /// Summed GPU pass time by timestamps, where the adapter has them.
+    pub gpu_ms: Option<f64>,
+    /// GPU bytes alive while this configuration is drawn (registry of the device).
+    pub live_bytes: u64,
+    pub strands: usize,
+}
+
+/// The frame with no optional effect, each effect alone, the scene's own combination and
+/// everything: what `hairloom bench effects` measures.
+pub fn effect_configurations(
+    scene: &hairloom_core::model::scene::Effects,
+) -> Vec<(&'static str, hairloom_core::model::scene::Effects)> {
+    let none = scene.none();
+    let list = [
+        ("nothing (Kajiya-Kay)", "none"),
+        ("marschner", "marschner"),
+        ("opacity-shadow-maps", "opacity-shadow-maps"),
+        ("deep-opacity-maps", "deep-opacity-maps"),
+        ("body-shadows", "body-shadows"),
+        ("marschner + dual-scattering", "marschner,dual-scattering"),
+        ("width-oit", "width-oit"),
+    ];
+    let mut configurations: Vec<_> = list
+        .iter()
+        .map(|(name, effects)| {
+            (
+                *name,
+                none.parse_list(effects).expect("the configurations parse"),
+            )
+        })
+        .collect();
+    configurations.push(("the scene's own", scene.clone()));
+    configurations.push(("everything", scene.all()));
+    configurations
+}
+
+/// The scene's effects with one effect switched (on when it is off, off when it is on), for
+/// each effect: what the editor's Scene panel measures to put a cost beside each switch.
+/// Self-shadowing switches between the scene's kind (or deep opacity maps) and none.
+pub fn toggled_effects(
+    effects: &hairloom_core::model::scene::Effects,
+) -> Vec<(&'static str, hairloom_core::model::scene::Effects)> {
+    use hairloom_core::model::scene::{Coverage, MultipleScattering, SelfShadowing, Shading};
+    let mut list = Vec::new();
+    let mut e = effects.clone();
+    e.shading = match e.shading {
+        Shading::KajiyaKay => Shading::Marschner,
+        Shading::Marschner => Shading::KajiyaKay,
+    };
+    list.push(("marschner", e));
+    let mut e = effects.clone();
+    e.self_shadowing = match e.self_shadowing {
+        SelfShadowing::None => SelfShadowing::DeepOpacityMaps,
+        _ => SelfShadowing::None,
+    };
+    list.push(("self-shadowing", e));
+    let mut e = effects.clone();
+    e.body_shadows = !e.body_shadows;
+    list.push(("body-shadows", e));
+    let mut e = effects.clone();
+    e.multiple_scattering = match e.multiple_scattering {
+        MultipleScattering::None => MultipleScattering::DualScattering,
+        MultipleScattering::DualScattering => MultipleScattering::None,
+    };
+    list.push(("dual-scattering", e));
+    let mut e = effects.clone();
+    e.coverage = match e.coverage {
+        Coverage::Msaa => Coverage::WidthOit,
+        Coverage::WidthOit => Coverage::Msaa,
+    };
+    list.push(("width-oit", e));
+    list
+}
+
+/// Times `scene` with each of `configurations` in place of its effects, one renderer for all
+/// (effect resources come and go between rows, as when an artist switches them): median of
+/// `runs` frames after a warm-up.
+pub fn effect_costs(
+    context: &GpuContext,
+    scene: &crate::preview::PreviewScene,
+    configurations: &[(&'static str, hairloom_core::model::scene::Effects)],
+    width: u32,
+    height: u32,
+    runs: usize,
+) -> Result<Vec<EffectCost>, crate::preview::PreviewError> {
+    let renderer = crate::preview::PreviewRenderer::new(context);
+    let mut costs = Vec::with_capacity(configurations.len());
+    for (name, effects) in configurations {
+        let lighting = hairloom_core::model::scene::Scene {
+            effects: effects.clone(),
+            ..scene.lighting.clone()
+        };
+        let scene = crate::preview::PreviewScene {
+            lighting: &lighting,
+            hair: scene.hair,
+            ..*scene
+        };
+        renderer.time_frame(context, &scene, width, height)?;
+        let mut timings = Vec::with_capacity(runs.max(1));
+        for _ in 0..runs.max(1) {
+            timings.push(renderer.time_frame(context, &scene, width, height)?);
+        }
+        timings.sort_by(|a, b| a.wall_ms.total_cmp(&b.wall_ms));
+        let median = timings[timings.len() / 2];
+        costs.push(EffectCost {
+            name,
+            effects: effects.clone(),
+            frame_ms: median.wall_ms,
+            gpu_ms: median.gpu_ms,
+            live_bytes: context.resources.live_bytes(),
+            strands: median.strands,
+        });
+    }
+    Ok(costs)
+}

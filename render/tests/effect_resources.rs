@@ -220,3 +220,70 @@ fn a_shadow_map_above_the_adapter_limit_is_refused_by_name() {
         "nothing was made"
     );
 }
+
+#[test]
+fn each_effect_is_measured_switched_on_and_off() {
+    use hairloom_render::measure::{effect_costs, toggled_effects};
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/samples/teapot_fur.hairloom");
+    let document = hairloom_core::io::project::load(&path)
+        .expect("sample")
+        .document;
+    let hair = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 2,
+            ..RuntimeOptions::default()
+        },
+    );
+    let generator = StrandGenRenderer::new(&context);
+    let gpu_hair = generator.upload(&context, &hair).expect("upload");
+    let body = GpuBody::upload(&context, &hair.body);
+    let (lo, hi) = hair.textures.hair_bounds().expect("hair");
+    let lighting = Scene {
+        effects: Effects {
+            shadow_resolution: 64,
+            ..Effects::default()
+        },
+        ..document.scene.clone()
+    };
+    let scene = default_scene(
+        &body,
+        HairSource::Generated {
+            generator: &generator,
+            hair: &gpu_hair,
+            filtering: Filtering::Exact,
+            lod: LodSettings::default(),
+        },
+        9,
+        (lo, hi),
+        Camera::framing(lo, hi, Vec3::new(0.3, 0.5, 1.0)),
+        &lighting,
+    );
+    let mut configurations = vec![("the scene", lighting.effects.clone())];
+    configurations.extend(toggled_effects(&lighting.effects));
+    let costs = effect_costs(&context, &scene, &configurations, 32, 32, 1).expect("measured");
+    let names: Vec<&str> = costs.iter().map(|c| c.name).collect();
+    assert_eq!(
+        names,
+        vec![
+            "the scene",
+            "marschner",
+            "self-shadowing",
+            "body-shadows",
+            "dual-scattering",
+            "width-oit"
+        ]
+    );
+    for cost in &costs {
+        assert!(cost.frame_ms.is_finite() && cost.frame_ms > 0.0, "{cost:?}");
+        assert!(cost.strands > 0);
+    }
+    // Switching self-shadowing off (the scene has it on) frees its maps: less memory.
+    assert!(costs[2].live_bytes < costs[0].live_bytes, "{costs:?}");
+    // Switching width-based coverage on adds its targets.
+    assert!(costs[5].live_bytes > costs[0].live_bytes, "{costs:?}");
+}

@@ -8,6 +8,7 @@ pub mod history_panel;
 pub mod layout_panel;
 pub mod outliner_panel;
 pub mod recovery;
+pub mod scene_panel;
 pub mod state;
 pub mod styling_panel;
 pub mod tools_panel;
@@ -25,6 +26,7 @@ use history_panel::HistoryPanel;
 use layout_panel::LayoutPanel;
 use outliner_panel::OutlinerPanel;
 use recovery::{AUTOSAVE_SECONDS, PendingRecovery, Recovery};
+use scene_panel::ScenePanel;
 use styling_panel::StylingPanel;
 use tools_panel::ToolsPanel;
 use viewport::Viewport;
@@ -64,6 +66,7 @@ pub enum Pane {
     Outliner,
     History,
     Styling,
+    Scene,
     Strands,
     Layout,
 }
@@ -76,6 +79,7 @@ impl Pane {
             Self::Outliner => "Outliner",
             Self::History => "History",
             Self::Styling => "Styling",
+            Self::Scene => "Scene",
             Self::Strands => "Strands & accuracy",
             Self::Layout => "uv / w layout",
         }
@@ -102,9 +106,10 @@ pub fn default_layout() -> egui_tiles::Tree<Pane> {
     }
     let viewport = tiles.insert_pane(Pane::Viewport);
     let styling = tiles.insert_pane(Pane::Styling);
+    let scene = tiles.insert_pane(Pane::Scene);
     let strands = tiles.insert_pane(Pane::Strands);
     let layout = tiles.insert_pane(Pane::Layout);
-    let right = tiles.insert_tab_tile(vec![styling, strands, layout]);
+    let right = tiles.insert_tab_tile(vec![styling, scene, strands, layout]);
     let root = tiles.insert_horizontal_tile(vec![left, viewport, right]);
     if let Some(egui_tiles::Tile::Container(egui_tiles::Container::Linear(linear))) =
         tiles.get_mut(root)
@@ -119,6 +124,7 @@ pub fn default_layout() -> egui_tiles::Tree<Pane> {
 pub struct HairloomApp {
     pub state: EditorState,
     pub styling: StylingPanel,
+    pub scene: ScenePanel,
     pub history: HistoryPanel,
     pub tools: ToolsPanel,
     pub outliner: OutlinerPanel,
@@ -165,6 +171,7 @@ impl HairloomApp {
             recovery,
             state,
             styling: StylingPanel::default(),
+            scene: ScenePanel::default(),
             history: HistoryPanel::default(),
             tools: ToolsPanel::default(),
             outliner: OutlinerPanel::default(),
@@ -786,6 +793,7 @@ struct PaneUi<'a> {
     outliner: &'a mut OutlinerPanel,
     history: &'a mut HistoryPanel,
     styling: &'a mut StylingPanel,
+    scene: &'a mut ScenePanel,
     layout: &'a mut LayoutPanel,
     viewport: &'a mut Viewport,
 }
@@ -814,6 +822,7 @@ impl egui_tiles::Behavior<Pane> for PaneUi<'_> {
                     Pane::Outliner => self.outliner.ui(ui, self.state),
                     Pane::History => self.history.ui(ui, self.state),
                     Pane::Styling => self.styling.ui(ui, self.state),
+                    Pane::Scene => self.scene.ui(ui, self.state, self.viewport),
                     Pane::Strands => self.viewport.settings_ui(ui, self.state),
                     Pane::Layout => self.layout.ui(ui, self.state),
                     Pane::Viewport => {}
@@ -879,6 +888,7 @@ impl eframe::App for HairloomApp {
                 outliner: &mut self.outliner,
                 history: &mut self.history,
                 styling: &mut self.styling,
+                scene: &mut self.scene,
                 layout: &mut self.layout_panel,
                 viewport: &mut self.viewport,
             };

@@ -70,6 +70,33 @@ pub enum Which {
         #[arg(long)]
         project: Option<std::path::PathBuf>,
     },
+    /// Accuracy against time of the lighting effects: each head sample near, middle and far,
+    /// path-traced on the CPU as the reference, and on the GPU in every configuration; the
+    /// ꟻLIP error and frame time of each (CSV and PNG grids).
+    Shading {
+        /// Samples to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("head_long_wavy"), String::from("head_curly"), String::from("head_short_straight")])]
+        samples: Vec<String>,
+        /// Picture side in pixels.
+        #[arg(long, default_value_t = 256)]
+        size: u32,
+        #[arg(long, default_value_t = 16)]
+        strands_per_bundle: u32,
+        /// Path-tracing samples per pixel of the reference.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        #[arg(long, default_value_t = 24)]
+        bounces: u32,
+        /// Time budget of each reference picture (it stops after the pass that passes it).
+        #[arg(long, default_value_t = 600.0)]
+        max_seconds: f64,
+        /// Measured GPU runs per row after one warm-up (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Folder for shading.csv and the PNG grids.
+        #[arg(long, default_value = "target/bench")]
+        out: std::path::PathBuf,
+    },
     /// What each lighting effect costs: the frame with none, each alone, the scene's own
     /// combination and everything, at 10K and 100K strands (time and GPU memory).
     Effects {
@@ -96,6 +123,25 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             strands,
         } => super::accuracy::run(project, &out, strands.max(1)),
         Which::Cpu { project } => super::accuracy::cpu(project),
+        Which::Shading {
+            samples,
+            size,
+            strands_per_bundle,
+            spp,
+            bounces,
+            max_seconds,
+            runs,
+            out,
+        } => super::bench_shading::run(&super::bench_shading::ShadingSettings {
+            samples,
+            size,
+            strands_per_bundle: strands_per_bundle.clamp(1, 4096),
+            samples_per_pixel: spp.max(1),
+            max_bounces: bounces,
+            max_seconds,
+            runs: runs.max(1),
+            out,
+        }),
         Which::Effects {
             project,
             strands,

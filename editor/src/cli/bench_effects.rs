@@ -6,49 +6,14 @@
 
 use std::path::PathBuf;
 
-use hairloom_core::model::scene::{
-    Coverage, Effects, MultipleScattering, Scene, SelfShadowing, Shading,
-};
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::{GpuContext, describe};
-use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
+use hairloom_render::measure::{effect_configurations, effect_costs};
+use hairloom_render::preview::{Camera, HairSource, default_scene};
 use hairloom_render::renderer::preview_body::GpuBody;
 use hairloom_render::renderer::strand_gen::StrandGenRenderer;
-
-/// The configurations of one strand count: a name and its effects.
-pub fn configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
-    let none = scene.none();
-    let with = |f: fn(&mut Effects)| {
-        let mut effects = none.clone();
-        f(&mut effects);
-        effects
-    };
-    vec![
-        ("nothing (Kajiya-Kay)", none.clone()),
-        ("marschner", with(|e| e.shading = Shading::Marschner)),
-        (
-            "opacity-shadow-maps",
-            with(|e| e.self_shadowing = SelfShadowing::OpacityShadowMaps),
-        ),
-        (
-            "deep-opacity-maps",
-            with(|e| e.self_shadowing = SelfShadowing::DeepOpacityMaps),
-        ),
-        ("body-shadows", with(|e| e.body_shadows = true)),
-        (
-            "marschner + dual-scattering",
-            with(|e| {
-                e.shading = Shading::Marschner;
-                e.multiple_scattering = MultipleScattering::DualScattering;
-            }),
-        ),
-        ("width-oit", with(|e| e.coverage = Coverage::WidthOit)),
-        ("the scene's own", scene.clone()),
-        ("everything", scene.all()),
-    ]
-}
 
 pub fn run(
     project: Option<PathBuf>,
@@ -97,47 +62,41 @@ pub fn run(
             .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
         let pad = (hi - lo) * 0.05;
         let camera = Camera::framing(lo - pad, hi + pad, glam::Vec3::new(0.75, 0.25, 1.0));
-        // One renderer for the whole table: effect resources come and go between rows, the
-        // way the editor switches them.
-        let renderer = PreviewRenderer::new(&context);
-        let mut baseline: Option<(f64, u64)> = None;
-        for (name, effects) in configurations(&document.scene.effects) {
-            let lighting = Scene {
-                effects,
-                ..document.scene.clone()
-            };
-            let scene = default_scene(
-                &body,
-                HairSource::Generated {
-                    generator: &generator,
-                    hair: &gpu_hair,
-                    filtering: Filtering::Exact,
-                    lod: LodSettings {
-                        enabled: false,
-                        ..LodSettings::default()
-                    },
+        let scene = default_scene(
+            &body,
+            HairSource::Generated {
+                generator: &generator,
+                hair: &gpu_hair,
+                filtering: Filtering::Exact,
+                lod: LodSettings {
+                    enabled: false,
+                    ..LodSettings::default()
                 },
-                17,
-                (lo, hi),
-                camera,
-                &lighting,
-            );
-            let timing = super::bench::median_timing(
-                || renderer.time_frame(&context, &scene, width, height),
-                runs,
-                |t| t.wall_ms,
-            )?;
-            let bytes = context.resources.live_bytes();
-            let (base_ms, base_bytes) = *baseline.get_or_insert((timing.wall_ms, bytes));
+            },
+            17,
+            (lo, hi),
+            camera,
+            &document.scene,
+        );
+        let costs = effect_costs(
+            &context,
+            &scene,
+            &effect_configurations(&document.scene.effects),
+            width,
+            height,
+            runs,
+        )?;
+        let (base_ms, base_bytes) = (costs[0].frame_ms, costs[0].live_bytes);
+        for cost in &costs {
             println!(
                 "{:>8} {:<28} {:>10.1} {:>10.1} {:>7.2}× {:>11.2} {:>11}",
                 gpu_hair.root_count,
-                name,
-                timing.wall_ms,
-                timing.wall_ms - base_ms,
-                timing.wall_ms / base_ms.max(1e-9),
-                bytes.saturating_sub(base_bytes) as f64 / 1e6,
-                timing.strands,
+                cost.name,
+                cost.frame_ms,
+                cost.frame_ms - base_ms,
+                cost.frame_ms / base_ms.max(1e-9),
+                cost.live_bytes.saturating_sub(base_bytes) as f64 / 1e6,
+                cost.strands,
             );
         }
     }

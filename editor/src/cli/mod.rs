@@ -14,6 +14,7 @@ use hairloom_core::runtime::textures::Precision;
 mod accuracy;
 mod bench;
 mod bench_effects;
+mod bench_shading;
 mod render;
 
 use hairloom_editor::files;

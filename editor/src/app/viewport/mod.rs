@@ -17,6 +17,8 @@
 //! live.
 
 mod camera;
+mod effect_costs;
+pub use effect_costs::EffectCostResult;
 mod input;
 mod overlay;
 mod paint;

@@ -1,0 +1,315 @@
+//! `hairloom bench shading`: accuracy against time of the lighting effects. Each head sample
+//! at near, middle and far framing (the hair's bounding sphere spans 60%, 20% and 2% of the
+//! picture's height, as in seed 001's Fig. 5) is path-traced on the CPU
+//! ([`hairloom_core::light::reference_render`]: the f64 reference strands as fibres, the same
+//! fibre model, exact shadows, many bounces) and rendered on the GPU in every configuration;
+//! each GPU picture's ꟻLIP error against the reference (NVIDIA's metric, `nv-flip`) sits beside
+//! its frame time. Writes `shading.csv` and one PNG grid per sample and framing (reference and
+//! configurations on top, ꟻLIP maps below).
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::{DVec3, Vec3};
+use hairloom_core::light::reference_render::{
+    Fibres, ReferenceCamera, ReferenceSettings, render_reference,
+};
+use hairloom_core::model::scene::{Effects, Scene};
+use hairloom_core::runtime::frame_plan::LodSettings;
+use hairloom_core::runtime::hair::{DEFAULT_SAMPLE_SEED, RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::strands::reference::{StrandOptions, generate_parallel};
+use hairloom_render::device::{GpuContext, describe};
+use hairloom_render::preview::{
+    Camera, HairSource, PreviewRenderer, default_scene, default_strand_width_m,
+};
+use hairloom_render::renderer::preview_body::GpuBody;
+use hairloom_render::renderer::strand_gen::StrandGenRenderer;
+
+/// The framings: name and the fraction of the picture's height the hair (its box's largest
+/// side) spans.
+pub const FRAMINGS: [(&str, f32); 3] = [("near", 0.6), ("middle", 0.2), ("far", 0.02)];
+
+/// The GPU configurations, each adding to the one before it (seed 001's comparison), and
+/// everything with width-based coverage.
+pub fn configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
+    let none = scene.none();
+    let list = [
+        ("kajiya-kay", "none"),
+        ("marschner", "marschner"),
+        (
+            "+ opacity shadow maps",
+            "marschner,opacity-shadow-maps,body-shadows",
+        ),
+        (
+            "+ deep opacity maps",
+            "marschner,deep-opacity-maps,body-shadows",
+        ),
+        (
+            "+ dual scattering",
+            "marschner,deep-opacity-maps,body-shadows,dual-scattering",
+        ),
+        ("+ width-based OIT", "all"),
+    ];
+    list.iter()
+        .map(|(name, effects)| {
+            (
+                *name,
+                none.parse_list(effects).expect("the configurations parse"),
+            )
+        })
+        .collect()
+}
+
+pub struct ShadingSettings {
+    pub samples: Vec<String>,
+    pub size: u32,
+    pub strands_per_bundle: u32,
+    pub samples_per_pixel: u32,
+    pub max_bounces: u32,
+    pub max_seconds: f64,
+    pub runs: usize,
+    pub out: PathBuf,
+}
+
+/// A camera that shows the sphere `(center, radius)` spanning `fraction` of the picture's
+/// height, looking from `direction`.
+pub fn framing_camera(center: Vec3, radius: f32, direction: Vec3, fraction: f32) -> Camera {
+    let fov_y_rad = 30f32.to_radians();
+    let distance = radius / (0.5 * fov_y_rad * fraction).tan();
+    Camera {
+        eye: center + direction.normalize() * distance,
+        target: center,
+        up: Vec3::Y,
+        fov_y_rad,
+    }
+}
+
+pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
+    let context = GpuContext::new_headless()?;
+    let generator = StrandGenRenderer::new(&context);
+    let renderer = PreviewRenderer::new(&context);
+    std::fs::create_dir_all(&settings.out)?;
+    let csv_path = settings.out.join("shading.csv");
+    let mut csv = std::fs::File::create(&csv_path)?;
+    writeln!(
+        csv,
+        "sample,framing,configuration,flip_mean,frame_ms,reference_seconds,reference_spp"
+    )?;
+    println!("Shading accuracy against time: ꟻLIP against the CPU path tracer, GPU frame time");
+    println!("adapter: {}", describe(&context.adapter_info));
+    println!("machine: {}", super::machine());
+    println!(
+        "{}x{} pixels, {} strands per bundle, reference {} samples per pixel, {} bounces",
+        settings.size,
+        settings.size,
+        settings.strands_per_bundle,
+        settings.samples_per_pixel,
+        settings.max_bounces
+    );
+    println!(
+        "{:<20} {:<7} {:<24} {:>8} {:>10}",
+        "sample", "framing", "configuration", "ꟻLIP", "frame ms"
+    );
+    let size = settings.size.max(16);
+    for name in &settings.samples {
+        let path = hairloom_core::samples::default_sample_path()
+            .with_file_name(format!("{name}.hairloom"));
+        let document = hairloom_core::io::project::load(&path)?.document;
+        let hair = RuntimeHair::from_document(
+            &document,
+            &RuntimeOptions {
+                strands_per_bundle: settings.strands_per_bundle,
+                ..RuntimeOptions::default()
+            },
+        );
+        let gpu_hair = generator.upload(&context, &hair)?;
+        let body = GpuBody::upload(&context, &hair.body);
+        let (lo, hi) = hair
+            .textures
+            .hair_bounds()
+            .ok_or_else(|| anyhow::anyhow!("{name}: no bundle grows hair"))?;
+        let width_m = default_strand_width_m(lo, hi);
+        let fibres = reference_fibres(&document, settings.strands_per_bundle, width_m as f64);
+        // The framings size the hair by its largest side.
+        let (center, radius) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
+        for (framing, fraction) in FRAMINGS {
+            let camera = framing_camera(center, radius, Vec3::new(0.75, 0.25, 1.0), fraction);
+            let started = Instant::now();
+            let reference = render_reference(
+                &fibres,
+                &document.body,
+                &document.scene,
+                &ReferenceCamera {
+                    eye: camera.eye.as_dvec3(),
+                    target: camera.target.as_dvec3(),
+                    up: camera.up.as_dvec3(),
+                    fov_y_rad: camera.fov_y_rad as f64,
+                    width: size,
+                    height: size,
+                },
+                &ReferenceSettings {
+                    samples_per_pixel: settings.samples_per_pixel,
+                    max_bounces: settings.max_bounces,
+                    max_seconds: settings.max_seconds,
+                    ..ReferenceSettings::default()
+                },
+            );
+            let reference_seconds = started.elapsed().as_secs_f64();
+            let background: [u8; 4] = reference.pixels[..4].try_into().unwrap_or([0; 4]);
+            let mut row_images = vec![reference.pixels.clone()];
+            let black: Vec<u8> = [0, 0, 0, 255].repeat((size * size) as usize);
+            let mut flip_images = vec![black];
+            for (configuration, effects) in configurations(&document.scene.effects) {
+                let lighting = Scene {
+                    effects,
+                    ..document.scene.clone()
+                };
+                let scene = default_scene(
+                    &body,
+                    HairSource::Generated {
+                        generator: &generator,
+                        hair: &gpu_hair,
+                        filtering: Filtering::Exact,
+                        lod: LodSettings::default(),
+                    },
+                    17,
+                    (lo, hi),
+                    camera,
+                    &lighting,
+                );
+                let plan = renderer.plan(&scene, size, size);
+                let pixels = renderer.render(&context, &scene, &plan, size, size)?;
+                let timing = super::bench::median_timing(
+                    || renderer.time_frame(&context, &scene, size, size),
+                    settings.runs,
+                    |t| t.wall_ms,
+                )?;
+                let (mean, map) = flip(&reference.pixels, &pixels, size, background);
+                println!(
+                    "{:<20} {:<7} {:<24} {:>8.4} {:>10.1}",
+                    name, framing, configuration, mean, timing.wall_ms
+                );
+                writeln!(
+                    csv,
+                    "{name},{framing},{configuration},{mean:.5},{:.2},{reference_seconds:.1},{}",
+                    timing.wall_ms, reference.samples_per_pixel
+                )?;
+                row_images.push(pixels);
+                flip_images.push(map);
+            }
+            let grid_path = settings.out.join(format!("shading_{name}_{framing}.png"));
+            write_grid(&grid_path, &[row_images, flip_images], size)?;
+            println!(
+                "{:<20} {:<7} reference: {} spp in {reference_seconds:.1} s ({:.1} M rays) -> {}",
+                name,
+                framing,
+                reference.samples_per_pixel,
+                reference.rays as f64 / 1e6,
+                grid_path.display()
+            );
+        }
+    }
+    println!("CSV: {}", csv_path.display());
+    Ok(())
+}
+
+/// The document's f64 reference strands as fibres, with their root indices.
+pub fn reference_fibres(
+    document: &hairloom_core::Document,
+    strands_per_bundle: u32,
+    width_m: f64,
+) -> Fibres {
+    let options = StrandOptions {
+        strands_per_bundle,
+        vertices_log2: 4,
+        sample_seed: DEFAULT_SAMPLE_SEED,
+        ..StrandOptions::default()
+    };
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let strands = generate_parallel(document, &options, threads);
+    let mut fibres = Fibres {
+        width_m,
+        ..Fibres::default()
+    };
+    let mut index_in_bundle = 0u32;
+    let mut last_bundle = u32::MAX;
+    for strand in &strands {
+        if strand.bundle != last_bundle {
+            (last_bundle, index_in_bundle) = (strand.bundle, 0);
+        }
+        let points: Vec<DVec3> = strand.points.clone();
+        fibres.push(
+            &points,
+            strand.bundle * strands_per_bundle + index_in_bundle,
+        );
+        index_in_bundle += 1;
+    }
+    fibres
+}
+
+/// Mean ꟻLIP of `test` against `reference` (RGBA8, sRGB) over the screen-space box of what
+/// the reference draws (pixels unlike `background`: hair and body, as seed 001 reports it), and
+/// the whole error map (magma, RGBA8).
+pub fn flip(reference: &[u8], test: &[u8], size: u32, background: [u8; 4]) -> (f32, Vec<u8>) {
+    let rgb =
+        |rgba: &[u8]| -> Vec<u8> { rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let reference = nv_flip::FlipImageRgb8::with_data(size, size, &rgb(reference));
+    let test = nv_flip::FlipImageRgb8::with_data(size, size, &rgb(test));
+    let drawn: Vec<(u32, u32)> = reference
+        .to_vec()
+        .chunks(3)
+        .enumerate()
+        .filter(|(_, p)| p[..] != background[..3])
+        .map(|(i, _)| (i as u32 % size, i as u32 / size))
+        .collect();
+    let error = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    let values = error.to_vec();
+    let (x0, x1) = (
+        drawn.iter().map(|p| p.0).min(),
+        drawn.iter().map(|p| p.0).max(),
+    );
+    let (y0, y1) = (
+        drawn.iter().map(|p| p.1).min(),
+        drawn.iter().map(|p| p.1).max(),
+    );
+    let mean = match (x0, x1, y0, y1) {
+        (Some(x0), Some(x1), Some(y0), Some(y1)) => {
+            let mut sum = 0.0f64;
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    sum += values[(y * size + x) as usize] as f64;
+                }
+            }
+            (sum / ((x1 - x0 + 1) * (y1 - y0 + 1)) as f64) as f32
+        }
+        _ => nv_flip::FlipPool::from_image(&error).mean(),
+    };
+    let map = error.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    let rgba = map
+        .chunks(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    (mean, rgba)
+}
+
+/// Writes rows of `size × size` RGBA8 pictures side by side as one PNG.
+fn write_grid(path: &Path, rows: &[Vec<Vec<u8>>], size: u32) -> anyhow::Result<()> {
+    let columns = rows.iter().map(Vec::len).max().unwrap_or(0) as u32;
+    let mut grid = image::RgbaImage::new(columns * size, rows.len() as u32 * size);
+    for (r, row) in rows.iter().enumerate() {
+        for (c, pixels) in row.iter().enumerate() {
+            let tile = image::RgbaImage::from_raw(size, size, pixels.clone())
+                .ok_or_else(|| anyhow::anyhow!("a {size}x{size} picture"))?;
+            image::imageops::replace(
+                &mut grid,
+                &tile,
+                (c as u32 * size) as i64,
+                (r as u32 * size) as i64,
+            );
+        }
+    }
+    grid.save(path)?;
+    Ok(())
+}
