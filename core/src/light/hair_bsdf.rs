@@ -156,7 +156,7 @@ impl HairBsdf {
     fn lobe_pdf(&self, ap: &[[f64; 3]; P_MAX + 1]) -> [f64; P_MAX + 1] {
         let weights = ap.map(|a| (a[0] + a[1] + a[2]) / 3.0);
         let total: f64 = weights.iter().sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return [1.0 / (P_MAX + 1) as f64; P_MAX + 1];
         }
         weights.map(|w| w / total)
@@ -469,8 +469,8 @@ mod tests {
                 DVec3::Y,
                 DVec3::Z,
                 -DVec3::Z,
-                direction(1.5707963, 0.0),
-                direction(-1.5707963, 2.0),
+                direction(std::f64::consts::FRAC_PI_2, 0.0),
+                direction(-std::f64::consts::FRAC_PI_2, 2.0),
             ];
             for &wo in &directions {
                 for &wi in &directions {

@@ -99,7 +99,7 @@ impl ShadowView {
     /// of `world`; `None` outside the view.
     pub fn project(&self, world: Vec3) -> Option<Vec3> {
         let clip = self.view_projection * world.extend(1.0);
-        if !(clip.w > 0.0) {
+        if clip.w.is_nan() || clip.w <= 0.0 {
             return None;
         }
         let ndc = clip.xyz() / clip.w;

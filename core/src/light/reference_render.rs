@@ -389,7 +389,7 @@ impl<'a> World<'a> {
             // Russian roulette after a few bounces keeps long paths unbiased and cheap.
             if bounce >= 3 {
                 let survive = throughput.iter().copied().fold(0.0, f64::max).min(0.95);
-                if !(rng.next_f64() < survive) {
+                if rng.next_f64() >= survive {
                     break;
                 }
                 throughput = throughput.map(|t| t / survive);
@@ -442,7 +442,7 @@ fn intersect_segment(
 ) -> Option<(f64, f64)> {
     let axis = b - a;
     let length = axis.length();
-    if !(length > 0.0) || !(radius > 0.0) {
+    if length.is_nan() || length <= 0.0 || radius.is_nan() || radius <= 0.0 {
         return None;
     }
     let u = axis / length;
@@ -607,13 +607,14 @@ pub fn render_reference(
     }
     let exposure = scene.exposure as f64;
     let mut pixels = Vec::with_capacity(pixel_count * 4);
-    for i in 0..pixel_count {
-        // A pixel's value: the mean of its samples' tone-mapped colours, with samples that
-        // left at once showing the background (as the GPU's MSAA resolve averages them).
-        let hit_fraction = 1.0 - background[i] as f64 / done as f64;
-        for c in 0..3 {
+    for (total, &missed) in sum.iter().zip(&background) {
+        // A pixel's value: the tone-mapped mean radiance of the samples that hit something,
+        // blended with the background by the fraction that missed (as the GPU's MSAA resolve
+        // blends coverage).
+        let hit_fraction = 1.0 - missed as f64 / done as f64;
+        for (c, channel) in total.iter().enumerate() {
             let mean_radiance = if hit_fraction > 0.0 {
-                sum[i][c] / (done as f64 * hit_fraction)
+                channel / (done as f64 * hit_fraction)
             } else {
                 0.0
             };

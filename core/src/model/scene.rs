@@ -417,7 +417,7 @@ fn check_direction(path: &str, v: [f32; 3]) -> Result<(), InvalidScene> {
         return Err(invalid(path, format!("{v:?} is not a finite direction")));
     }
     let length_squared: f32 = v.iter().map(|c| c * c).sum();
-    if !(length_squared > 1e-12) {
+    if length_squared.is_nan() || length_squared <= 1e-12 {
         return Err(invalid(path, "a direction cannot have zero length"));
     }
     Ok(())
@@ -582,7 +582,8 @@ mod tests {
 
     #[test]
     fn bad_values_are_refused_with_the_field_named() {
-        let cases: Vec<(Box<dyn Fn(&mut Scene)>, &str)> = vec![
+        type Change = Box<dyn Fn(&mut Scene)>;
+        let cases: Vec<(Change, &str)> = vec![
             (
                 Box::new(|s| s.material.longitudinal_roughness = -0.1),
                 "material.longitudinal_roughness",

@@ -70,27 +70,19 @@ pub fn parse_view(view: &str, scene: &Scene) -> anyhow::Result<Vec3> {
     if let Some(preset) = scene.camera(view) {
         return Ok(Vec3::from(preset.direction));
     }
-    Ok(match view {
-        custom => {
-            let parts: Vec<f32> = custom
-                .split(',')
-                .map(|p| p.trim().parse())
-                .collect::<Result<_, _>>()
-                .with_context(|| format!("--view {custom:?}"))?;
-            let [x, y, z] = parts[..] else {
-                let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
-                bail!(
-                    "--view takes a camera of the scene ({}) or x,y,z",
-                    names.join(", ")
-                )
-            };
-            let direction = Vec3::new(x, y, z);
-            if !direction.is_finite() || direction.length() == 0.0 {
-                bail!("--view {custom:?} is not a direction");
-            }
-            direction
-        }
-    })
+    let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+    let parts: Option<Vec<f32>> = view.split(',').map(|p| p.trim().parse().ok()).collect();
+    let Some([x, y, z]) = parts.as_deref().and_then(|p| <[f32; 3]>::try_from(p).ok()) else {
+        bail!(
+            "--view {view:?}: takes a camera of the scene ({}) or x,y,z",
+            names.join(", ")
+        )
+    };
+    let direction = Vec3::new(x, y, z);
+    if !direction.is_finite() || direction.length() == 0.0 {
+        bail!("--view {view:?} is not a direction");
+    }
+    Ok(direction)
 }
 
 /// The runtime asset a render draws: a runtime bundle folder (the game's input) as stored,
