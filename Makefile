@@ -85,9 +85,13 @@ lint: toolchain
 samples: toolchain
 	$(CARGO) run -p hairloom-core --example make_samples
 
-bench: toolchain
+# The benchmarks of BENCHMARKS.md. The lighting ones are long on a software adapter (about
+# half an hour for `effects` at 100K strands and `shading` on lavapipe, 2 cores).
+bench: toolchain gpu-deps
 	$(CARGO) build --release -p hairloom-editor
 	./target/release/hairloom bench interior
+	./target/release/hairloom bench effects --size 800x800 --runs 1
+	./target/release/hairloom bench shading --size 320 --spp 64 --runs 1
 
 # Every fuzz target (project load, glTF import, runtime bundle, KTX2) for FUZZ_SECONDS each,
 # optimised with overflow checks on (profile `fuzz`). A panic saves its input under

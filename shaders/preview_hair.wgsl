@@ -3,9 +3,10 @@
 // with dual scattering (light/radiance_*.wgsl) — with the fibres in front of each point
 // from the opacity maps (`hairs_in_front`) and the body's shadow (`body_visibility`); the
 // renderer prepends the modules the scene's effects name and stubs for the rest.
-// `fs_main` draws opaque ribbons; with width-based coverage, strands narrower than a pixel
-// go to `fs_oit` instead, which accumulates weighted blended transparency (McGuire & Bavoil
-// 2013; composited by oit_composite.wgsl).
+// `fs_main` draws opaque ribbons where the depth pre-pass (`fs_depth`) left them nearest;
+// with width-based coverage, strands narrower than a pixel stay out of the pre-pass (so the
+// lit pass never sees them) and go to `fs_oit` instead, which accumulates weighted blended
+// transparency (McGuire & Bavoil 2013; composited by oit_composite.wgsl).
 
 struct VertexOutput {
     // Invariant: the depth pre-pass and the colour pass must compute the same depth.
@@ -36,11 +37,26 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOutput {
     return out;
 }
 
+// Gauss-Legendre nodes and weights over h ∈ [−1, 1] (weights summing to 1) for 1, 2 and 3
+// points.
+const GL_NODES = array<vec3<f32>, 3>(
+    vec3<f32>(0.0, 0.0, 0.0),
+    vec3<f32>(-0.5773503, 0.5773503, 0.0),
+    vec3<f32>(-0.7745967, 0.0, 0.7745967),
+);
+const GL_WEIGHTS = array<vec3<f32>, 3>(
+    vec3<f32>(1.0, 0.0, 0.0),
+    vec3<f32>(0.5, 0.5, 0.0),
+    vec3<f32>(0.2777778, 0.4444444, 0.2777778),
+);
+
 // Single scattering of a fibre: a fibre a few pixels wide or more is shaded at the pixel's
 // own offset h; a thinner one covers every offset within its pixel, so it takes the average
-// over h (three-point Gauss-Legendre), which is also what a path tracer's pixel averages to.
-// Blended between 2 and 4 pixels so nothing pops as a strand's width changes. (Multiple
-// scattering does not depend on h: `hair_radiance` adds it once.)
+// over h by Gauss-Legendre with the scene's number of points (`effects.fibre_offsets`: each
+// point is one more evaluation per light; `hairloom bench shading` measures what each buys),
+// which is what a path tracer's pixel averages to. Blended between 2 and 4 pixels so nothing
+// pops as a strand's width changes. (Multiple scattering does not depend on h:
+// `hair_radiance` adds it once.)
 fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: vec3<f32>) -> vec3<f32> {
     let averaged = clamp(2.0 - 0.5 * width_px, 0.0, 1.0);
     var result = vec3<f32>(0.0);
@@ -48,10 +64,13 @@ fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: ve
         result += (1.0 - averaged) * hair_single(wo, wi, clamp(h, -1.0, 1.0), sigma_a);
     }
     if averaged > 0.0 {
-        let outer = 0.7745967;
-        let average = (5.0 / 18.0) * hair_single(wo, wi, -outer, sigma_a)
-            + (8.0 / 18.0) * hair_single(wo, wi, 0.0, sigma_a)
-            + (5.0 / 18.0) * hair_single(wo, wi, outer, sigma_a);
+        let points = clamp(scene.quality.x, 1u, 3u);
+        let nodes = GL_NODES[points - 1u];
+        let weights = GL_WEIGHTS[points - 1u];
+        var average = vec3<f32>(0.0);
+        for (var k = 0u; k < points; k++) {
+            average += weights[k] * hair_single(wo, wi, nodes[k], sigma_a);
+        }
         result += averaged * average;
     }
     return result;
@@ -94,11 +113,10 @@ fn fs_depth(in: VertexOutput) {
     }
 }
 
+// The lit pass. No `discard` here: a shader that may discard loses the early depth test, and
+// the early test against the pre-pass is what keeps shading to one fragment per sample.
 @fragment
 fn fs_main(in: VertexOutput) -> @location(0) vec4<f32> {
-    if scene.counts.w == 1u && in.coverage < 0.999 {
-        discard;
-    }
     return vec4<f32>(shade_hair(in), 1.0);
 }
 

@@ -38,6 +38,8 @@ struct SceneUniforms {
     ds_lobe_shift: vec4<f32>,
     ds_lobe_variance: vec4<f32>,
     body_color: vec4<f32>,
+    // x: Gauss-Legendre offsets averaged across thin fibres (1 to 3).
+    quality: vec4<u32>,
 }
 
 @group(1) @binding(0) var<uniform> scene: SceneUniforms;

@@ -719,6 +719,10 @@ mod tests {
             written.sort();
             assert_eq!(on_disk, written);
             let loaded = load_runtime_bundle(&dir).expect("loads");
+            assert_eq!(
+                loaded.scene, document.scene,
+                "the scene travels with the bundle"
+            );
             let built = RuntimeTextures::build(&document.hair_mesh, precision);
             assert_eq!(loaded.textures.hair_mesh, built.hair_mesh);
             assert_eq!(
@@ -751,6 +755,13 @@ mod tests {
         std::fs::write(&manifest_path, serde_json::to_vec(&value).expect("json")).expect("write");
         let error = load_runtime_bundle(&dir).expect_err("newer version");
         assert!(error.to_string().contains("format_version 99"), "{error}");
+        // The scene travels with the bundle and is validated like a project's.
+        let mut value: serde_json::Value = serde_json::from_slice(&original).expect("json");
+        assert!(value["scene"]["material"]["pigment"].is_object());
+        value["scene"]["material"]["ior"] = (-2.0).into();
+        std::fs::write(&manifest_path, serde_json::to_vec(&value).expect("json")).expect("write");
+        let error = load_runtime_bundle(&dir).expect_err("bad scene");
+        assert!(error.to_string().contains("scene.material.ior"), "{error}");
         std::fs::write(&manifest_path, &original).expect("restore");
         let manifest: Manifest = serde_json::from_slice(&original).expect("manifest");
         let w_file = dir.join(&manifest.w.file);

@@ -65,6 +65,8 @@ pub struct SceneUniforms {
     pub ds_lobe_variance: [f32; 4],
     /// rgb: the body's albedo.
     pub body_color: [f32; 4],
+    /// x: Gauss-Legendre offsets across thin fibres (1 to 3); y, z, w: 0.
+    pub quality: [u32; 4],
 }
 
 /// Deep opacity maps' default depth (the layers' span behind the first hair) as a fraction of
@@ -189,6 +191,7 @@ impl SceneUniforms {
             uniforms.ds_lobe_variance = rgb(tables.lobe_variance, 0.0);
         }
         uniforms.body_color = rgb(scene.body_color, 0.0);
+        uniforms.quality = [effects.fibre_offsets.clamp(1, 3), 0, 0, 0];
         uniforms
     }
 }

@@ -189,7 +189,14 @@ pub struct Effects {
     pub shadow_resolution: u32,
     pub multiple_scattering: MultipleScattering,
     pub coverage: Coverage,
+    /// Offsets h across a fibre averaged for strands thinner than two pixels (Gauss-Legendre
+    /// points, one of [`FIBRE_OFFSET_CHOICES`]): an accuracy switch of the Marschner model,
+    /// measured in `hairloom bench shading`.
+    pub fibre_offsets: u32,
 }
+
+/// Gauss-Legendre point counts the shaders have.
+pub const FIBRE_OFFSET_CHOICES: [u32; 3] = [1, 2, 3];
 
 impl Default for Effects {
     fn default() -> Self {
@@ -202,6 +209,7 @@ impl Default for Effects {
             shadow_resolution: 1024,
             multiple_scattering: MultipleScattering::DualScattering,
             coverage: Coverage::Msaa,
+            fibre_offsets: 3,
         }
     }
 }
@@ -474,6 +482,15 @@ impl HairMaterial {
 
 impl Effects {
     pub fn validate(&self) -> Result<(), InvalidScene> {
+        if !FIBRE_OFFSET_CHOICES.contains(&self.fibre_offsets) {
+            return Err(invalid(
+                "effects.fibre_offsets",
+                format!(
+                    "{} offsets are not supported; choose {:?}",
+                    self.fibre_offsets, FIBRE_OFFSET_CHOICES
+                ),
+            ));
+        }
         if !OPACITY_LAYER_CHOICES.contains(&self.opacity_layers) {
             return Err(invalid(
                 "effects.opacity_layers",

@@ -5,8 +5,8 @@
 //! frame.
 
 use hairloom_core::model::scene::{
-    Coverage, Effects, HairMaterial, Light, LightSource, MAX_LIGHTS, MultipleScattering,
-    OPACITY_LAYER_CHOICES, Pigment, Scene, SelfShadowing, Shading,
+    Coverage, Effects, FIBRE_OFFSET_CHOICES, HairMaterial, Light, LightSource, MAX_LIGHTS,
+    MultipleScattering, OPACITY_LAYER_CHOICES, Pigment, Scene, SelfShadowing, Shading,
 };
 use hairloom_render::measure::EffectCost;
 
@@ -210,6 +210,31 @@ impl ScenePanel {
                 ));
                 ui.end_row();
             });
+        ui.add_enabled_ui(effects.shading == Shading::Marschner, |ui| {
+            let mut offsets = effects.fibre_offsets;
+            let response = egui::ComboBox::from_label("Thin-fibre offsets")
+                .selected_text(offsets.to_string())
+                .show_ui(ui, |ui| {
+                    let mut any = None::<egui::Response>;
+                    for choice in FIBRE_OFFSET_CHOICES {
+                        let r = ui.selectable_value(&mut offsets, choice, choice.to_string());
+                        any = Some(match any {
+                            Some(a) => a | r,
+                            None => r,
+                        });
+                    }
+                    any
+                });
+            response.response.on_hover_text(
+                "offsets averaged across strands thinner than two pixels (Gauss-Legendre \
+                 points): each is one more fibre evaluation per light",
+            );
+            if let Some(Some(inner)) = response.inner {
+                edit_scene(state, &inner, "Scene: thin-fibre offsets", |s| {
+                    s.effects.fibre_offsets = offsets
+                });
+            }
+        });
         ui.add_enabled_ui(effects.needs_shadow_maps(), |ui| {
             ui.horizontal(|ui| {
                 let mut layers = effects.opacity_layers;

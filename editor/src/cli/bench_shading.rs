@@ -31,8 +31,9 @@ use hairloom_render::renderer::strand_gen::StrandGenRenderer;
 /// side) spans.
 pub const FRAMINGS: [(&str, f32); 3] = [("near", 0.6), ("middle", 0.2), ("far", 0.02)];
 
-/// The GPU configurations, each adding to the one before it (seed 001's comparison), and
-/// everything with width-based coverage.
+/// The GPU configurations, each adding to the one before it (seed 001's comparison),
+/// everything with width-based coverage, and the full scene with fewer offsets averaged
+/// across thin fibres (2 and 1 instead of 3).
 pub fn configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
     let none = scene.none();
     let list = [
@@ -52,14 +53,27 @@ pub fn configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
         ),
         ("+ width-based OIT", "all"),
     ];
-    list.iter()
+    let mut configurations: Vec<(&'static str, Effects)> = list
+        .iter()
         .map(|(name, effects)| {
             (
                 *name,
                 none.parse_list(effects).expect("the configurations parse"),
             )
         })
-        .collect()
+        .collect();
+    // The accuracy switch of thin fibres: fewer offsets across them, cheaper and less exact.
+    let full = configurations[4].1.clone();
+    for (name, offsets) in [("  h: 2 points", 2), ("  h: 1 point", 1)] {
+        configurations.push((
+            name,
+            Effects {
+                fibre_offsets: offsets,
+                ..full.clone()
+            },
+        ));
+    }
+    configurations
 }
 
 pub struct ShadingSettings {
