@@ -49,6 +49,11 @@ fn project_seeds() -> Vec<(String, Vec<u8>)> {
     deep["document"]["hair_mesh"]["bundles"][0]["layers"] = json!(20_000);
     let mut index: Value = serde_json::from_slice(&valid).expect("json");
     index["document"]["hair_mesh"]["bundles"][0]["vertices"][0] = json!(4_294_967_295u64);
+    // A hostile scene: a light with no direction, a huge shadow map, a NaN-like roughness.
+    let mut scene: Value = serde_json::from_slice(&valid).expect("json");
+    scene["document"]["scene"]["lights"][0]["source"]["directional"]["to_light"] = json!([0, 0, 0]);
+    scene["document"]["scene"]["effects"]["shadow_resolution"] = json!(4_294_967_295u64);
+    scene["document"]["scene"]["material"]["longitudinal_roughness"] = json!(1e39);
     vec![
         ("grid_with_history.hairloom".into(), valid),
         (
@@ -58,6 +63,10 @@ fn project_seeds() -> Vec<(String, Vec<u8>)> {
         (
             "crafted_vertex_index_u32_max.hairloom".into(),
             serde_json::to_vec(&index).expect("json"),
+        ),
+        (
+            "crafted_scene_zero_light_huge_shadow_map.hairloom".into(),
+            serde_json::to_vec(&scene).expect("json"),
         ),
     ]
 }
