@@ -37,19 +37,6 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOutput {
     return out;
 }
 
-// Gauss-Legendre nodes and weights over h ∈ [−1, 1] (weights summing to 1) for 1, 2 and 3
-// points.
-const GL_NODES = array<vec3<f32>, 3>(
-    vec3<f32>(0.0, 0.0, 0.0),
-    vec3<f32>(-0.5773503, 0.5773503, 0.0),
-    vec3<f32>(-0.7745967, 0.0, 0.7745967),
-);
-const GL_WEIGHTS = array<vec3<f32>, 3>(
-    vec3<f32>(1.0, 0.0, 0.0),
-    vec3<f32>(0.5, 0.5, 0.0),
-    vec3<f32>(0.2777778, 0.4444444, 0.2777778),
-);
-
 // Single scattering of a fibre: a fibre a few pixels wide or more is shaded at the pixel's
 // own offset h; a thinner one covers every offset within its pixel, so it takes the average
 // over h by Gauss-Legendre with the scene's number of points (`effects.fibre_offsets`: each
@@ -64,12 +51,19 @@ fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: ve
         result += (1.0 - averaged) * hair_single(wo, wi, clamp(h, -1.0, 1.0), sigma_a);
     }
     if averaged > 0.0 {
-        let points = clamp(scene.quality.x, 1u, 3u);
-        let nodes = GL_NODES[points - 1u];
-        let weights = GL_WEIGHTS[points - 1u];
-        var average = vec3<f32>(0.0);
-        for (var k = 0u; k < points; k++) {
-            average += weights[k] * hair_single(wo, wi, nodes[k], sigma_a);
+        // Gauss-Legendre over h ∈ [−1, 1], weights summing to 1, written out per count (a
+        // loop over constant arrays indexed at run time costs twice as much on a CPU adapter).
+        var average: vec3<f32>;
+        let points = scene.quality.x;
+        if points <= 1u {
+            average = hair_single(wo, wi, 0.0, sigma_a);
+        } else if points == 2u {
+            average = 0.5 * (hair_single(wo, wi, -0.5773503, sigma_a)
+                + hair_single(wo, wi, 0.5773503, sigma_a));
+        } else {
+            average = 0.2777778 * (hair_single(wo, wi, -0.7745967, sigma_a)
+                + hair_single(wo, wi, 0.7745967, sigma_a))
+                + 0.4444444 * hair_single(wo, wi, 0.0, sigma_a);
         }
         result += averaged * average;
     }

@@ -99,10 +99,13 @@ impl ScenePanel {
             (switched.frame_ms, scene.frame_ms)
         };
         let cost = with - without;
-        if on {
-            format!("costs {cost:.1} ms")
-        } else {
-            format!("would add {cost:.1} ms")
+        // Differences within a few percent of the frame are the machine's noise.
+        let noise = 0.03 * scene.frame_ms.max(switched.frame_ms);
+        match (on, cost.abs() < noise) {
+            (true, true) => format!("costs ≈ 0 ms (< {noise:.0} ms)"),
+            (false, true) => format!("would add ≈ 0 ms (< {noise:.0} ms)"),
+            (true, false) => format!("costs {cost:.1} ms"),
+            (false, false) => format!("would add {cost:.1} ms"),
         }
     }
 
@@ -236,7 +239,7 @@ impl ScenePanel {
             }
         });
         ui.add_enabled_ui(effects.needs_shadow_maps(), |ui| {
-            ui.horizontal(|ui| {
+            ui.horizontal_wrapped(|ui| {
                 let mut layers = effects.opacity_layers;
                 let response = egui::ComboBox::from_label("Opacity layers")
                     .selected_text(layers.to_string())
