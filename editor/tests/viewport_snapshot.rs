@@ -137,6 +137,30 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
         change > 1.0,
         "curl changed the viewport by only {change:.3}"
     );
+
+    // The frame budget: the full picture took longer than the budget (it does on a CPU
+    // adapter), so the frame right after an edit is interactive — fewer pixels, no optional
+    // effect — and the full picture comes back once input is still.
+    use hairloom_editor::app::viewport::{FRAME_BUDGET_MS, FrameQuality, SETTLE};
+    if frame_ms > FRAME_BUDGET_MS {
+        assert!(
+            matches!(
+                harness.state().viewport.shown_quality,
+                FrameQuality::Interactive { scale } if scale < 1.0
+            ),
+            "{:?}",
+            harness.state().viewport.shown_quality
+        );
+        std::thread::sleep(SETTLE + std::time::Duration::from_millis(50));
+        let settled = viewport_image(&mut harness);
+        assert_eq!(harness.state().viewport.shown_quality, FrameQuality::Full);
+        assert!(
+            common::mean_error(&settled, &curled) > 0.5,
+            "the full picture differs"
+        );
+    } else {
+        eprintln!("a full frame took {frame_ms:.1} ms, within the budget: no interactive frame");
+    }
 }
 
 #[test]

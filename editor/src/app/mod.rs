@@ -772,14 +772,23 @@ impl HairloomApp {
                 self.viewport.drawn_strands, self.viewport.drawn_vertices
             ));
             if let Some(ms) = self.viewport.frame_ms() {
+                // The viewport's real rate: from its last frame's cost, not the UI's repaints
+                // (which idle between frames).
                 ui.separator();
-                ui.label(format!("GPU generate + draw {ms:.1} ms"));
+                ui.label(format!(
+                    "GPU generate + draw {ms:.1} ms ({:.1} fps)",
+                    1e3 / ms.max(1e-3)
+                ));
             }
-            ui.separator();
-            ui.label(format!(
-                "fps {:.0}",
-                1.0 / ui.input(|i| i.stable_dt).max(1e-3)
-            ));
+            if let viewport::FrameQuality::Interactive { scale } = self.viewport.shown_quality {
+                ui.separator();
+                ui.label(format!(
+                    "interactive: {:.0}% size, no effects (budget {} ms)",
+                    scale * 100.0,
+                    viewport::FRAME_BUDGET_MS
+                ))
+                .on_hover_text("the full picture follows when input is still");
+            }
             ui.separator();
             ui.label(&self.viewport.adapter);
         });

@@ -213,6 +213,11 @@ impl EditorState {
         project
     }
 
+    /// Whether an edit (a drag, a modal tool, a slider held) is running.
+    pub fn edit_open(&self) -> bool {
+        self.edit.is_some()
+    }
+
     /// Ends the running edit: one command in the history if anything changed.
     pub fn commit_edit(&mut self) {
         if let Some(edit) = self.edit.take() {

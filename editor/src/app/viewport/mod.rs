@@ -117,7 +117,26 @@ struct DrawnKey {
     settings: ViewSettings,
     orbit: Orbit,
     size: [u32; 2],
+    quality: FrameQuality,
 }
+
+/// How much of the picture a frame draws (see [`FRAME_BUDGET_MS`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameQuality {
+    /// The scene's effects at the viewport's full size.
+    Full,
+    /// While the artist interacts and the full frame is over budget: no optional effect,
+    /// drawn at `scale` of the viewport's size (then stretched).
+    Interactive { scale: f32 },
+}
+
+/// The viewport's frame budget while the artist interacts (navigating, dragging a vertex or
+/// a slider, a modal tool): when the full picture costs more, interactive frames drop the
+/// optional effects and draw fewer pixels, the scale adapting to what the last interactive
+/// frame cost; the full picture follows once input has been still for [`SETTLE`].
+pub const FRAME_BUDGET_MS: f64 = 120.0;
+/// How long input must be still before the full picture is drawn again.
+pub const SETTLE: std::time::Duration = std::time::Duration::from_millis(400);
 
 /// What an accuracy measurement gives: every switch's row, or why it failed.
 type AccuracyResult = Result<Vec<AccuracyRow>, String>;
@@ -147,6 +166,15 @@ pub struct Viewport {
     /// Wall time of generating and drawing the last frame on the GPU (submit to idle).
     /// Written by the queue's work-done callback, so drawing never waits on the GPU.
     frame_ms: Arc<std::sync::Mutex<Option<f64>>>,
+    /// The quality of the frame `frame_ms` timed, and the last full frame's time.
+    frame_quality: Arc<std::sync::Mutex<Option<FrameQuality>>>,
+    full_frame_ms: Option<f64>,
+    /// When what the viewport shows last changed (an edit, the camera, the size).
+    last_change: Option<std::time::Instant>,
+    /// The resolution scale of interactive frames, adapted to the budget.
+    interactive_scale: f32,
+    /// The quality of the picture shown now (the status bar says when it is reduced).
+    pub shown_quality: FrameQuality,
     pub adapter: String,
     pub error: Option<String>,
     /// Why the hair could not be uploaded (an adapter limit); the document is kept.
@@ -259,6 +287,11 @@ impl Viewport {
             drawn_strands: 0,
             drawn_vertices: 0,
             frame_ms: Arc::default(),
+            frame_quality: Arc::default(),
+            full_frame_ms: None,
+            last_change: None,
+            interactive_scale: 0.5,
+            shown_quality: FrameQuality::Full,
             error: None,
             upload_error: None,
             keyboard_blocked: false,

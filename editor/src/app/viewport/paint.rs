@@ -4,6 +4,53 @@
 use super::*;
 
 impl Viewport {
+    /// The quality of the next frame: full unless the artist is interacting and the full
+    /// picture is over [`FRAME_BUDGET_MS`]. Learns from the last timed frame: a full frame's
+    /// time decides whether to degrade, an interactive frame's time adapts the scale.
+    fn frame_quality(
+        &mut self,
+        ui: &egui::Ui,
+        state: &EditorState,
+        size: [u32; 2],
+        settings: ViewSettings,
+    ) -> FrameQuality {
+        let timed = self.frame_quality.lock().ok().and_then(|mut q| q.take());
+        if let (Some(quality), Some(ms)) = (timed, self.frame_ms()) {
+            match quality {
+                FrameQuality::Full => self.full_frame_ms = Some(ms),
+                FrameQuality::Interactive { scale } => {
+                    // Pixels go as the square of the scale; move halfway toward the budget.
+                    let ideal = scale * (FRAME_BUDGET_MS / ms.max(1e-3)).sqrt() as f32;
+                    self.interactive_scale = (0.5 * (scale + ideal)).clamp(0.2, 1.0);
+                }
+            }
+        }
+        let content = (state.revision, settings, self.orbit, size);
+        let changed = self
+            .drawn
+            .is_none_or(|d| (d.revision, d.settings, d.orbit, d.size) != content);
+        let now = std::time::Instant::now();
+        if changed {
+            self.last_change = Some(now);
+        }
+        let interacting = state.edit_open()
+            || self.transform.is_some()
+            || ui.input(|i| i.pointer.any_down() || i.smooth_scroll_delta != egui::Vec2::ZERO)
+            || self
+                .last_change
+                .is_some_and(|t| now.duration_since(t) < SETTLE);
+        let over_budget = self.full_frame_ms.is_some_and(|ms| ms > FRAME_BUDGET_MS);
+        if interacting && over_budget {
+            // Come back for the full picture once input is still.
+            ui.ctx().request_repaint_after(SETTLE);
+            FrameQuality::Interactive {
+                scale: self.interactive_scale,
+            }
+        } else {
+            FrameQuality::Full
+        }
+    }
+
     /// Generates and draws the strands when the document, settings, view or size changed.
     pub(super) fn draw(&mut self, ui: &mut egui::Ui, state: &mut EditorState, rect: egui::Rect) {
         let problem = self.device_problem.lock().ok().and_then(|p| p.clone());
@@ -20,7 +67,7 @@ impl Viewport {
             self.error = Some(problem);
             return;
         }
-        let Some(gpu) = self.gpu.as_mut() else {
+        if self.gpu.is_none() {
             ui.painter().text(
                 rect.center(),
                 egui::Align2::CENTER_CENTER,
@@ -29,13 +76,28 @@ impl Viewport {
                 ui.visuals().weak_text_color(),
             );
             return;
-        };
+        }
         // The overlay does not change the picture: leave it out of what triggers GPU work.
         let settings = ViewSettings {
             wireframe: false,
             frame_glyphs: false,
             gizmo: false,
             ..self.settings
+        };
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        let full_size = [
+            ((rect.width() * pixels_per_point).round() as u32).clamp(1, 8192),
+            ((rect.height() * pixels_per_point).round() as u32).clamp(1, 8192),
+        ];
+        let quality = self.frame_quality(ui, state, full_size, settings);
+        let size = match quality {
+            FrameQuality::Full => full_size,
+            FrameQuality::Interactive { scale } => {
+                full_size.map(|side| ((side as f32 * scale).round() as u32).max(1))
+            }
+        };
+        let Some(gpu) = self.gpu.as_mut() else {
+            return;
         };
         let key = (state.revision, settings);
         if self.uploaded != Some(key) {
@@ -91,16 +153,12 @@ impl Viewport {
             self.uploaded = Some(key);
             self.drawn = None;
         }
-        let pixels_per_point = ui.ctx().pixels_per_point();
-        let size = [
-            ((rect.width() * pixels_per_point).round() as u32).clamp(1, 8192),
-            ((rect.height() * pixels_per_point).round() as u32).clamp(1, 8192),
-        ];
         let drawn = DrawnKey {
             revision: state.revision,
             settings,
             orbit: self.orbit,
-            size,
+            size: full_size,
+            quality,
         };
         if self.drawn != Some(drawn) {
             self.error = None;
@@ -111,6 +169,18 @@ impl Viewport {
                         self.framed_from_hair = true;
                     }
                     let (lo, hi) = self.camera_bounds.unwrap_or(hair.bounds);
+                    let document_scene = &state.document().scene;
+                    let interactive_scene;
+                    let lighting = match quality {
+                        FrameQuality::Full => document_scene,
+                        FrameQuality::Interactive { .. } => {
+                            interactive_scene = hairloom_core::model::scene::Scene {
+                                effects: document_scene.effects.none(),
+                                ..document_scene.clone()
+                            };
+                            &interactive_scene
+                        }
+                    };
                     let scene = default_scene(
                         &hair.body,
                         HairSource::Generated {
@@ -122,7 +192,7 @@ impl Viewport {
                         17,
                         hair.bounds,
                         self.orbit.camera(lo, hi),
-                        &state.document().scene,
+                        lighting,
                     );
                     let plan = gpu.preview.plan(&scene, size[0], size[1]);
                     self.drawn_strands = plan.strands;
@@ -134,13 +204,21 @@ impl Viewport {
                     // The status bar says what generating and drawing this frame cost, from
                     // submission to the GPU finishing it, without waiting here: egui's own
                     // submission on the same queue orders the texture before its use.
-                    let (frame_ms, ctx) = (Arc::clone(&self.frame_ms), ui.ctx().clone());
+                    let (frame_ms, timed_quality, ctx) = (
+                        Arc::clone(&self.frame_ms),
+                        Arc::clone(&self.frame_quality),
+                        ui.ctx().clone(),
+                    );
                     gpu.context.queue.on_submitted_work_done(move || {
-                        if let Ok(mut slot) = frame_ms.lock() {
+                        if let (Ok(mut slot), Ok(mut timed)) =
+                            (frame_ms.lock(), timed_quality.lock())
+                        {
                             *slot = Some(started.elapsed().as_secs_f64() * 1e3);
+                            *timed = Some(quality);
                         }
                         ctx.request_repaint(); // the status bar shows the new time
                     });
+                    self.shown_quality = quality;
                     match rendered {
                         Ok(texture) => {
                             // egui composites gamma-encoded bytes: sample the sRGB image raw.
