@@ -8,6 +8,7 @@
 //! | [`edit`] | edits as pure functions (topology, transforms, coordinates, wisps), selection and picking |
 //! | [`geometry`] | derived f64 geometry: interior vertices, styling frames, column curves, uv |
 //! | [`strands`] | root samples, random numbers, styling ops, LOD formulas, the f64 reference strands |
+//! | [`simulate`] | hair that moves: the body's distance field, wind, XPBD on the hair-mesh vertices, drape |
 //! | [`light`] | the scene's light on the CPU: fibre material, the Marschner model, dual-scattering tables, opacity-map math, the reference path tracer |
 //! | [`runtime`] | the runtime asset ([`runtime::hair::RuntimeHair`]: textures, samples, placements, styling) and the CPU mirror of every shader |
 //! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) and strand exports |
@@ -23,6 +24,7 @@ pub mod light;
 pub mod model;
 pub mod runtime;
 pub mod samples;
+pub mod simulate;
 pub mod strands;
 
 pub use io::project::Project;

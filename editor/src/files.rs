@@ -17,7 +17,7 @@ use hairloom_core::runtime::textures::Precision;
 use hairloom_core::strands::reference::{Strand, StrandContext, StrandOptions, StrandPlan};
 
 /// Strand width written to the strand files (80 µm, a typical human hair).
-const STRAND_WIDTH_M: f32 = 8e-5;
+pub const STRAND_WIDTH_M: f32 = 8e-5;
 
 /// Strands have 2^N + 1 vertices in exported strand files unless asked otherwise.
 pub const EXPORT_VERTICES_LOG2: u32 = 5;

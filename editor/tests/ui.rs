@@ -1245,3 +1245,45 @@ fn scene_panel_adds_aims_and_removes_lights() {
     assert_eq!(harness.state().state.document().scene.lights.len(), lights);
     scene.validate().expect("every edit leaves a valid scene");
 }
+
+#[test]
+fn drape_lets_the_hair_fall_onto_the_body_as_one_undo_step() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    harness.get_by_label("Drape").click();
+    harness.run();
+    let state = &harness.state().state;
+    assert!(
+        state.message.starts_with("Drape: settled"),
+        "{}",
+        state.message
+    );
+    let draped = state.document().clone();
+    draped.validate().expect("a valid document after the drape");
+    assert_ne!(draped.hair_mesh, original.hair_mesh);
+    // Roots stay on the scalp; the rest fell: the mean tip is lower than before.
+    let tips = |d: &hairloom_core::Document| {
+        let columns = &d.hair_mesh.columns;
+        columns
+            .iter()
+            .map(|c| c.positions.last().expect("a column has a root").y)
+            .sum::<f64>()
+            / columns.len() as f64
+    };
+    assert!(tips(&draped) < tips(&original));
+    for (a, b) in draped
+        .hair_mesh
+        .columns
+        .iter()
+        .zip(&original.hair_mesh.columns)
+    {
+        assert_eq!(a.positions[0], b.positions[0]);
+    }
+    assert_eq!(
+        state.project.history.undo.last().map(|c| c.label()),
+        Some("Drape")
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original, "one undo step");
+}

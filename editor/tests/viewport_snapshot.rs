@@ -301,3 +301,67 @@ fn the_gizmo_is_drawn_at_the_selection() {
         "only {changed} pixels changed near the gizmo"
     );
 }
+
+#[test]
+fn motion_is_simulated_and_uploaded_only_when_the_scene_has_it() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    // The sample's scene has no motion: frames pass, nothing steps, nothing is re-uploaded.
+    let uploads = harness.state().viewport.uploads;
+    for _ in 0..4 {
+        harness.step();
+    }
+    assert_eq!(harness.state().state.playback.steps, 0);
+    assert_eq!(harness.state().viewport.uploads, uploads);
+
+    harness.get_by_label("Scene").click();
+    harness.run();
+    harness.get_by_label("Simulate motion").click();
+    harness.run();
+    let modelled = harness.state().state.document().clone();
+    assert!(modelled.scene.motion.is_some());
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .project
+            .history
+            .undo
+            .last()
+            .map(|c| c.label()),
+        Some("Scene: motion")
+    );
+    // Still paused: switching motion on simulates nothing by itself.
+    harness.step();
+    assert_eq!(harness.state().state.playback.steps, 0);
+
+    harness.get_by_label("Play").click();
+    let before = harness.state().viewport.uploads;
+    for _ in 0..6 {
+        harness.step();
+    }
+    let playback = &harness.state().state.playback;
+    assert!(playback.steps > 0, "Play simulated nothing");
+    assert!(playback.is_posed());
+    assert!(playback.time_s() > 0.0);
+    // The drawn hair follows the simulation: uploads happened, and the shown mesh moved
+    // while the document (what is saved and undone) did not.
+    assert!(harness.state().viewport.uploads.full > before.full);
+    let state = &harness.state().state;
+    assert_eq!(state.document(), &modelled);
+    assert_ne!(state.shown_document().hair_mesh, modelled.hair_mesh);
+
+    harness.get_by_label("Pause").click();
+    harness.run();
+    let paused_at = harness.state().state.playback.steps;
+    harness.step();
+    assert_eq!(harness.state().state.playback.steps, paused_at);
+    harness.get_by_label("Reset").click();
+    harness.run();
+    assert!(!harness.state().state.playback.is_posed());
+    assert_eq!(
+        harness.state().state.shown_document().hair_mesh,
+        modelled.hair_mesh
+    );
+}

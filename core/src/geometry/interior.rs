@@ -111,21 +111,25 @@ pub fn fit_affine(from: &[DVec3], to: &[DVec3]) -> AffineMap {
         (g, f)
     };
     let xty_t = xty.transpose();
-    let image = |axis: usize, prior: DVec3| {
-        let v = eigenvectors.col(axis);
-        let (g, f) = factors(eigenvalues[axis]);
+    // The image of eigen-direction `v` (eigenvalue `lambda`): the data's least-squares image
+    // blended with `prior`.
+    let image = |v: DVec3, lambda: f64, prior: DVec3| {
+        let (g, f) = factors(lambda);
         xty_t * v * g + prior * f
     };
-    // Eigenvalues are sorted descending, so axis 2 is the least determined direction.
+    // Eigenvalues are sorted descending, so axis 2 is the least determined direction. Its
+    // vector is taken as e0 × e1 for both the data term and the prior: the solver's third
+    // eigenvector may point the other way, and mixing the two orientations reflected the
+    // map (interior vertices of a curved scalp landed inside the head).
     let e0 = eigenvectors.col(0);
     let e1 = eigenvectors.col(1);
     let n = e0.cross(e1);
-    let a0 = image(0, e0);
-    let a1 = image(1, e1);
+    let a0 = image(e0, eigenvalues.x, e0);
+    let a1 = image(e1, eigenvalues.y, e1);
     let c = a0.cross(a1);
     let scale2 = (a0.length_squared() + a1.length_squared()).max(f64::MIN_POSITIVE);
     let completion = c / (c.length() + 1e-24 * scale2).sqrt();
-    let a2 = image(2, completion);
+    let a2 = image(n, eigenvalues.z, completion);
     // L = Σ a_i v_iᵀ, with v_2 = n (same orientation used for the completion).
     let linear = outer(e0, a0) + outer(e1, a1) + outer(n, a2);
     let linear = linear.transpose() * (scale_to / scale_from);
@@ -456,6 +460,38 @@ mod tests {
             }
             let probe = DVec3::new(5.0, -4.0, 7.0);
             assert!(fit.apply(probe).distance(map.apply(probe)) < 1e-9);
+        }
+    }
+
+    /// Regression: the rim of a scalp cap on a sphere spans its thinnest direction only a
+    /// little, so the fit blends data and prior there; when the eigen-solver's third vector
+    /// pointed against e0 × e1 the data term was applied with the wrong sign and the map
+    /// reflected (an interior vertex of a 2 cm layer landed 1.5 cm inside the head).
+    #[test]
+    fn affine_fit_of_a_curved_rim_keeps_its_orientation() {
+        let mesh = crate::samples::sphere_cap(0.1, 0.6, 6, 1, 0.02);
+        let topology = Topology::build(&mesh);
+        let rim: Vec<usize> = (0..mesh.columns.len())
+            .filter(|&c| topology.root_boundary[c])
+            .collect();
+        for scale in [1.2, 0.9, 3.0] {
+            for turn in [0.0, 1.0, 2.5] {
+                let map = AffineMap {
+                    linear: DMat3::from_rotation_x(turn) * scale,
+                    translation: DVec3::new(0.1, -0.2, 0.3),
+                };
+                let from: Vec<DVec3> = rim.iter().map(|&c| mesh.columns[c].positions[0]).collect();
+                let to: Vec<DVec3> = from.iter().map(|&p| map.apply(p)).collect();
+                let fit = fit_affine(&from, &to);
+                assert!(fit.linear.determinant() > 0.0, "reflected: {fit:?}");
+                let crown = DVec3::new(0.0, 0.1, 0.0);
+                assert!(
+                    fit.apply(crown).distance(map.apply(crown)) < 1e-9,
+                    "{scale} {turn}: {} vs {}",
+                    fit.apply(crown),
+                    map.apply(crown)
+                );
+            }
         }
     }
 

@@ -86,6 +86,70 @@ pub fn usda_file(strands: &[Strand], width_m: f32) -> String {
     out
 }
 
+/// An animated USD stage: the same `BasisCurves` prim as [`usda_file`], its points sampled at
+/// each frame (`points.timeSamples`, time codes = frame numbers at `frames_per_second`).
+/// Every frame must hold the same curves (counts) as the first; an empty list is refused.
+pub fn usda_animation(
+    frames: &[Vec<Strand>],
+    width_m: f32,
+    frames_per_second: f64,
+) -> Result<String, String> {
+    use std::fmt::Write;
+    let Some(first) = frames.first() else {
+        return Err("an animation needs at least one frame".into());
+    };
+    if !(frames_per_second.is_finite() && frames_per_second > 0.0) {
+        return Err(format!(
+            "{frames_per_second} frames per second is not a rate"
+        ));
+    }
+    let counts: Vec<usize> = first.iter().map(|s| s.points.len()).collect();
+    for (i, frame) in frames.iter().enumerate() {
+        if frame.len() != counts.len()
+            || frame.iter().zip(&counts).any(|(s, &n)| s.points.len() != n)
+        {
+            return Err(format!("frame {i} has other curves than frame 0"));
+        }
+    }
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n    startTimeCode = 0\n    endTimeCode = {}\n    timeCodesPerSecond = {frames_per_second}\n    framesPerSecond = {frames_per_second}\n    doc = \"Simulated by Hairloom\"\n)\n",
+        frames.len() - 1
+    );
+    let _ = writeln!(
+        out,
+        "def BasisCurves \"Hair\"\n{{\n    uniform token type = \"linear\"\n    uniform token wrap = \"nonperiodic\""
+    );
+    let counts: Vec<String> = counts.iter().map(usize::to_string).collect();
+    let _ = writeln!(out, "    int[] curveVertexCounts = [{}]", counts.join(", "));
+    let _ = writeln!(out, "    point3f[] points.timeSamples = {{");
+    for (i, frame) in frames.iter().enumerate() {
+        let points: Vec<String> = frame
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .map(|p| format!("({}, {}, {})", p.x as f32, p.y as f32, p.z as f32))
+            .collect();
+        let _ = writeln!(out, "        {i}: [{}],", points.join(", "));
+    }
+    let _ = writeln!(out, "    }}");
+    let _ = writeln!(
+        out,
+        "    float[] widths = [{width_m}] (\n        interpolation = \"constant\"\n    )"
+    );
+    let uvs: Vec<String> = first
+        .iter()
+        .map(|s| format!("({}, {})", s.root_uv.x as f32, s.root_uv.y as f32))
+        .collect();
+    let _ = writeln!(
+        out,
+        "    texCoord2f[] primvars:st = [{}] (\n        interpolation = \"uniform\"\n    )",
+        uvs.join(", ")
+    );
+    let _ = writeln!(out, "}}");
+    Ok(out)
+}
+
 /// Binary glTF with one mesh of LINES (glTF has no curve primitive): every strand segment
 /// is a line between two shared vertices.
 pub fn glb_lines(strands: &[Strand]) -> Vec<u8> {

@@ -4,5 +4,6 @@
 pub mod document;
 pub mod history;
 pub mod mesh;
+pub mod motion;
 pub mod scene;
 pub mod styling;

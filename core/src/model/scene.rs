@@ -9,6 +9,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::model::motion::Motion;
+
 /// The most lights a scene may hold (the shaders' uniform array size).
 pub const MAX_LIGHTS: usize = 8;
 /// The most lights that may cast shadows: each one costs its own shadow passes and maps.
@@ -340,6 +342,10 @@ pub struct Scene {
     /// Diffuse albedo of the body, linear RGB.
     pub body_color: [f32; 3],
     pub effects: Effects,
+    /// What moves the hair (head animation, gravity, wind) and how it is simulated; `None`
+    /// is a still scene, where no simulator exists and nothing is stepped.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motion: Option<Motion>,
 }
 
 impl Default for Scene {
@@ -371,6 +377,7 @@ impl Default for Scene {
             material: HairMaterial::default(),
             body_color: [0.5, 0.35, 0.28],
             effects: Effects::default(),
+            motion: None,
         }
     }
 }
@@ -565,7 +572,11 @@ impl Scene {
         }
         self.material.validate()?;
         check_color("body_color", self.body_color, 1.0)?;
-        self.effects.validate()
+        self.effects.validate()?;
+        match &self.motion {
+            Some(motion) => motion.validate(),
+            None => Ok(()),
+        }
     }
 
     /// The lights that cast shadows, in order (at most [`MAX_SHADOWED_LIGHTS`] in a valid

@@ -466,3 +466,60 @@ pub fn straight_layers(mut mesh: HairMesh, layers: u32, step: DVec3) -> HairMesh
     mesh.update_w();
     mesh
 }
+
+/// A UV-sphere body of `radius_m` around the origin, outward-facing: a stand-in head for
+/// tests and benchmarks of collision and simulation.
+pub fn sphere_body(radius_m: f64, rings: u32, segments: u32) -> BodyMesh {
+    let (rings, segments) = (rings.max(2), segments.max(3));
+    let mut positions = Vec::new();
+    for r in 0..=rings {
+        let theta = std::f64::consts::PI * r as f64 / rings as f64;
+        for s in 0..segments {
+            let phi = std::f64::consts::TAU * s as f64 / segments as f64;
+            let p = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
+            positions.push((p * radius_m).as_vec3().to_array());
+        }
+    }
+    let mut triangles = Vec::new();
+    for r in 0..rings {
+        for s in 0..segments {
+            let a = r * segments + s;
+            let b = r * segments + (s + 1) % segments;
+            let (c, d) = (a + segments, b + segments);
+            triangles.push([a, b, c]);
+            triangles.push([b, d, c]);
+        }
+    }
+    BodyMesh {
+        positions,
+        triangles,
+    }
+}
+
+/// A cap of hair on [`sphere_body`]: an `n × n` grid of quads over the sphere's crown
+/// (within `cap_rad` of the top), each column going straight out along its root's normal by
+/// `step_m` per layer. The simulator's test and benchmark subject.
+pub fn sphere_cap(radius_m: f64, cap_rad: f64, n: usize, layers: u32, step_m: f64) -> HairMesh {
+    let direction = |s: f64, t: f64| {
+        let (a, b) = ((2.0 * s - 1.0) * cap_rad, (2.0 * t - 1.0) * cap_rad);
+        DVec3::new(a.sin(), 1.0, -b.sin()).normalize()
+    };
+    let mut mesh = grid_scalp(n, n, |s, t| direction(s, t) * radius_m);
+    for column in &mut mesh.columns {
+        let root = column.positions[0];
+        let normal = root.normalize_or(DVec3::Y);
+        column.positions = (0..=layers)
+            .map(|k| root + normal * (step_m * k as f64))
+            .collect();
+    }
+    for bundle in &mut mesh.bundles {
+        bundle.layers = layers;
+    }
+    interior::place_interior(&mut mesh, None);
+    mesh.update_w();
+    mesh
+}

@@ -7,6 +7,7 @@ pub mod gizmo;
 pub mod history_panel;
 pub mod layout_panel;
 pub mod outliner_panel;
+pub mod playback;
 pub mod recovery;
 pub mod scene_panel;
 pub mod state;
@@ -869,6 +870,9 @@ impl eframe::App for HairloomApp {
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.autosave(ui.input(|i| i.time));
+        if self.state.tick_playback(ui.input(|i| i.time)) {
+            ui.ctx().request_repaint();
+        }
         // The window's close button asks first, like File ▸ Quit.
         if ui.input(|i| i.viewport().close_requested()) && !self.quitting {
             ui.ctx()

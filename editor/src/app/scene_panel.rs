@@ -4,6 +4,7 @@
 //! (a drag is one step), validated with the field named; the viewport draws it on the next
 //! frame.
 
+use hairloom_core::model::motion::Motion;
 use hairloom_core::model::scene::{
     Coverage, Effects, FIBRE_OFFSET_CHOICES, HairMaterial, Light, LightSource, MAX_LIGHTS,
     MultipleScattering, OPACITY_LAYER_CHOICES, Pigment, Scene, SelfShadowing, Shading,
@@ -45,6 +46,9 @@ fn edit_scene(
 impl ScenePanel {
     pub fn ui(&mut self, ui: &mut egui::Ui, state: &mut EditorState, viewport: &Viewport) {
         self.receive(ui);
+        ui.heading("Motion");
+        motion_ui(ui, state);
+        ui.separator();
         ui.heading("Effects");
         self.effects_ui(ui, state, viewport);
         ui.separator();
@@ -696,4 +700,196 @@ fn environment_ui(ui: &mut egui::Ui, state: &mut EditorState) {
         state.edit("Scene: default effects").scene.effects = Effects::default();
         state.commit_edit();
     }
+}
+
+/// A slider over a motion parameter: one undoable scene edit per change (a drag is one step).
+fn motion_slider(
+    ui: &mut egui::Ui,
+    state: &mut EditorState,
+    label: &str,
+    value: f64,
+    range: std::ops::RangeInclusive<f64>,
+    set: impl FnOnce(&mut Motion, f64),
+) {
+    let mut v = value;
+    let r = ui.add(egui::Slider::new(&mut v, range).text(label));
+    edit_scene(
+        state,
+        &r,
+        &format!("Scene: {}", label.to_lowercase()),
+        |s| {
+            if let Some(motion) = s.motion.as_mut() {
+                set(motion, v);
+            }
+        },
+    );
+}
+
+/// The scene's motion (a switch, presets, wind, physics, accuracy) and the timeline: Play,
+/// Reset and a time slider. Without motion nothing is simulated, and the panel says so.
+fn motion_ui(ui: &mut egui::Ui, state: &mut EditorState) {
+    let motion = state.document().scene.motion.clone();
+    let mut on = motion.is_some();
+    let r = ui
+        .checkbox(&mut on, "Simulate motion")
+        .on_hover_text("Off: the hair stays as modelled and no simulation runs");
+    edit_scene(state, &r, "Scene: motion", |s| {
+        s.motion = on.then(|| Motion::head_turn(0.3, 0.6, 70.0));
+    });
+    let Some(motion) = motion else {
+        ui.label(egui::RichText::new("No motion: nothing is simulated.").weak());
+        return;
+    };
+    ui.horizontal(|ui| {
+        let playing = state.playback.playing;
+        if ui
+            .button(if playing { "Pause" } else { "Play" })
+            .on_hover_text("Simulate in real time")
+            .clicked()
+        {
+            state.playback.playing = !playing;
+        }
+        if ui
+            .button("Reset")
+            .on_hover_text("Back to the modelled shape at 0 s")
+            .clicked()
+        {
+            state.playback.reset();
+        }
+    });
+    let end_s = (motion.duration_s() + 2.0).max(4.0);
+    let mut time_s = state.playback.time_s();
+    let r = ui.add(egui::Slider::new(&mut time_s, 0.0..=end_s).text("Time s"));
+    if r.changed() {
+        state.playback.playing = false;
+        state.seek_playback(time_s);
+    }
+    ui.label(
+        egui::RichText::new(format!(
+            "{} steps at {} Hz × {} sub-steps × {} iterations{}",
+            state.playback.steps,
+            motion.quality.rate_hz,
+            motion.quality.substeps,
+            motion.quality.iterations,
+            state
+                .playback
+                .step_ms
+                .map(|ms| format!("; simulating costs {ms:.2} ms per step"))
+                .unwrap_or_default()
+        ))
+        .small()
+        .weak(),
+    );
+    ui.horizontal(|ui| {
+        if ui.button("Head turn").clicked() {
+            let keys = Motion::head_turn(0.3, 0.6, 70.0).head_animation;
+            if let Some(motion) = state.edit("Scene: head turn").scene.motion.as_mut() {
+                motion.head_animation = keys;
+            }
+            state.commit_edit();
+        }
+        if ui.button("Still head").clicked() {
+            if let Some(motion) = state.edit("Scene: still head").scene.motion.as_mut() {
+                motion.head_animation.clear();
+            }
+            state.commit_edit();
+        }
+    });
+    egui::CollapsingHeader::new("Wind and gravity")
+        .default_open(false)
+        .show(ui, |ui| {
+            motion_slider(
+                ui,
+                state,
+                "Wind m/s",
+                motion.wind.speed_m_per_s,
+                0.0..=30.0,
+                |m, v| m.wind.speed_m_per_s = v,
+            );
+            motion_slider(
+                ui,
+                state,
+                "Gusts",
+                motion.wind.gust_strength,
+                0.0..=1.0,
+                |m, v| m.wind.gust_strength = v,
+            );
+            motion_slider(
+                ui,
+                state,
+                "Gravity m/s²",
+                motion.gravity_m_per_s2,
+                0.0..=20.0,
+                |m, v| m.gravity_m_per_s2 = v,
+            );
+        });
+    egui::CollapsingHeader::new("Physics")
+        .default_open(false)
+        .show(ui, |ui| {
+            let p = &motion.physics;
+            motion_slider(
+                ui,
+                state,
+                "Bend stiffness",
+                p.bend_stiffness,
+                0.0..=1.0,
+                |m, v| m.physics.bend_stiffness = v,
+            );
+            motion_slider(
+                ui,
+                state,
+                "Shape stiffness",
+                p.shape_stiffness,
+                0.0..=1.0,
+                |m, v| m.physics.shape_stiffness = v,
+            );
+            motion_slider(
+                ui,
+                state,
+                "Style hold at root",
+                p.retention_root,
+                0.0..=1.0,
+                |m, v| m.physics.retention_root = v,
+            );
+            motion_slider(
+                ui,
+                state,
+                "Style hold at tip",
+                p.retention_tip,
+                0.0..=1.0,
+                |m, v| m.physics.retention_tip = v,
+            );
+            motion_slider(
+                ui,
+                state,
+                "Damping /s",
+                p.damping_per_s,
+                0.0..=20.0,
+                |m, v| m.physics.damping_per_s = v,
+            );
+            motion_slider(ui, state, "Friction", p.friction, 0.0..=2.0, |m, v| {
+                m.physics.friction = v
+            });
+        });
+    egui::CollapsingHeader::new("Accuracy")
+        .default_open(false)
+        .show(ui, |ui| {
+            let q = &motion.quality;
+            motion_slider(
+                ui,
+                state,
+                "Sub-steps",
+                q.substeps as f64,
+                1.0..=16.0,
+                |m, v| m.quality.substeps = v.round() as u32,
+            );
+            motion_slider(
+                ui,
+                state,
+                "Iterations",
+                q.iterations as f64,
+                1.0..=16.0,
+                |m, v| m.quality.iterations = v.round() as u32,
+            );
+        });
 }

@@ -20,7 +20,7 @@ const SAMPLE_PROJECT: &[u8] = include_bytes!("../../../assets/samples/head_long_
 const SAMPLE_NAME: &str = "head_long_wavy.hairloom (sample)";
 
 /// A fresh document revision number (process-wide).
-fn next_revision() -> u64 {
+pub(super) fn next_revision() -> u64 {
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
     NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
@@ -91,6 +91,8 @@ pub struct EditorState {
     pub tool: ToolSettings,
     /// Recovered work counts as unsaved even where it equals a file on disk.
     unsaved: bool,
+    /// The scene's motion played back (view state).
+    pub playback: super::playback::Playback,
 }
 
 impl EditorState {
@@ -106,6 +108,7 @@ impl EditorState {
             vertex_selection: BTreeSet::new(),
             tool: ToolSettings::default(),
             unsaved: false,
+            playback: Default::default(),
         }
     }
 
@@ -152,6 +155,28 @@ impl EditorState {
 
     pub fn document(&self) -> &Document {
         &self.project.document
+    }
+
+    /// What the viewport draws: the document posed by the playing motion, or as modelled.
+    pub fn shown_document(&self) -> &Document {
+        self.playback.shown(&self.project.document, self.revision)
+    }
+
+    /// Changes whenever [`Self::shown_document`] does.
+    pub fn shown_revision(&self) -> u64 {
+        self.playback.shown_revision(self.revision)
+    }
+
+    /// Steps the playing motion by the wall clock; whether another frame is wanted.
+    pub fn tick_playback(&mut self, now_s: f64) -> bool {
+        self.playback
+            .tick(&self.project.document, self.revision, now_s)
+    }
+
+    /// Shows the motion at `time_s`.
+    pub fn seek_playback(&mut self, time_s: f64) {
+        self.playback
+            .seek(&self.project.document, self.revision, time_s);
     }
 
     /// The project's name as the user knows it: its file name, "untitled", or the sample's.

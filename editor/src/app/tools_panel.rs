@@ -150,6 +150,34 @@ impl ToolsPanel {
                 state.edit_mesh("Subdivide", edit::subdivide);
             }
         });
+        ui.horizontal(|ui| {
+            if ui
+                .button("Drape")
+                .on_hover_text(
+                    "Let the selected bundles (all without a selection) fall onto the body and settle",
+                )
+                .clicked()
+            {
+                let body = state.document().body.clone();
+                let mut report = None;
+                let draped = state.edit_mesh("Drape", |mesh, bundles| {
+                    hairloom_core::simulate::drape(mesh, &body, bundles, &[]).map(
+                        |(outcome, drape)| {
+                            report = Some(drape);
+                            outcome
+                        },
+                    )
+                });
+                if let (true, Some(report)) = (draped, report) {
+                    state.message = format!(
+                        "Drape: {} after {:.1} s simulated",
+                        if report.settled { "settled" } else { "still moving (stopped)" },
+                        report.simulated_s
+                    );
+                }
+            }
+            ui.label(egui::RichText::new("under gravity, onto the body").weak());
+        });
         ui.separator();
         ui.heading("Wisps");
         ui.horizontal(|ui| {

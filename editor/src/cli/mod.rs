@@ -16,6 +16,7 @@ mod bench;
 mod bench_effects;
 mod bench_shading;
 mod render;
+mod simulate;
 
 use hairloom_editor::files;
 
@@ -128,6 +129,43 @@ enum Command {
         /// Vertex LOD morph window λ in [0, 1] (eq. 10-12); 0 switches levels abruptly.
         #[arg(long, default_value_t = hairloom_core::runtime::frame_plan::DEFAULT_LAMBDA)]
         lambda: f64,
+        /// Simulate the scene's motion from 0 to this time (seconds) and render that moment
+        /// (a scene without motion renders as modelled).
+        #[arg(long, default_value_t = 0.0)]
+        time: f64,
+    },
+    /// Simulate a project's motion and write the frames as a PNG sequence (and, with
+    /// --usda, the strands animated over time).
+    Simulate {
+        project: PathBuf,
+        /// Folder for frame_0000.png, frame_0001.png, …
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long, default_value_t = 3.0)]
+        seconds: f64,
+        #[arg(long, default_value_t = 24.0)]
+        fps: f64,
+        /// What moves the hair: the scene's own motion, or a preset for a scene without one.
+        #[arg(long, value_enum, default_value_t = simulate::MotionArg::Scene)]
+        motion: simulate::MotionArg,
+        /// Image size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "480x480")]
+        size: String,
+        /// A camera preset of the scene, or x,y,z.
+        #[arg(long, default_value = "three-quarter")]
+        view: String,
+        /// Override the scene's optional effects (as for render).
+        #[arg(long)]
+        effects: Option<String>,
+        /// Strands per bundle drawn (and written with --usda).
+        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        strands_per_bundle: u32,
+        /// Also write OUT/hair.usda: the strands at every frame as USD time samples.
+        #[arg(long)]
+        usda: bool,
+        /// Write the strands only (with --usda), no pictures.
+        #[arg(long)]
+        no_render: bool,
     },
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
     Adapters,
@@ -213,6 +251,7 @@ pub fn main() -> ExitCode {
             alpha_strands,
             alpha_vertices,
             lambda,
+            time,
         }) => {
             let lod_values = [alpha_strands, alpha_vertices, lambda];
             if lod_values.iter().any(|v| !v.is_finite() || *v < 0.0) || lambda > 1.0 {
@@ -240,9 +279,35 @@ pub fn main() -> ExitCode {
                     alpha_vertices,
                     lambda,
                 },
+                time_s: time,
             };
             render::run(&input, &out, &settings)
         }
+        Some(Command::Simulate {
+            project,
+            out,
+            seconds,
+            fps,
+            motion,
+            size,
+            view,
+            effects,
+            strands_per_bundle,
+            usda,
+            no_render,
+        }) => simulate::run(&simulate::SimulateSettings {
+            project,
+            out,
+            seconds,
+            fps,
+            motion,
+            size,
+            view,
+            effects,
+            strands_per_bundle,
+            usda,
+            render: !no_render,
+        }),
         Some(Command::Adapters) => adapters(),
         Some(Command::Bench { which }) => bench::run(which),
     };

@@ -19,6 +19,9 @@ use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scen
 use hairloom_render::renderer::preview_body::GpuBody;
 use hairloom_render::renderer::strand_gen::StrandGenRenderer;
 
+/// The longest simulated time a command accepts (`--time`, `--seconds`): bounded work.
+pub const MAX_SIMULATED_S: f64 = 600.0;
+
 /// Vertices per strand in previews by default: 2^4 + 1.
 pub const PREVIEW_VERTICES_LOG2: u32 = 4;
 
@@ -37,6 +40,8 @@ pub struct RenderSettings {
     pub precision: Precision,
     pub filtering: Filtering,
     pub lod: LodSettings,
+    /// `--time`: simulate the scene's motion to this time first (projects only).
+    pub time_s: f64,
 }
 
 impl Default for RenderSettings {
@@ -50,6 +55,7 @@ impl Default for RenderSettings {
             precision: Precision::F32,
             filtering: Filtering::Exact,
             lod: LodSettings::default(),
+            time_s: 0.0,
         }
     }
 }
@@ -85,10 +91,29 @@ pub fn parse_view(view: &str, scene: &Scene) -> anyhow::Result<Vec3> {
     Ok(direction)
 }
 
+/// `document` at `time_s` of its scene's motion: simulated from the start when the scene has
+/// motion, as modelled when it has none (no simulator is made).
+pub fn posed_at(
+    document: &hairloom_core::Document,
+    time_s: f64,
+) -> std::borrow::Cow<'_, hairloom_core::Document> {
+    match &document.scene.motion {
+        Some(motion) if time_s > 0.0 => {
+            let mut sim = hairloom_core::simulate::simulator(document, motion);
+            sim.seek(time_s);
+            std::borrow::Cow::Owned(hairloom_core::simulate::posed_document(document, &sim))
+        }
+        _ => std::borrow::Cow::Borrowed(document),
+    }
+}
+
 /// The runtime asset a render draws: a runtime bundle folder (the game's input) as stored,
 /// or a project turned into what an export with `settings` would write.
 pub fn load_hair(path: &Path, settings: &RenderSettings) -> anyhow::Result<RuntimeHair> {
     if path.is_dir() {
+        if settings.time_s != 0.0 {
+            bail!("--time needs a project: a runtime bundle holds no hair mesh to simulate");
+        }
         let mut hair = load_runtime_bundle(path)?;
         if let Some(per_bundle) = settings.strands_per_bundle {
             hair.set_strands_per_bundle(per_bundle)
@@ -97,8 +122,9 @@ pub fn load_hair(path: &Path, settings: &RenderSettings) -> anyhow::Result<Runti
         Ok(hair)
     } else {
         let project = hairloom_core::io::project::load(path)?;
+        let document = posed_at(&project.document, settings.time_s);
         Ok(RuntimeHair::from_document(
-            &project.document,
+            &document,
             &RuntimeOptions {
                 precision: settings.precision,
                 strands_per_bundle: settings
@@ -110,6 +136,90 @@ pub fn load_hair(path: &Path, settings: &RenderSettings) -> anyhow::Result<Runti
     }
 }
 
+/// The GPU renderers of a headless picture, made once and reused for every frame of a
+/// sequence (`hairloom simulate`).
+pub struct HeadlessRenderer {
+    generator: StrandGenRenderer,
+    preview: PreviewRenderer,
+}
+
+impl HeadlessRenderer {
+    pub fn new(context: &GpuContext) -> Self {
+        Self {
+            generator: StrandGenRenderer::new(context),
+            preview: PreviewRenderer::new(context),
+        }
+    }
+
+    /// Draws `hair` seen from `direction` with a camera framing the box `frame`; returns
+    /// RGBA8 pixels and a one-line description.
+    pub fn draw(
+        &self,
+        context: &GpuContext,
+        hair: &RuntimeHair,
+        (width, height): (u32, u32),
+        frame: (Vec3, Vec3),
+        direction: Vec3,
+        settings: &RenderSettings,
+    ) -> anyhow::Result<(Vec<u8>, String)> {
+        let (vertices_log2, filtering) = (settings.vertices_log2, settings.filtering);
+        let gpu_hair = self.generator.upload(context, hair)?;
+        let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
+        let hair_bounds = hair
+            .textures
+            .hair_bounds()
+            .context("nothing to render: no bundle grows hair")?;
+        let camera = Camera::framing(frame.0, frame.1, direction);
+        let body = GpuBody::upload(context, &hair.body);
+        let lighting = scene_for(hair, settings)?;
+        let scene = default_scene(
+            &body,
+            HairSource::Generated {
+                generator: &self.generator,
+                hair: &gpu_hair,
+                filtering,
+                lod: settings.lod,
+            },
+            vertex_count,
+            hair_bounds,
+            camera,
+            &lighting,
+        );
+        let renderer = &self.preview;
+        let plan = renderer.plan(&scene, width, height);
+        let pixels = renderer.render(context, &scene, &plan, width, height)?;
+        let names = lighting.effects.names();
+        let summary = format!(
+            "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), effects: {}, {}× MSAA, on {}",
+            plan.strands,
+            gpu_hair.root_count,
+            plan.vertices,
+            if settings.lod.enabled { "on" } else { "off" },
+            filtering,
+            hair.textures.precision,
+            if names.is_empty() {
+                "none (Kajiya-Kay)".to_string()
+            } else {
+                names.join(", ")
+            },
+            renderer.sample_count,
+            describe(&context.adapter_info)
+        );
+        Ok((pixels, summary))
+    }
+}
+
+/// The box a still picture frames: the hair's bounds, padded by 5% (the head scan's
+/// shoulders would make the hair tiny).
+pub fn still_frame(hair: &RuntimeHair) -> anyhow::Result<(Vec3, Vec3)> {
+    let (lo, hi) = hair
+        .textures
+        .hair_bounds()
+        .context("nothing to render: no bundle grows hair")?;
+    let pad = (hi - lo) * 0.05;
+    Ok((lo - pad, hi + pad))
+}
+
 /// Draws `hair` seen from `direction`; returns RGBA8 pixels and a one-line description.
 pub fn render_pixels(
     context: &GpuContext,
@@ -119,53 +229,14 @@ pub fn render_pixels(
     direction: Vec3,
     settings: &RenderSettings,
 ) -> anyhow::Result<(Vec<u8>, String)> {
-    let (vertices_log2, filtering) = (settings.vertices_log2, settings.filtering);
-    let generator = StrandGenRenderer::new(context);
-    let gpu_hair = generator.upload(context, hair)?;
-    let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
-    // Frame the hair (the head scan's shoulders would make it tiny), padded by a margin.
-    let (lo, hi) = hair
-        .textures
-        .hair_bounds()
-        .context("nothing to render: no bundle grows hair")?;
-    let pad = (hi - lo) * 0.05;
-    let camera = Camera::framing(lo - pad, hi + pad, direction);
-    let renderer = PreviewRenderer::new(context);
-    let body = GpuBody::upload(context, &hair.body);
-    let lighting = scene_for(hair, settings)?;
-    let scene = default_scene(
-        &body,
-        HairSource::Generated {
-            generator: &generator,
-            hair: &gpu_hair,
-            filtering,
-            lod: settings.lod,
-        },
-        vertex_count,
-        (lo, hi),
-        camera,
-        &lighting,
-    );
-    let plan = renderer.plan(&scene, width, height);
-    let pixels = renderer.render(context, &scene, &plan, width, height)?;
-    let names = lighting.effects.names();
-    let summary = format!(
-        "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), effects: {}, {}× MSAA, on {}",
-        plan.strands,
-        gpu_hair.root_count,
-        plan.vertices,
-        if settings.lod.enabled { "on" } else { "off" },
-        filtering,
-        hair.textures.precision,
-        if names.is_empty() {
-            "none (Kajiya-Kay)".to_string()
-        } else {
-            names.join(", ")
-        },
-        renderer.sample_count,
-        describe(&context.adapter_info)
-    );
-    Ok((pixels, summary))
+    HeadlessRenderer::new(context).draw(
+        context,
+        hair,
+        (width, height),
+        still_frame(hair)?,
+        direction,
+        settings,
+    )
 }
 
 /// RGBA8 pixels as a PNG file, written atomically.
@@ -198,6 +269,12 @@ pub fn scene_for(hair: &RuntimeHair, settings: &RenderSettings) -> anyhow::Resul
 
 pub fn run(input: &Path, out: &Path, settings: &RenderSettings) -> anyhow::Result<()> {
     let (width, height) = parse_size(&settings.size)?;
+    if !(settings.time_s.is_finite() && (0.0..=MAX_SIMULATED_S).contains(&settings.time_s)) {
+        bail!(
+            "--time {}: must be between 0 and {MAX_SIMULATED_S} s",
+            settings.time_s
+        );
+    }
     let hair = load_hair(input, settings)?;
     let direction = parse_view(&settings.view, &hair.scene)?;
     scene_for(&hair, settings)?;

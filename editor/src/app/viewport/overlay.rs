@@ -7,7 +7,7 @@ impl Viewport {
     /// The hair-mesh wireframe (when on) and the selected bundles' outlines, drawn over the
     /// picture with the picture's camera (not depth-tested: an X-ray view).
     pub(super) fn paint_overlay(&mut self, ui: &egui::Ui, state: &EditorState, rect: egui::Rect) {
-        let mesh = &state.document().hair_mesh;
+        let mesh = &state.shown_document().hair_mesh;
         let Some(projector) = self.projector(state, rect) else {
             return;
         };
@@ -48,7 +48,7 @@ impl Viewport {
             if self
                 .interior
                 .as_ref()
-                .is_none_or(|(r, _)| *r != state.revision)
+                .is_none_or(|(r, _)| *r != state.shown_revision())
             {
                 let topology = hairloom_core::Topology::build(mesh);
                 let interior = (0..mesh.columns.len())
@@ -58,7 +58,7 @@ impl Viewport {
                             .collect()
                     })
                     .collect();
-                self.interior = Some((state.revision, interior));
+                self.interior = Some((state.shown_revision(), interior));
             }
             let interior = self.interior.as_ref().map(|(_, i)| i);
             for (c, column) in mesh.columns.iter().enumerate() {
@@ -86,12 +86,12 @@ impl Viewport {
             if self
                 .frames
                 .as_ref()
-                .is_none_or(|(r, _)| *r != state.revision)
+                .is_none_or(|(r, _)| *r != state.shown_revision())
             {
                 let frames = (0..=mesh.max_layers())
                     .map(|layer| hairloom_core::geometry::frames::layer_frames(mesh, layer))
                     .collect();
-                self.frames = Some((state.revision, frames));
+                self.frames = Some((state.shown_revision(), frames));
             }
             let length = mesh.size() * 0.012;
             if let Some((_, frames)) = &self.frames {

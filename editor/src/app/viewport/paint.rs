@@ -25,7 +25,7 @@ impl Viewport {
                 }
             }
         }
-        let content = (state.revision, settings, self.orbit, size);
+        let content = (state.shown_revision(), settings, self.orbit, size);
         let changed = self
             .drawn
             .is_none_or(|d| (d.revision, d.settings, d.orbit, d.size) != content);
@@ -99,9 +99,9 @@ impl Viewport {
         let Some(gpu) = self.gpu.as_mut() else {
             return;
         };
-        let key = (state.revision, settings);
+        let key = (state.shown_revision(), settings);
         if self.uploaded != Some(key) {
-            let document = state.document();
+            let document = state.shown_document();
             // A styling-only change (same hair mesh, body and view settings) rewrites the
             // styling buffers in place: no texture rebuild, no re-upload.
             let restyle = match (&mut gpu.hair, self.uploaded) {
@@ -154,7 +154,7 @@ impl Viewport {
             self.drawn = None;
         }
         let drawn = DrawnKey {
-            revision: state.revision,
+            revision: state.shown_revision(),
             settings,
             orbit: self.orbit,
             size: full_size,

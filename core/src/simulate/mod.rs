@@ -1,0 +1,133 @@
+//! Hair that falls and moves: the hair mesh simulated on the CPU (seed 000 §3.4; Wu & Yuksel
+//! 2016), only when the scene has motion.
+//!
+//! | file | what |
+//! |---|---|
+//! | [`body_sdf`] | the body's signed distance field, built once, for collision |
+//! | [`wind`] | the wind field (mean flow, travelling gusts) |
+//! | [`xpbd`] | [`HairSim`]: fixed-rate XPBD on the hair-mesh vertices |
+//!
+//! and [`drape`], the modelling tool that lets bundles fall onto the body as one edit.
+//!
+//! The strands follow the simulated mesh the way they follow any edit: the runtime textures
+//! are rebuilt from [`HairSim::posed_mesh`], so the styling frames ride along (§3.4).
+
+pub mod body_sdf;
+pub mod wind;
+pub mod xpbd;
+
+pub use body_sdf::BodySdf;
+pub use xpbd::HairSim;
+
+use std::collections::BTreeSet;
+
+use crate::edit::{EditError, EditOutcome, check_bundles};
+use crate::geometry::interior::place_interior;
+use crate::model::document::{BodyMesh, Document};
+use crate::model::mesh::{HairMesh, VertexRef};
+use crate::model::motion::{HairPhysics, Motion};
+
+/// The longest simulated time a drape may take before it stops settling.
+pub const DRAPE_MAX_S: f64 = 12.0;
+/// The hair is at rest when no vertex moves faster than this for [`DRAPE_REST_STEPS`] steps.
+pub const DRAPE_REST_SPEED_M_PER_S: f64 = 0.01;
+pub const DRAPE_REST_STEPS: u32 = 15;
+
+/// How a drape went.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DrapeReport {
+    pub simulated_s: f64,
+    /// Whether the hair came to rest before [`DRAPE_MAX_S`].
+    pub settled: bool,
+    pub deepest_penetration_m: f64,
+}
+
+/// Lets `bundles` (every active bundle when empty) fall under gravity onto `body` and
+/// settle, keeping `locked` vertices and every vertex of the other bundles where they are.
+/// Interior vertices are placed again from the draped exterior and w refreshed, as after
+/// any edit, so the result is one ordinary undo step.
+pub fn drape(
+    mesh: &HairMesh,
+    body: &BodyMesh,
+    bundles: &[u32],
+    locked: &[VertexRef],
+) -> Result<(EditOutcome, DrapeReport), EditError> {
+    let selected: BTreeSet<u32> = if bundles.is_empty() {
+        (0..mesh.bundles.len() as u32)
+            .filter(|&b| !mesh.bundles[b as usize].removed)
+            .collect()
+    } else {
+        check_bundles(mesh, bundles)?;
+        bundles.iter().copied().collect()
+    };
+    if selected.is_empty() {
+        return Err(EditError::EmptySelection);
+    }
+    // Everything a bundle outside the selection uses stays put.
+    let mut pinned: BTreeSet<VertexRef> = locked.iter().copied().collect();
+    for (b, bundle) in mesh.bundles.iter().enumerate() {
+        if selected.contains(&(b as u32)) || bundle.removed {
+            continue;
+        }
+        for &column in &bundle.vertices {
+            for layer in 0..=bundle.layers {
+                pinned.insert(VertexRef { column, layer });
+            }
+        }
+    }
+    let motion = Motion {
+        physics: HairPhysics::drape(),
+        ..Motion::default()
+    };
+    let pinned: Vec<VertexRef> = pinned.into_iter().collect();
+    let mut sim = HairSim::with_body(mesh, body, &motion, &pinned);
+    let max_steps = (DRAPE_MAX_S / sim.step_s()).ceil() as u32;
+    let mut still = 0;
+    let mut settled = false;
+    for _ in 0..max_steps {
+        sim.step();
+        still = if sim.max_speed_m_per_s() < DRAPE_REST_SPEED_M_PER_S {
+            still + 1
+        } else {
+            0
+        };
+        if still >= DRAPE_REST_STEPS {
+            settled = true;
+            break;
+        }
+    }
+    let report = DrapeReport {
+        simulated_s: sim.time_s(),
+        settled,
+        deepest_penetration_m: sim.deepest_penetration_m(),
+    };
+    let mut draped = sim.posed_mesh();
+    place_interior(&mut draped, None);
+    draped.update_w();
+    draped.validate()?;
+    Ok((
+        EditOutcome {
+            mesh: draped,
+            affected_bundles: selected.into_iter().collect(),
+        },
+        report,
+    ))
+}
+
+/// A simulator for `document` moved by `motion` (the scene's, or one chosen for a command).
+pub fn simulator(document: &Document, motion: &Motion) -> HairSim {
+    HairSim::with_body(&document.hair_mesh, &document.body, motion, &[])
+}
+
+/// `document` as the simulation has it now: the posed hair mesh on the posed body. The
+/// strands follow the way they follow any edit: the runtime asset is rebuilt from it.
+pub fn posed_document(document: &Document, sim: &HairSim) -> Document {
+    Document {
+        hair_mesh: sim.posed_mesh(),
+        body: sim.posed_body(&document.body),
+        ..document.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests;
