@@ -65,6 +65,32 @@ struct Distance {
     kind: Kind,
 }
 
+/// Orders constraints by a greedy colouring: within a colour no two share a particle, so
+/// consecutive projections do not wait on each other's results and the CPU overlaps their
+/// square roots and divisions (the Gauss-Seidel loop is latency-bound otherwise). The order
+/// is fixed by the input's, so results stay deterministic.
+fn by_colour(constraints: Vec<Distance>, particles: usize) -> Vec<Distance> {
+    let mut used = vec![0u64; particles];
+    let mut colours: Vec<Vec<Distance>> = Vec::new();
+    let mut overflow = Vec::new();
+    for constraint in constraints {
+        let (a, b) = (constraint.a as usize, constraint.b as usize);
+        let free = !(used[a] | used[b]);
+        if free == 0 {
+            overflow.push(constraint); // more than 64 colours: a pathological vertex
+            continue;
+        }
+        let colour = free.trailing_zeros() as usize;
+        used[a] |= 1 << colour;
+        used[b] |= 1 << colour;
+        if colours.len() <= colour {
+            colours.resize_with(colour + 1, Vec::new);
+        }
+        colours[colour].push(constraint);
+    }
+    colours.into_iter().flatten().chain(overflow).collect()
+}
+
 /// What a step counted, for tests and the status bar.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepStats {
@@ -90,8 +116,16 @@ pub struct HairSim {
     inverse_mass: Vec<f64>,
     /// Compliance of each particle's pull toward its modelled position (`None`: no pull).
     retention: Vec<Option<f64>>,
+    /// Distance each particle keeps from the body: the margin plus its layer's volume.
+    clearance_m: Vec<f64>,
     constraints: Vec<Distance>,
     pose: RigidMotion,
+    /// Buffers reused by every sub-step (no allocation per step).
+    lambda_scratch: Vec<f64>,
+    retention_lambda_scratch: Vec<f64>,
+    target_scratch: Vec<DVec3>,
+    /// The air's velocity at each particle for the current step (empty without wind).
+    wind_scratch: Vec<DVec3>,
     steps: u64,
     accumulator_s: f64,
     stats: StepStats,
@@ -115,6 +149,7 @@ impl HairSim {
         let mut rest_position = Vec::new();
         let mut retention = Vec::new();
         let mut inverse_mass = Vec::new();
+        let mut clearance_m = Vec::new();
         let physics = &motion.physics;
         for (c, column) in mesh.columns.iter().enumerate() {
             column_start.push(rest_position.len());
@@ -126,6 +161,7 @@ impl HairSim {
                     + (physics.retention_tip - physics.retention_root) * fraction;
                 retention.push((stiffness > 0.0).then(|| compliance(stiffness)));
                 inverse_mass.push(if k == 0 { 0.0 } else { 1.0 });
+                clearance_m.push(physics.collision_margin_m + physics.volume_m_per_layer * k as f64);
             }
         }
         for vertex in pinned {
@@ -181,7 +217,7 @@ impl HairSim {
                 }
             }
         }
-        let constraints = edges
+        let constraints: Vec<Distance> = edges
             .into_iter()
             .map(|((a, b), kind)| Distance {
                 a,
@@ -191,6 +227,7 @@ impl HairSim {
             })
             .filter(|d| d.rest_m.is_finite())
             .collect();
+        let constraints = by_colour(constraints, rest_position.len());
         let pose = motion.head_pose(0.0);
         let position: Vec<DVec3> = rest_position.iter().map(|&p| pose.apply(p)).collect();
         Self {
@@ -206,8 +243,13 @@ impl HairSim {
             rest_position,
             inverse_mass,
             retention,
+            clearance_m,
             constraints,
             pose,
+            lambda_scratch: Vec::new(),
+            retention_lambda_scratch: Vec::new(),
+            target_scratch: Vec::new(),
+            wind_scratch: Vec::new(),
             steps: 0,
             accumulator_s: 0.0,
             stats: StepStats::default(),
@@ -232,6 +274,22 @@ impl HairSim {
 
     pub fn constraint_count(&self) -> usize {
         self.constraints.len()
+    }
+
+    /// Bytes the simulator holds (particles, constraints, the modelled mesh; the body's
+    /// field counted apart, see [`BodySdf::memory_bytes`]).
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let particles = self.position.len()
+            * (4 * size_of::<DVec3>() + size_of::<f64>() + size_of::<Option<f64>>());
+        let constraints = self.constraints.len() * size_of::<Distance>();
+        let mesh: usize = self
+            .rest
+            .columns
+            .iter()
+            .map(|c| c.positions.len() * (size_of::<DVec3>() + size_of::<f64>()))
+            .sum();
+        particles + constraints + mesh
     }
 
     /// Fixed steps taken since the start.
@@ -329,6 +387,19 @@ impl HairSim {
         let quality = self.motion.quality.clone();
         let substeps = quality.substeps.max(1);
         let dt = self.step_s() / substeps as f64;
+        // The air at the middle of the step, once per step: gusts change over tenths of a
+        // second, sub-steps over milliseconds.
+        let mut wind = std::mem::take(&mut self.wind_scratch);
+        wind.clear();
+        if self.motion.wind.speed_m_per_s > 0.0 {
+            let time_s = self.time_s() + 0.5 * self.step_s();
+            wind.extend(
+                self.position
+                    .iter()
+                    .map(|&p| wind_velocity(&self.motion.wind, p, time_s)),
+            );
+        }
+        self.wind_scratch = wind;
         for substep in 0..substeps {
             let time_s = self.time_s() + (substep + 1) as f64 * dt;
             self.substep(time_s, dt, quality.iterations.max(1));
@@ -369,7 +440,7 @@ impl HairSim {
                 self.velocity[i] = DVec3::ZERO;
                 continue;
             }
-            let air = wind_velocity(&motion.wind, self.position[i], time_s);
+            let air = self.wind_scratch.get(i).copied().unwrap_or(DVec3::ZERO);
             let mut v = self.velocity[i] * damping + gravity * dt;
             v = air + (v - air) * drag;
             self.velocity[i] = v;
@@ -387,10 +458,20 @@ impl HairSim {
             compliance_of(Kind::Shape),
             compliance_of(Kind::Bend),
         ];
-        let mut lambda = vec![0.0; self.constraints.len()];
-        let mut retention_lambda = vec![0.0; self.position.len()];
-        for _ in 0..iterations {
-            for (c, constraint) in self.constraints.iter().enumerate() {
+        // 1 / (w_a + w_b + α̃) by kind and by how many ends move (particles have unit or zero
+        // inverse mass): no division in the constraint loop but the one for the direction.
+        let inverse_denominator = stiffness.map(|alpha| [1.0 / (1.0 + alpha), 1.0 / (2.0 + alpha)]);
+        let mut lambda = std::mem::take(&mut self.lambda_scratch);
+        lambda.clear();
+        lambda.resize(self.constraints.len(), 0.0);
+        let mut targets = std::mem::take(&mut self.target_scratch);
+        targets.clear();
+        targets.extend(self.rest_position.iter().map(|&p| new_pose.apply(p)));
+        let mut retention_lambda = std::mem::take(&mut self.retention_lambda_scratch);
+        retention_lambda.clear();
+        retention_lambda.resize(self.position.len(), 0.0);
+        for iteration in 0..iterations {
+            for (constraint, lambda) in self.constraints.iter().zip(lambda.iter_mut()) {
                 let (a, b) = (constraint.a as usize, constraint.b as usize);
                 let (wa, wb) = (self.inverse_mass[a], self.inverse_mass[b]);
                 let w = wa + wb;
@@ -398,17 +479,26 @@ impl HairSim {
                     continue;
                 }
                 let delta = self.position[a] - self.position[b];
-                let length = delta.length();
-                if length.is_nan() || length <= 1e-12 {
+                let length_squared = delta.length_squared();
+                if length_squared.is_nan() || length_squared <= 1e-24 {
                     continue; // coincident: no direction to push along
                 }
-                let normal = delta / length;
-                let alpha = stiffness[constraint.kind as usize];
-                let violation = length - constraint.rest_m;
-                let change = (-violation - alpha * lambda[c]) / (w + alpha);
-                lambda[c] += change;
-                self.position[a] += normal * (wa * change);
-                self.position[b] -= normal * (wb * change);
+                let length = length_squared.sqrt();
+                let kind = constraint.kind as usize;
+                let alpha = stiffness[kind];
+                let inverse = if w == 1.0 {
+                    inverse_denominator[kind][0]
+                } else if w == 2.0 {
+                    inverse_denominator[kind][1]
+                } else {
+                    1.0 / (w + alpha)
+                };
+                let change = (constraint.rest_m - length - alpha * *lambda) * inverse;
+                *lambda += change;
+                // The unit direction folded into one scale: one division per constraint.
+                let scale = change / length;
+                self.position[a] += delta * (wa * scale);
+                self.position[b] -= delta * (wb * scale);
             }
             for (i, lambda) in retention_lambda.iter_mut().enumerate() {
                 let (Some(alpha), w) = (self.retention[i], self.inverse_mass[i]) else {
@@ -417,19 +507,26 @@ impl HairSim {
                 if w == 0.0 {
                     continue;
                 }
-                let target = new_pose.apply(self.rest_position[i]);
-                let delta = self.position[i] - target;
-                let length = delta.length();
-                if length.is_nan() || length <= 1e-12 {
+                let delta = self.position[i] - targets[i];
+                let length_squared = delta.length_squared();
+                if length_squared.is_nan() || length_squared <= 1e-24 {
                     continue;
                 }
+                let length = length_squared.sqrt();
                 let alpha = alpha / dt2;
                 let change = (-length - alpha * *lambda) / (w + alpha);
                 *lambda += change;
-                self.position[i] += delta / length * (w * change);
+                self.position[i] += delta * (w * change / length);
             }
-            self.collide(old_pose, new_pose);
+            // Collisions are projected last, once per sub-step: nothing moves a particle
+            // after them, and each costs a field lookup.
+            if iteration + 1 == iterations {
+                self.collide(old_pose, new_pose);
+            }
         }
+        self.lambda_scratch = lambda;
+        self.target_scratch = targets;
+        self.retention_lambda_scratch = retention_lambda;
 
         for i in 0..self.position.len() {
             let v = (self.position[i] - self.previous[i]) / dt;
@@ -452,17 +549,16 @@ impl HairSim {
             return;
         }
         let physics = &self.motion.physics;
-        let margin = physics.collision_margin_m;
         for i in 0..self.position.len() {
             if self.inverse_mass[i] == 0.0 {
                 continue;
             }
+            let margin = self.clearance_m[i];
             let local = new_pose.inverse_apply(self.position[i]);
-            let distance = self.sdf.distance_m(local);
+            let (distance, normal) = self.sdf.distance_and_gradient(local);
             if distance.is_nan() || distance >= margin {
                 continue;
             }
-            let normal = self.sdf.gradient(local);
             let depth = margin - distance;
             let mut pushed = local + normal * depth;
             let before = old_pose.inverse_apply(self.previous[i]);

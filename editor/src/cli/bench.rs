@@ -112,11 +112,42 @@ pub enum Which {
         #[arg(long, default_value_t = 3)]
         runs: usize,
     },
+    /// The hair-mesh simulator's accuracy against time: sub-steps × iterations against a
+    /// converged reference on each head sample turning its head in wind; position error,
+    /// time per simulated second and per 60 Hz frame, memory (CSV and a PNG chart).
+    Sim {
+        /// Samples to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("head_long_wavy"), String::from("head_curly"), String::from("head_short_straight")])]
+        samples: Vec<String>,
+        /// Simulated seconds per run.
+        #[arg(long, default_value_t = 1.5)]
+        seconds: f64,
+        /// The converged reference: sub-steps and iterations.
+        #[arg(long, default_value_t = 32)]
+        reference_substeps: u32,
+        #[arg(long, default_value_t = 24)]
+        reference_iterations: u32,
+        /// Folder for sim.csv and sim.png.
+        #[arg(long, default_value = "target/bench")]
+        out: std::path::PathBuf,
+    },
 }
 
 pub fn run(which: Which) -> anyhow::Result<()> {
     match which {
         Which::Interior { repeat } => interior(repeat.max(1)),
+        Which::Sim {
+            samples,
+            seconds,
+            reference_substeps,
+            reference_iterations,
+            out,
+        } => super::bench_sim::run(
+            &samples,
+            seconds,
+            (reference_substeps, reference_iterations),
+            &out,
+        ),
         Which::Accuracy {
             project,
             out,

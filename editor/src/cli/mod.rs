@@ -15,6 +15,7 @@ mod accuracy;
 mod bench;
 mod bench_effects;
 mod bench_shading;
+mod bench_sim;
 mod render;
 mod simulate;
 

@@ -1,4 +1,8 @@
 //! Image comparison shared by the golden-image tests.
+#![allow(
+    dead_code,
+    reason = "each test binary that includes this module uses a different part of it"
+)]
 
 /// Mean absolute channel difference of two same-sized images (0-255 scale).
 pub fn mean_error(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
