@@ -90,6 +90,7 @@ samples: toolchain
 bench: toolchain gpu-deps
 	$(CARGO) build --release -p hairloom-editor
 	./target/release/hairloom bench interior
+	./target/release/hairloom bench sim
 	./target/release/hairloom bench effects --size 800x800 --runs 1
 	./target/release/hairloom bench shading --size 320 --spp 64 --runs 1
 

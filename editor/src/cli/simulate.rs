@@ -121,7 +121,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         .textures
         .hair_bounds()
         .context("nothing to simulate: no bundle grows hair")?;
-    let (centre, reach) = ((lo + hi) * 0.5, (hi - lo).length() * 0.4);
+    let (centre, reach) = ((lo + hi) * 0.5, (hi - lo).length() * 0.3);
     let frame = (centre - Vec3::splat(reach), centre + Vec3::splat(reach));
 
     let gpu = if settings.render {
