@@ -400,3 +400,41 @@ fn special_files_and_oversized_histories_are_refused_by_name() {
     assert_eq!(json_path, "history", "{message}");
     assert!(message.contains("20001 undo and redo entries"), "{message}");
 }
+
+/// Measured with the body's own distance field (the simulator's): no hair-mesh vertex above
+/// the scalp lies inside the head scan by more than the field's interpolation error.
+#[test]
+fn head_samples_keep_every_hair_mesh_vertex_out_of_the_body() {
+    use hairloom_core::simulate::body_sdf::{BodySdf, DEFAULT_RESOLUTION};
+    for path in sample_paths()
+        .iter()
+        .filter(|p| p.to_string_lossy().contains("head_"))
+    {
+        let document = project::load(path).expect("sample").document;
+        let sdf = BodySdf::build(&document.body, DEFAULT_RESOLUTION, 0.02);
+        let tolerance_m = 0.5 * sdf.cell_m();
+        let inside: Vec<(usize, usize, f64)> = document
+            .hair_mesh
+            .columns
+            .iter()
+            .enumerate()
+            .flat_map(|(c, column)| {
+                column
+                    .positions
+                    .iter()
+                    .enumerate()
+                    .skip(1)
+                    .map(move |(k, p)| (c, k, *p))
+            })
+            .map(|(c, k, p)| (c, k, sdf.distance_m(p)))
+            .filter(|(_, _, d)| *d < -tolerance_m)
+            .collect();
+        assert!(
+            inside.is_empty(),
+            "{}: {} vertices inside the body, e.g. {:?}",
+            path.display(),
+            inside.len(),
+            &inside[..inside.len().min(3)]
+        );
+    }
+}

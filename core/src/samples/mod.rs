@@ -167,7 +167,8 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
         let mut previous = root;
         for k in 1..column.positions.len() {
             let fraction = k as f64 / growth.layers.max(1) as f64;
-            let bend = (growth.gravity * fraction * 1.3).min(1.0);
+            // Hair leaves the scalp and lies down soon after: bend grows fast near the root.
+            let bend = (growth.gravity * fraction.sqrt() * 1.3).min(1.0);
             let outward = DVec3::new(n.x, 0.0, n.z).normalize_or_zero() * 0.3;
             // Hair from the front of the scalp sweeps back instead of falling over the face.
             let front = (root.z / radii_m.z).max(0.0);
@@ -188,6 +189,33 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
     interior::place_interior(&mut mesh, None);
     mesh.update_w();
     mesh
+}
+
+/// Pushes every hair-mesh vertex out of the body with the simulator's collision, holding
+/// the grown style (no gravity, full style hold) for half a second of steps: the growth's
+/// ellipsoid is only a stand-in for the scan's real surface (ears, neck and nape stick out of
+/// it). Interior vertices keep their simulated places: re-placing them from the exterior
+/// would put some back inside (the placement knows nothing of the body), so the next edit of
+/// one of their layers may too — a limit of automatic interior placement on curved bodies.
+pub fn keep_out_of_body(mesh: &HairMesh, body: &BodyMesh) -> HairMesh {
+    use crate::model::motion::{HairPhysics, Motion};
+    let motion = Motion {
+        gravity_m_per_s2: 0.0,
+        physics: HairPhysics {
+            retention_root: 1.0,
+            retention_tip: 0.6,
+            volume_m_per_layer: 0.0,
+            ..HairPhysics::default()
+        },
+        ..Motion::default()
+    };
+    let mut sim = crate::simulate::HairSim::with_body(mesh, body, &motion, &[]);
+    for _ in 0..30 {
+        sim.step();
+    }
+    let mut settled = sim.posed_mesh();
+    settled.update_w();
+    settled
 }
 
 /// Area-weighted root-layer vertex normals.
@@ -214,8 +242,8 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
         Growth {
             layers: 2,
             step_m: 0.012,
-            gravity: 0.25,
-            volume: 0.12,
+            gravity: 0.45,
+            volume: 0.09,
         },
     ),
     (
@@ -224,7 +252,7 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
             layers: 6,
             step_m: 0.04,
             gravity: 1.0,
-            volume: 0.18,
+            volume: 0.06,
         },
     ),
     (
@@ -232,8 +260,8 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
         Growth {
             layers: 4,
             step_m: 0.025,
-            gravity: 0.5,
-            volume: 0.3,
+            gravity: 0.65,
+            volume: 0.16,
         },
     ),
 ];
@@ -323,7 +351,7 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
     Ok(HEAD_STYLES
         .iter()
         .map(|(name, growth)| {
-            let mesh = grow(&scalp, *growth, radii_m);
+            let mesh = keep_out_of_body(&grow(&scalp, *growth, radii_m), &body);
             let mut document = Document::new(*name, mesh);
             document.styling.global = head_style(name);
             document.scene.material = head_material(name);

@@ -428,10 +428,18 @@ mod tests {
         let g = sdf.gradient(DVec3::new(0.0, 0.0, 0.105));
         assert!(g.dot(DVec3::Z) > 0.95, "{g}");
         // The fast path agrees with the slow one.
-        for p in [DVec3::new(0.0, 0.0, 0.105), DVec3::new(0.06, 0.07, -0.02), DVec3::X * 0.5] {
+        for p in [
+            DVec3::new(0.0, 0.0, 0.105),
+            DVec3::new(0.06, 0.07, -0.02),
+            DVec3::X * 0.5,
+        ] {
             let (d, n) = sdf.distance_and_gradient(p);
             assert!((d - sdf.distance_m(p)).abs() < 1e-9, "{p}");
-            assert!(n.dot(sdf.gradient(p)) > 0.98, "{p}: {n} vs {}", sdf.gradient(p));
+            assert!(
+                n.dot(sdf.gradient(p)) > 0.98,
+                "{p}: {n} vs {}",
+                sdf.gradient(p)
+            );
         }
         assert!(sdf.distance_m(DVec3::NAN) == f64::INFINITY);
     }

@@ -161,7 +161,8 @@ impl HairSim {
                     + (physics.retention_tip - physics.retention_root) * fraction;
                 retention.push((stiffness > 0.0).then(|| compliance(stiffness)));
                 inverse_mass.push(if k == 0 { 0.0 } else { 1.0 });
-                clearance_m.push(physics.collision_margin_m + physics.volume_m_per_layer * k as f64);
+                clearance_m
+                    .push(physics.collision_margin_m + physics.volume_m_per_layer * k as f64);
             }
         }
         for vertex in pinned {
