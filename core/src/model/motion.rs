@@ -212,6 +212,11 @@ pub const MAX_HEAD_KEYS: usize = 10_000;
 pub const MAX_RATE_HZ: f64 = 1000.0;
 pub const MAX_SUBSTEPS: u32 = 64;
 pub const MAX_ITERATIONS: u32 = 64;
+/// The most constraint sweeps (rate × sub-steps × iterations) per simulated second: 60 Hz ×
+/// 16 × 16, about 80 ms of work per frame on the long sample; more is a typing mistake.
+pub const MAX_SWEEPS_PER_S: f64 = 60.0 * 16.0 * 16.0;
+/// The latest time a head-animation key may have (ten minutes): bounded work to reach it.
+pub const MAX_KEY_TIME_S: f64 = 600.0;
 
 fn invalid(path: String, message: String) -> InvalidScene {
     InvalidScene { path, message }
@@ -253,8 +258,9 @@ impl Motion {
         }
     }
 
-    /// The body's pose at `time_s`: keys interpolated linearly (translation) and spherically
-    /// (rotation), held before the first and after the last.
+    /// The body's pose at `time_s`: keys interpolated linearly (translation and each of yaw,
+    /// pitch and roll, so a 270° turn between two keys turns 270°, not the short way), held
+    /// before the first and after the last.
     pub fn head_pose(&self, time_s: f64) -> RigidMotion {
         let keys = &self.head_animation;
         let pose = |key: &HeadKey| RigidMotion {
@@ -267,23 +273,28 @@ impl Motion {
         if time_s.partial_cmp(&first.time_s) != Some(std::cmp::Ordering::Greater) {
             return pose(first);
         }
-        for pair in keys.windows(2) {
-            let (a, b) = (&pair[0], &pair[1]);
-            if time_s <= b.time_s {
-                let span = b.time_s - a.time_s;
-                let t = if span > 0.0 {
-                    ((time_s - a.time_s) / span).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
-                let (pa, pb) = (pose(a), pose(b));
-                return RigidMotion {
-                    rotation: pa.rotation.slerp(pb.rotation, t).normalize(),
-                    translation: pa.translation.lerp(pb.translation, t),
-                };
-            }
-        }
-        pose(keys.last().unwrap_or(first))
+        // The first key at or after `time_s` (keys are in time order).
+        let next = keys.partition_point(|k| k.time_s < time_s);
+        let (Some(a), Some(b)) = (keys.get(next.wrapping_sub(1)), keys.get(next)) else {
+            return pose(keys.last().unwrap_or(first));
+        };
+        let span = b.time_s - a.time_s;
+        let t = if span > 0.0 {
+            ((time_s - a.time_s) / span).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let lerp = |x: f64, y: f64| x + (y - x) * t;
+        let between = HeadKey {
+            time_s,
+            translation_m: DVec3::from(a.translation_m)
+                .lerp(DVec3::from(b.translation_m), t)
+                .to_array(),
+            yaw_deg: lerp(a.yaw_deg, b.yaw_deg),
+            pitch_deg: lerp(a.pitch_deg, b.pitch_deg),
+            roll_deg: lerp(a.roll_deg, b.roll_deg),
+        };
+        pose(&between)
     }
 
     /// The animation's length: the last key's time (0 for a still head).
@@ -304,7 +315,7 @@ impl Motion {
         let mut previous = f64::NEG_INFINITY;
         for (i, key) in self.head_animation.iter().enumerate() {
             let at = |field: &str| format!("motion.head_animation[{i}].{field}");
-            check(&at("time_s"), key.time_s, 0.0, 1e6)?;
+            check(&at("time_s"), key.time_s, 0.0, MAX_KEY_TIME_S)?;
             if key.time_s < previous {
                 return Err(invalid(
                     at("time_s"),
@@ -391,6 +402,16 @@ impl Motion {
                 ),
             ));
         }
+        let sweeps = q.rate_hz * q.substeps as f64 * q.iterations as f64;
+        if sweeps > MAX_SWEEPS_PER_S {
+            return Err(invalid(
+                "motion.quality".into(),
+                format!(
+                    "{} Hz × {} sub-steps × {} iterations is {sweeps} constraint sweeps per simulated second, more than the {MAX_SWEEPS_PER_S} allowed",
+                    q.rate_hz, q.substeps, q.iterations
+                ),
+            ));
+        }
         Ok(())
     }
 }
@@ -411,6 +432,23 @@ mod tests {
         let x = motion.head_pose(1.5).apply(DVec3::X);
         assert!((x - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-9, "{x}");
         assert_eq!(motion.head_pose(1e9), RigidMotion::IDENTITY);
+        // Angles interpolate as angles: halfway through a 270° turn is 135°, not −45°.
+        let wide = Motion {
+            head_animation: vec![
+                HeadKey::at(0.0),
+                HeadKey {
+                    yaw_deg: 270.0,
+                    ..HeadKey::at(1.0)
+                },
+            ],
+            ..Motion::default()
+        };
+        let (_, angle) = wide.head_pose(0.5).rotation.to_axis_angle();
+        assert!(
+            (angle.to_degrees() - 135.0).abs() < 1e-9,
+            "{}",
+            angle.to_degrees()
+        );
         let nan = motion.head_pose(f64::NAN);
         assert!(nan.rotation.is_finite() && nan.translation.is_finite());
     }
@@ -434,6 +472,26 @@ mod tests {
         assert_eq!(
             motion.validate().expect_err("invalid").path,
             "motion.physics.friction"
+        );
+        let mut motion = Motion::default();
+        motion.quality.substeps = 0;
+        assert_eq!(
+            motion.validate().expect_err("invalid").path,
+            "motion.quality.substeps"
+        );
+        let mut motion = Motion::default();
+        motion.quality.rate_hz = 1000.0;
+        motion.quality.substeps = 64;
+        motion.quality.iterations = 64;
+        assert_eq!(
+            motion.validate().expect_err("invalid").path,
+            "motion.quality"
+        );
+        let mut motion = Motion::head_turn(0.0, 1.0, 30.0);
+        motion.head_animation[4].time_s = 1e6;
+        assert_eq!(
+            motion.validate().expect_err("invalid").path,
+            "motion.head_animation[4].time_s"
         );
         let mut motion = Motion::default();
         motion.quality.substeps = 0;

@@ -19,8 +19,9 @@ use crate::model::document::BodyMesh;
 
 /// Grid points along the body's longest side by default: about 4 mm cells on a head.
 pub const DEFAULT_RESOLUTION: usize = 72;
-/// The largest resolution accepted: bounds the field's memory (256³ × 4 B = 64 MiB).
-pub const MAX_RESOLUTION: usize = 256;
+/// The largest resolution accepted: bounds the build's memory (about 163³ points × 16 B =
+/// 69 MB while building, a quarter of it kept).
+pub const MAX_RESOLUTION: usize = 160;
 
 /// Which part of a triangle is closest to a point: decides the pseudo-normal for the sign.
 #[derive(Clone, Copy, Debug, PartialEq)]

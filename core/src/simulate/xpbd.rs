@@ -38,6 +38,12 @@ use crate::simulate::wind::wind_velocity;
 /// Frame time above which the simulator drops time instead of catching up (a stalled
 /// frame must not trigger a burst of steps).
 pub const MAX_FRAME_S: f64 = 0.25;
+/// The most fixed steps one frame may take; time beyond them is dropped (a slow machine
+/// plays slower instead of falling further behind with every frame).
+pub const MAX_STEPS_PER_FRAME: u32 = 16;
+/// Layers above which the hair's volume stops adding clearance from the body: volume is how
+/// thick hair lies on the head, which a long strand's tip does not add to.
+pub const VOLUME_LAYERS: usize = 4;
 /// The head moving faster than this between two sub-steps is a cut (teleport), not motion:
 /// the hair is carried with it rigidly instead of being yanked.
 pub const TELEPORT_SPEED_M_PER_S: f64 = 10.0;
@@ -161,8 +167,10 @@ impl HairSim {
                     + (physics.retention_tip - physics.retention_root) * fraction;
                 retention.push((stiffness > 0.0).then(|| compliance(stiffness)));
                 inverse_mass.push(if k == 0 { 0.0 } else { 1.0 });
-                clearance_m
-                    .push(physics.collision_margin_m + physics.volume_m_per_layer * k as f64);
+                clearance_m.push(
+                    physics.collision_margin_m
+                        + physics.volume_m_per_layer * k.min(VOLUME_LAYERS) as f64,
+                );
             }
         }
         for vertex in pinned {
@@ -338,10 +346,14 @@ impl HairSim {
     }
 
     /// Signed distance of the deepest particle below the body's surface (positive: inside).
+    /// Pinned vertices (the roots on the scalp) are left out: they sit on the surface by
+    /// construction.
     pub fn deepest_penetration_m(&self) -> f64 {
         self.position
             .iter()
-            .map(|&p| -self.sdf.distance_m(self.pose.inverse_apply(p)))
+            .zip(&self.inverse_mass)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(&p, _)| -self.sdf.distance_m(self.pose.inverse_apply(p)))
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
@@ -358,6 +370,10 @@ impl HairSim {
         let mut taken = 0;
         // A tolerance of a millionth of a step absorbs the rounding of frame times.
         while self.accumulator_s >= step_s * (1.0 - 1e-6) {
+            if taken == MAX_STEPS_PER_FRAME {
+                self.accumulator_s = 0.0;
+                break;
+            }
             self.step();
             self.accumulator_s -= step_s;
             taken += 1;
@@ -367,8 +383,9 @@ impl HairSim {
     }
 
     /// Runs (from the start if `time_s` is in the past) until the simulated time reaches
-    /// `time_s`, rounded to whole steps. For scrubbing and `render --time`.
-    pub fn seek(&mut self, time_s: f64) {
+    /// `time_s`, rounded to whole steps. For scrubbing and `render --time`. Returns the
+    /// steps it ran.
+    pub fn seek(&mut self, time_s: f64) -> u64 {
         let target = if time_s.is_finite() {
             (time_s.max(0.0) / self.step_s()).round() as u64
         } else {
@@ -377,10 +394,12 @@ impl HairSim {
         if target < self.steps {
             *self = Self::new(&self.rest, self.sdf.clone(), &self.motion, &self.pinned);
         }
+        let ran = target.saturating_sub(self.steps);
         while self.steps < target {
             self.step();
         }
         self.accumulator_s = 0.0;
+        ran
     }
 
     /// One fixed step: `substeps` predictions, each followed by `iterations` projections.
@@ -419,7 +438,8 @@ impl HairSim {
             .1;
         let turn = turn.min(std::f64::consts::TAU - turn).abs();
         let moved = (new_pose.translation - old_pose.translation).length();
-        if moved > TELEPORT_SPEED_M_PER_S * dt || turn > TELEPORT_TURN_RAD_PER_S * dt {
+        let cut = moved > TELEPORT_SPEED_M_PER_S * dt || turn > TELEPORT_TURN_RAD_PER_S * dt;
+        if cut {
             // A cut: carry everything with the head, keeping its shape and body-relative
             // velocity.
             let delta = new_pose.rotation * old_pose.rotation.inverse();
@@ -522,7 +542,9 @@ impl HairSim {
             // Collisions are projected last, once per sub-step: nothing moves a particle
             // after them, and each costs a field lookup.
             if iteration + 1 == iterations {
-                self.collide(old_pose, new_pose);
+                // After a cut the previous positions were carried too: they are in the new
+                // pose's frame.
+                self.collide(if cut { new_pose } else { old_pose }, new_pose);
             }
         }
         self.lambda_scratch = lambda;

@@ -99,10 +99,10 @@ impl Playback {
         }
         let frame_s = self.last_tick_s.map_or(0.0, |last| now_s - last);
         self.last_tick_s = Some(now_s);
-        let started = Instant::now();
         let Some(sim) = self.simulator(document, revision) else {
             return false;
         };
+        let started = Instant::now();
         let taken = sim.advance(frame_s);
         if taken > 0 {
             let ms = started.elapsed().as_secs_f64() * 1e3 / taken as f64;
@@ -118,11 +118,7 @@ impl Playback {
         let Some(sim) = self.simulator(document, revision) else {
             return;
         };
-        let before = sim.stats().steps;
-        let rewound = time_s < sim.time_s();
-        sim.seek(time_s);
-        let after = sim.stats().steps;
-        self.steps += if rewound { after } else { after - before };
+        self.steps += sim.seek(time_s);
         self.pose(document, revision);
     }
 }

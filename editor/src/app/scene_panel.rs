@@ -702,6 +702,9 @@ fn environment_ui(ui: &mut egui::Ui, state: &mut EditorState) {
     }
 }
 
+/// The longest time the motion's time slider reaches.
+const MAX_SCRUB_S: f64 = 60.0;
+
 /// A slider over a motion parameter: one undoable scene edit per change (a drag is one step).
 fn motion_slider(
     ui: &mut egui::Ui,
@@ -757,7 +760,9 @@ fn motion_ui(ui: &mut egui::Ui, state: &mut EditorState) {
             state.playback.reset();
         }
     });
-    let end_s = (motion.duration_s() + 2.0).max(4.0);
+    // Scrubbing re-simulates from the start when it goes back, on this thread: a minute at
+    // most keeps a drag responsive.
+    let end_s = (motion.duration_s() + 2.0).clamp(4.0, MAX_SCRUB_S);
     let mut time_s = state.playback.time_s();
     let r = ui.add(egui::Slider::new(&mut time_s, 0.0..=end_s).text("Time s"));
     if r.changed() {

@@ -173,6 +173,15 @@ impl EditorState {
             .tick(&self.project.document, self.revision, now_s)
     }
 
+    /// Selection and edits act on the modelled shape: a posed playback goes back to it first
+    /// (what is picked is then what is drawn).
+    pub fn stop_playback_for_editing(&mut self) {
+        if self.playback.is_posed() {
+            self.playback.reset();
+            self.message = "playback reset: selection and edits act on the modelled shape".into();
+        }
+    }
+
     /// Shows the motion at `time_s`.
     pub fn seek_playback(&mut self, time_s: f64) {
         self.playback
@@ -361,6 +370,7 @@ impl EditorState {
         edit: impl FnOnce(&HairMesh, &[u32]) -> Result<EditOutcome, EditError>,
     ) -> bool {
         self.commit_edit();
+        self.stop_playback_for_editing();
         let selected: Vec<u32> = self.selection.iter().copied().collect();
         match edit(&self.project.document.hair_mesh, &selected) {
             Ok(outcome) => {

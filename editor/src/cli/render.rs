@@ -98,12 +98,13 @@ pub fn posed_at(
     time_s: f64,
 ) -> std::borrow::Cow<'_, hairloom_core::Document> {
     match &document.scene.motion {
-        Some(motion) if time_s > 0.0 => {
+        // Time 0 too: the body's first key may not be its modelled pose.
+        Some(motion) => {
             let mut sim = hairloom_core::simulate::simulator(document, motion);
             sim.seek(time_s);
             std::borrow::Cow::Owned(hairloom_core::simulate::posed_document(document, &sim))
         }
-        _ => std::borrow::Cow::Borrowed(document),
+        None => std::borrow::Cow::Borrowed(document),
     }
 }
 

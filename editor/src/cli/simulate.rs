@@ -22,6 +22,9 @@ use super::render::{
 
 /// The most frames one command writes.
 pub const MAX_FRAMES: usize = 10_000;
+/// Strand points per bundle over all frames an animated USD may hold (with a few hundred
+/// bundles, some hundred million points: a few GB of text at most).
+pub const MAX_USDA_POINTS_PER_BUNDLE: f64 = 1e6;
 /// Vertices per strand in the animated USD: 2^3 + 1 (a sequence is many copies).
 pub const USDA_VERTICES_LOG2: u32 = 3;
 
@@ -86,6 +89,18 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
     let frame_count = (seconds * fps).round() as usize + 1;
     if frame_count > MAX_FRAMES {
         bail!("{frame_count} frames are more than the {MAX_FRAMES} one command writes");
+    }
+    if settings.usda {
+        // Every frame's strands are held until the file is written: bound them.
+        let points = frame_count as f64
+            * (settings.strands_per_bundle as f64)
+            * ((1u64 << USDA_VERTICES_LOG2) + 1) as f64;
+        if points > MAX_USDA_POINTS_PER_BUNDLE {
+            bail!(
+                "--usda: {frame_count} frames × {} strands per bundle is too much to hold; lower --strands-per-bundle, --fps or --seconds",
+                settings.strands_per_bundle
+            );
+        }
     }
     if !settings.render && !settings.usda {
         bail!("nothing to write: --no-render without --usda");

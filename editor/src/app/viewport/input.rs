@@ -36,11 +36,14 @@ impl Viewport {
         projector: Projector,
     ) {
         let modifiers = ui.input(|i| i.modifiers);
-        let mesh = &state.document().hair_mesh;
         // Without X-ray only what the body leaves in view is picked (no selecting through
         // the head). The depth map is built only for a click or a finished region.
         let gesture_ends =
             response.clicked() || (response.drag_stopped() && self.drag_path.len() > 1);
+        if gesture_ends {
+            state.stop_playback_for_editing();
+        }
+        let mesh = &state.document().hair_mesh;
         let depth = (gesture_ends && !state.tool.xray).then(|| {
             let body = &state.document().body;
             select::DepthMap::rasterize(

@@ -262,6 +262,7 @@ impl Viewport {
         kind: TransformKind,
     ) {
         state.commit_edit();
+        state.stop_playback_for_editing();
         let (vertices, pivot) = self.selection_targets(state);
         let Some(pivot) = pivot else {
             state.message = format!(
