@@ -776,9 +776,11 @@ impl HairloomApp {
                 // The viewport's real rate: from its last frame's cost, not the UI's repaints
                 // (which idle between frames).
                 ui.separator();
+                let fps = 1e3 / ms.max(1e-3);
+                // Below one frame a second, show enough digits to tell 0.05 from 0.5.
+                let digits = if fps < 1.0 { 2 } else { 1 };
                 ui.label(format!(
-                    "GPU generate + draw {ms:.1} ms ({:.1} fps)",
-                    1e3 / ms.max(1e-3)
+                    "GPU generate + draw {ms:.1} ms ({fps:.digits$} fps)"
                 ));
             }
             if let viewport::FrameQuality::Interactive { scale } = self.viewport.shown_quality {
