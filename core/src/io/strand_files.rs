@@ -51,11 +51,28 @@ pub fn hair_file(strands: &[Strand], thickness_m: f32, color: [f32; 3]) -> Vec<u
 /// A USD stage with one `BasisCurves` prim (`/Hair`, linear curves, metres, y up), constant
 /// width and the root uv as a uniform `primvars:st`.
 pub fn usda_file(strands: &[Strand], width_m: f32) -> String {
+    let points = format!("    point3f[] points = {}\n", usda_points(strands));
+    usda_stage("", "Exported by Hairloom", strands, &points, width_m)
+}
+
+/// `[(x, y, z), …]`: every strand's points in order, as USD writes a `point3f[]`.
+fn usda_points(strands: &[Strand]) -> String {
+    let points: Vec<String> = strands
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .map(|p| format!("({}, {}, {})", p.x as f32, p.y as f32, p.z as f32))
+        .collect();
+    format!("[{}]", points.join(", "))
+}
+
+/// The stage around the `/Hair` prim: `metadata` lines join the stage's, `points` is the
+/// prim's points attribute (a value or time samples); counts and uv come from `strands`.
+fn usda_stage(metadata: &str, doc: &str, strands: &[Strand], points: &str, width_m: f32) -> String {
     use std::fmt::Write;
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n    doc = \"Exported by Hairloom\"\n)\n"
+        "#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n{metadata}    doc = \"{doc}\"\n)\n"
     );
     let _ = writeln!(
         out,
@@ -63,12 +80,7 @@ pub fn usda_file(strands: &[Strand], width_m: f32) -> String {
     );
     let counts: Vec<String> = strands.iter().map(|s| s.points.len().to_string()).collect();
     let _ = writeln!(out, "    int[] curveVertexCounts = [{}]", counts.join(", "));
-    let points: Vec<String> = strands
-        .iter()
-        .flat_map(|s| s.points.iter())
-        .map(|p| format!("({}, {}, {})", p.x as f32, p.y as f32, p.z as f32))
-        .collect();
-    let _ = writeln!(out, "    point3f[] points = [{}]", points.join(", "));
+    out.push_str(points);
     let _ = writeln!(
         out,
         "    float[] widths = [{width_m}] (\n        interpolation = \"constant\"\n    )"
@@ -103,51 +115,32 @@ pub fn usda_animation(
             "{frames_per_second} frames per second is not a rate"
         ));
     }
-    let counts: Vec<usize> = first.iter().map(|s| s.points.len()).collect();
     for (i, frame) in frames.iter().enumerate() {
-        if frame.len() != counts.len()
-            || frame.iter().zip(&counts).any(|(s, &n)| s.points.len() != n)
+        if frame.len() != first.len()
+            || frame
+                .iter()
+                .zip(first)
+                .any(|(s, f)| s.points.len() != f.points.len())
         {
             return Err(format!("frame {i} has other curves than frame 0"));
         }
     }
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n    startTimeCode = 0\n    endTimeCode = {}\n    timeCodesPerSecond = {frames_per_second}\n    framesPerSecond = {frames_per_second}\n    doc = \"Simulated by Hairloom\"\n)\n",
+    let metadata = format!(
+        "    startTimeCode = 0\n    endTimeCode = {}\n    timeCodesPerSecond = {frames_per_second}\n    framesPerSecond = {frames_per_second}\n",
         frames.len() - 1
     );
-    let _ = writeln!(
-        out,
-        "def BasisCurves \"Hair\"\n{{\n    uniform token type = \"linear\"\n    uniform token wrap = \"nonperiodic\""
-    );
-    let counts: Vec<String> = counts.iter().map(usize::to_string).collect();
-    let _ = writeln!(out, "    int[] curveVertexCounts = [{}]", counts.join(", "));
-    let _ = writeln!(out, "    point3f[] points.timeSamples = {{");
+    let mut points = String::from("    point3f[] points.timeSamples = {\n");
     for (i, frame) in frames.iter().enumerate() {
-        let points: Vec<String> = frame
-            .iter()
-            .flat_map(|s| s.points.iter())
-            .map(|p| format!("({}, {}, {})", p.x as f32, p.y as f32, p.z as f32))
-            .collect();
-        let _ = writeln!(out, "        {i}: [{}],", points.join(", "));
+        let _ = writeln!(points, "        {i}: {},", usda_points(frame));
     }
-    let _ = writeln!(out, "    }}");
-    let _ = writeln!(
-        out,
-        "    float[] widths = [{width_m}] (\n        interpolation = \"constant\"\n    )"
-    );
-    let uvs: Vec<String> = first
-        .iter()
-        .map(|s| format!("({}, {})", s.root_uv.x as f32, s.root_uv.y as f32))
-        .collect();
-    let _ = writeln!(
-        out,
-        "    texCoord2f[] primvars:st = [{}] (\n        interpolation = \"uniform\"\n    )",
-        uvs.join(", ")
-    );
-    let _ = writeln!(out, "}}");
-    Ok(out)
+    points.push_str("    }\n");
+    Ok(usda_stage(
+        &metadata,
+        "Simulated by Hairloom",
+        first,
+        &points,
+        width_m,
+    ))
 }
 
 /// Binary glTF with one mesh of LINES (glTF has no curve primitive): every strand segment

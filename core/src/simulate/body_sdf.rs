@@ -304,6 +304,12 @@ impl BodySdf {
         }
     }
 
+    /// The field the simulator uses for `mesh` on `body`: the default resolution, with room
+    /// around the body of 5% of the hair's size (hair reaching past the body stays inside it).
+    pub fn for_hair(body: &BodyMesh, mesh: &crate::model::mesh::HairMesh) -> Self {
+        Self::build(body, DEFAULT_RESOLUTION, 0.05 * mesh.size().max(1e-3))
+    }
+
     fn value(&self, i: usize, j: usize, k: usize) -> f64 {
         self.distance_m[i + self.dims[0] * (j + self.dims[1] * k)] as f64
     }

@@ -272,9 +272,7 @@ impl HairSim {
         motion: &Motion,
         pinned: &[VertexRef],
     ) -> Self {
-        let padding_m = 0.05 * mesh.size().max(1e-3);
-        let sdf = BodySdf::build(body, super::body_sdf::DEFAULT_RESOLUTION, padding_m);
-        Self::new(mesh, sdf, motion, pinned)
+        Self::new(mesh, BodySdf::for_hair(body, mesh), motion, pinned)
     }
 
     pub fn particle_count(&self) -> usize {

@@ -12,7 +12,7 @@ use std::time::Instant;
 use anyhow::Context;
 use hairloom_core::geometry::interior::place_interior;
 use hairloom_core::model::motion::{Motion, SimQuality, Wind};
-use hairloom_core::simulate::{BodySdf, HairSim, body_sdf};
+use hairloom_core::simulate::{BodySdf, HairSim};
 
 /// Checkpoints per run where positions are compared (evenly spaced, the last at the end).
 const CHECKPOINTS: usize = 6;
@@ -79,11 +79,7 @@ pub fn run(
             .with_file_name(format!("{name}.hairloom"));
         let document = hairloom_core::io::project::load(&path)?.document;
         let started = Instant::now();
-        let sdf = BodySdf::build(
-            &document.body,
-            body_sdf::DEFAULT_RESOLUTION,
-            0.05 * document.hair_mesh.size().max(1e-3),
-        );
+        let sdf = BodySdf::for_hair(&document.body, &document.hair_mesh);
         let sdf_ms = started.elapsed().as_secs_f64() * 1e3;
         let reference_quality = SimQuality {
             substeps: reference_substeps,

@@ -137,37 +137,7 @@ enum Command {
     },
     /// Simulate a project's motion and write the frames as a PNG sequence (and, with
     /// --usda, the strands animated over time).
-    Simulate {
-        project: PathBuf,
-        /// Folder for frame_0000.png, frame_0001.png, …
-        #[arg(long)]
-        out: PathBuf,
-        #[arg(long, default_value_t = 3.0)]
-        seconds: f64,
-        #[arg(long, default_value_t = 24.0)]
-        fps: f64,
-        /// What moves the hair: the scene's own motion, or a preset for a scene without one.
-        #[arg(long, value_enum, default_value_t = simulate::MotionArg::Scene)]
-        motion: simulate::MotionArg,
-        /// Image size, WIDTHxHEIGHT.
-        #[arg(long, default_value = "480x480")]
-        size: String,
-        /// A camera preset of the scene, or x,y,z.
-        #[arg(long, default_value = "three-quarter")]
-        view: String,
-        /// Override the scene's optional effects (as for render).
-        #[arg(long)]
-        effects: Option<String>,
-        /// Strands per bundle drawn (and written with --usda).
-        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
-        strands_per_bundle: u32,
-        /// Also write OUT/hair.usda: the strands at every frame as USD time samples.
-        #[arg(long)]
-        usda: bool,
-        /// Write the strands only (with --usda), no pictures.
-        #[arg(long)]
-        no_render: bool,
-    },
+    Simulate(simulate::SimulateSettings),
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
     Adapters,
     /// Measure performance; prints a table (see BENCHMARKS.md).
@@ -284,31 +254,7 @@ pub fn main() -> ExitCode {
             };
             render::run(&input, &out, &settings)
         }
-        Some(Command::Simulate {
-            project,
-            out,
-            seconds,
-            fps,
-            motion,
-            size,
-            view,
-            effects,
-            strands_per_bundle,
-            usda,
-            no_render,
-        }) => simulate::run(&simulate::SimulateSettings {
-            project,
-            out,
-            seconds,
-            fps,
-            motion,
-            size,
-            view,
-            effects,
-            strands_per_bundle,
-            usda,
-            render: !no_render,
-        }),
+        Some(Command::Simulate(settings)) => simulate::run(&settings),
         Some(Command::Adapters) => adapters(),
         Some(Command::Bench { which }) => bench::run(which),
     };

@@ -64,18 +64,37 @@ impl MotionArg {
     }
 }
 
+#[derive(clap::Args)]
 pub struct SimulateSettings {
     pub project: PathBuf,
+    /// Folder for frame_0000.png, frame_0001.png, …
+    #[arg(long)]
     pub out: PathBuf,
+    #[arg(long, default_value_t = 3.0)]
     pub seconds: f64,
+    #[arg(long, default_value_t = 24.0)]
     pub fps: f64,
+    /// What moves the hair: the scene's own motion, or a preset for a scene without one.
+    #[arg(long, value_enum, default_value_t = MotionArg::Scene)]
     pub motion: MotionArg,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "480x480")]
     pub size: String,
+    /// A camera preset of the scene, or x,y,z.
+    #[arg(long, default_value = "three-quarter")]
     pub view: String,
+    /// Override the scene's optional effects (as for render).
+    #[arg(long)]
     pub effects: Option<String>,
+    /// Strands per bundle drawn (and written with --usda).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub strands_per_bundle: u32,
+    /// Also write OUT/hair.usda: the strands at every frame as USD time samples.
+    #[arg(long)]
     pub usda: bool,
-    pub render: bool,
+    /// Write the strands only (with --usda), no pictures.
+    #[arg(long)]
+    pub no_render: bool,
 }
 
 pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
@@ -102,7 +121,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
             );
         }
     }
-    if !settings.render && !settings.usda {
+    if settings.no_render && !settings.usda {
         bail!("nothing to write: --no-render without --usda");
     }
     let (width, height) = parse_size(&settings.size)?;
@@ -139,7 +158,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
     let (centre, reach) = ((lo + hi) * 0.5, (hi - lo).length() * 0.3);
     let frame = (centre - Vec3::splat(reach), centre + Vec3::splat(reach));
 
-    let gpu = if settings.render {
+    let gpu = if !settings.no_render {
         let context = GpuContext::new_headless()?;
         let renderer = HeadlessRenderer::new(&context);
         println!("adapter: {}", describe(&context.adapter_info));
