@@ -1301,3 +1301,51 @@ fn drape_lets_the_hair_fall_onto_the_body_as_one_undo_step() {
     harness.run();
     assert_eq!(harness.state().state.document(), &original, "one undo step");
 }
+
+/// Lock keeps vertices where the artist put them (placement and Drape leave them alone);
+/// it is one undo step, and Unlock returns them to automatic placement.
+#[test]
+fn lock_and_unlock_the_selected_bundles_vertices_as_undo_steps() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    harness.state_mut().state.selection = [0u32, 1].into_iter().collect();
+    harness.get_by_label("Lock").click();
+    harness.run();
+    let state = &harness.state().state;
+    let locked = state.document().hair_mesh.locked.clone();
+    let bundle = &original.hair_mesh.bundles[0];
+    assert!(
+        bundle
+            .vertices
+            .iter()
+            .all(|&column| locked.contains(&hairloom_core::VertexRef {
+                column,
+                layer: bundle.layers
+            })),
+        "bundle 0's vertices are locked: {locked:?}"
+    );
+    assert!(locked.iter().all(|v| v.layer >= 1), "roots are not locks");
+    state.document().validate().expect("valid");
+    assert_eq!(
+        state.project.history.undo.last().map(|c| c.label()),
+        Some("Lock vertices")
+    );
+    harness.get_by_label("Unlock").click();
+    harness.run();
+    let unlocked = harness.state().state.document().hair_mesh.locked.clone();
+    assert!(
+        unlocked.len() < locked.len(),
+        "unlocked {} of {}",
+        locked.len() - unlocked.len(),
+        locked.len()
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().state.document(),
+        &original,
+        "two undo steps"
+    );
+}

@@ -22,7 +22,7 @@ pub mod wisps;
 use std::collections::BTreeSet;
 
 use crate::geometry::interior::place_interior;
-use crate::model::mesh::HairMesh;
+use crate::model::mesh::{HairMesh, VertexRef};
 
 // The edit API in one place: callers write `edit::extrude`, whichever file it lives in.
 pub use coordinates::{set_corner_uvs, set_w, set_w_mode};
@@ -82,11 +82,55 @@ pub(crate) fn check_bundles(mesh: &HairMesh, bundles: &[u32]) -> Result<(), Edit
     Ok(())
 }
 
+/// Locks (or unlocks) `vertices`: automatic interior placement keeps a locked vertex where
+/// it is (a known value of its layer, like an exterior vertex) and a drape holds it still.
+/// The layers involved are placed again, so an unlocked interior vertex returns to its
+/// automatic place.
+pub fn set_locked(
+    mesh: &HairMesh,
+    vertices: &[VertexRef],
+    locked: bool,
+) -> Result<EditOutcome, EditError> {
+    if vertices.is_empty() {
+        return Err(EditError::EmptySelection);
+    }
+    for v in vertices {
+        if mesh.position(*v).is_none() {
+            return Err(EditError::VertexOutOfRange {
+                column: v.column,
+                layer: v.layer,
+            });
+        }
+    }
+    let mut out = mesh.clone();
+    out.set_locked(vertices, locked);
+    let layers: BTreeSet<usize> = vertices.iter().map(|v| v.layer as usize).collect();
+    let layers: Vec<usize> = layers.into_iter().collect();
+    let affected: BTreeSet<u32> = mesh
+        .bundles
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| vertices.iter().any(|v| b.vertices.contains(&v.column)))
+        .map(|(i, _)| i as u32)
+        .collect();
+    finish(out, affected, Some(&layers))
+}
+
 pub(crate) fn finish(
     mut mesh: HairMesh,
     affected: BTreeSet<u32>,
     layers: Option<&[usize]>,
 ) -> Result<EditOutcome, EditError> {
+    // A lock on a vertex an edit took away (a shorter column) goes with it.
+    let kept: Vec<VertexRef> = mesh
+        .locked
+        .iter()
+        .copied()
+        .filter(|v| mesh.position(*v).is_some())
+        .collect();
+    if kept.len() != mesh.locked.len() {
+        mesh.locked = kept;
+    }
     place_interior(&mut mesh, layers);
     mesh.update_w();
     mesh.validate()?;
@@ -103,6 +147,81 @@ mod tests {
     use crate::model::mesh::test_meshes::grid;
     use glam::{DVec2, DVec3};
     use wisps::centre_path;
+
+    fn at(column: u32, layer: u32) -> VertexRef {
+        VertexRef { column, layer }
+    }
+
+    #[test]
+    fn a_locked_interior_vertex_keeps_its_place_and_steers_its_neighbours() {
+        // 3×3 quads, two layers: columns 5, 6, 9, 10 are interior at layer 1.
+        let mesh = grid(3, 3, 2, 0.5);
+        assert!(mesh.is_interior(&crate::model::mesh::Topology::build(&mesh), 5, 1));
+        let placed = mesh.position(at(6, 1)).expect("vertex");
+        // An artist pulls column 5's middle vertex up and locks it there.
+        let mut moved = mesh.clone();
+        moved.columns[5].positions[1] += DVec3::new(0.0, 0.0, 0.3);
+        let locked = set_locked(&moved, &[at(5, 1)], true).expect("lock");
+        assert_eq!(locked.mesh.locked, vec![at(5, 1)]);
+        assert_eq!(
+            locked.mesh.columns[5].positions[1], moved.columns[5].positions[1],
+            "placement kept the locked vertex"
+        );
+        assert!(
+            locked.mesh.position(at(6, 1)).expect("vertex").z > placed.z + 1e-6,
+            "its interior neighbour follows it"
+        );
+        // An edit elsewhere re-places layer 1 and still keeps it.
+        let extruded = transform_vertices(
+            &locked.mesh,
+            &[at(0, 1)],
+            VertexTransform::Translate {
+                offset: [0.01, 0.0, 0.0],
+            },
+            0.0,
+        )
+        .expect("move");
+        assert_eq!(
+            extruded.mesh.columns[5].positions[1],
+            moved.columns[5].positions[1]
+        );
+        // Unlocking returns it to its automatic place.
+        let unlocked = set_locked(&locked.mesh, &[at(5, 1)], false).expect("unlock");
+        assert!(unlocked.mesh.locked.is_empty());
+        let automatic = mesh.position(at(5, 1)).expect("vertex");
+        assert!((unlocked.mesh.position(at(5, 1)).expect("vertex") - automatic).length() < 1e-9);
+        // A vertex the mesh does not have is refused by name.
+        assert!(matches!(
+            set_locked(&mesh, &[at(5, 9)], true),
+            Err(EditError::VertexOutOfRange {
+                column: 5,
+                layer: 9
+            })
+        ));
+    }
+
+    #[test]
+    fn locks_follow_inserted_and_deleted_layers() {
+        let mesh = grid(2, 1, 3, 0.5);
+        let all: Vec<u32> = (0..mesh.bundles.len() as u32).collect();
+        let locked = set_locked(&mesh, &[at(0, 1), at(0, 3)], true).expect("lock");
+        let inserted = insert_layer(&locked.mesh, &all, 2).expect("insert");
+        assert_eq!(inserted.mesh.locked, vec![at(0, 1), at(0, 4)]);
+        let deleted = delete_layer(&inserted.mesh, &all, 1).expect("delete");
+        assert_eq!(deleted.mesh.locked, vec![at(0, 3)], "the deleted lock went");
+        deleted.mesh.validate().expect("valid");
+    }
+
+    #[test]
+    fn a_lock_the_mesh_does_not_have_is_named() {
+        let mut mesh = grid(2, 1, 1, 0.5);
+        mesh.locked = vec![at(0, 7)];
+        let error = mesh.validate().expect_err("out of range");
+        assert_eq!(error.path, "locked[0]");
+        mesh.locked = vec![at(1, 1), at(0, 1)];
+        let error = mesh.validate().expect_err("unsorted");
+        assert_eq!(error.path, "locked[1]");
+    }
 
     #[test]
     fn pasting_a_shape_copies_the_centre_path_and_keeps_the_width() {

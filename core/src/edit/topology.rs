@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::edit::{EditError, EditOutcome, check_bundles, finish};
 use crate::geometry::curve::{cubic_point, curve_segments};
-use crate::model::mesh::{Bundle, Column, HairMesh, Topology};
+use crate::model::mesh::{Bundle, Column, HairMesh, Topology, VertexRef};
 
 /// Direction of an extrusion.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -193,6 +193,35 @@ fn edit_layer(
     for &c in &columns {
         edit_column(&mut out.columns[c as usize], layer as usize);
     }
+    // Locked vertices move with their layer: up one above an inserted layer, down one above
+    // a deleted one, and a deleted vertex's lock goes with it.
+    let edited = |c: u32| {
+        columns.contains(&c)
+            && out.columns[c as usize].positions.len() != mesh.columns[c as usize].positions.len()
+    };
+    let locked: Vec<VertexRef> = mesh
+        .locked
+        .iter()
+        .filter_map(|&v| {
+            if !edited(v.column) || v.layer < layer {
+                Some(v)
+            } else if layer_change > 0 {
+                Some(VertexRef {
+                    layer: v.layer + 1,
+                    ..v
+                })
+            } else if v.layer == layer {
+                None
+            } else {
+                Some(VertexRef {
+                    layer: v.layer - 1,
+                    ..v
+                })
+            }
+        })
+        .collect();
+    out.locked.clear();
+    out.set_locked(&locked, true);
     for &b in &affected {
         let bundle = &mut out.bundles[b as usize];
         bundle.layers = bundle.layers.saturating_add_signed(layer_change);

@@ -54,7 +54,7 @@ const MIN_KNOT_INTERVAL: f64 = 1e-150;
 /// from `p1` to `p2` with neighbours `p0` and `p3` (Yuksel et al. 2011, α = ½):
 /// `d_i = |p_i − p_{i−1}|^½`,
 /// `b1 = p1 + (d1² (p2 − p1) + d2² (p1 − p0)) / (3 d1 (d1 + d2))`,
-/// `b2 = p2 − (d3² (p1 − p2) + d2² (p3 − p2)) / (3 d3 (d3 + d2))` — written with the
+/// `b2 = p2 + (d3² (p1 − p2) + d2² (p2 − p3)) / (3 d3 (d3 + d2))` — written with the
 /// symmetric form below.
 pub fn centripetal_bezier(p0: DVec3, p1: DVec3, p2: DVec3, p3: DVec3) -> [DVec3; 4] {
     let d1 = p1.distance(p0).sqrt();

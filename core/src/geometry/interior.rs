@@ -234,7 +234,9 @@ fn place_layer(mesh: &mut HairMesh, topology: &Topology, layer: usize) {
                 if slot[v] == ABSENT {
                     slot[v] = members.len() as u32;
                     members.push(v);
-                    interior_flags.push(mesh.is_interior(topology, v, layer));
+                    // A locked vertex is known, like an exterior one.
+                    interior_flags
+                        .push(mesh.is_interior(topology, v, layer) && !mesh.is_locked(v, layer));
                     neighbours.push(Vec::new());
                 }
             }

@@ -16,7 +16,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::model::document::{BodyMesh, Document};
-use crate::model::mesh::{Bundle, Column, WMode};
+use crate::model::mesh::{Bundle, Column, VertexRef, WMode};
 use crate::model::scene::Scene;
 use crate::model::styling::StylingSet;
 
@@ -189,6 +189,9 @@ pub struct DocumentDiff {
     pub columns: VecDiff<Column>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub w_mode: Option<Swap<WMode>>,
+    /// Boxed: only Lock, Unlock and Drape change it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub locked: Option<Box<Swap<Vec<VertexRef>>>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<Swap<String>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -210,6 +213,7 @@ impl DocumentDiff {
             bundles: VecDiff::between(&before.hair_mesh.bundles, &after.hair_mesh.bundles),
             columns: VecDiff::between(&before.hair_mesh.columns, &after.hair_mesh.columns),
             w_mode: Swap::between(&before.hair_mesh.w_mode, &after.hair_mesh.w_mode),
+            locked: Swap::between(&before.hair_mesh.locked, &after.hair_mesh.locked).map(Box::new),
             name: Swap::between(&before.name, &after.name),
             source: Swap::between(&before.source, &after.source),
             body: Swap::between(&before.body, &after.body).map(Box::new),
@@ -222,6 +226,7 @@ impl DocumentDiff {
         self.bundles.is_empty()
             && self.columns.is_empty()
             && self.w_mode.is_none()
+            && self.locked.is_none()
             && self.name.is_none()
             && self.source.is_none()
             && self.body.is_none()
@@ -235,6 +240,9 @@ impl DocumentDiff {
         // before any change, on a copy of the bundles.
         if let Some(swap) = &self.w_mode {
             swap.check(&document.hair_mesh.w_mode, forward, "hair_mesh.w_mode")?;
+        }
+        if let Some(swap) = &self.locked {
+            swap.check(&document.hair_mesh.locked, forward, "hair_mesh.locked")?;
         }
         if let Some(swap) = &self.name {
             swap.check(&document.name, forward, "name")?;
@@ -262,6 +270,9 @@ impl DocumentDiff {
         document.hair_mesh.bundles = bundles;
         if let Some(swap) = &self.w_mode {
             swap.write(&mut document.hair_mesh.w_mode, forward);
+        }
+        if let Some(swap) = &self.locked {
+            swap.write(&mut document.hair_mesh.locked, forward);
         }
         if let Some(swap) = &self.name {
             swap.write(&mut document.name, forward);

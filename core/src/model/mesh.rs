@@ -88,6 +88,12 @@ pub struct HairMesh {
     pub columns: Vec<Column>,
     #[serde(default)]
     pub w_mode: WMode,
+    /// Vertices the artist placed (or a drape settled) that automatic interior placement
+    /// leaves where they are: a locked interior vertex is a known value of its layer's
+    /// placement, like an exterior one, and a drape holds locked vertices still. Sorted, no
+    /// repeats.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub locked: Vec<VertexRef>,
 }
 
 /// A structural problem, with the path of the offending value.
@@ -175,6 +181,7 @@ impl HairMesh {
             bundles: Vec::new(),
             columns: Vec::new(),
             w_mode: WMode::FromPathLength,
+            locked: Vec::new(),
         }
     }
 
@@ -202,6 +209,7 @@ impl HairMesh {
             bundles,
             columns,
             w_mode: WMode::FromPathLength,
+            locked: Vec::new(),
         }
     }
 
@@ -382,7 +390,57 @@ impl HairMesh {
                 }
             }
         }
+        for (i, v) in self.locked.iter().enumerate() {
+            let layers = self
+                .columns
+                .get(v.column as usize)
+                .map(|c| c.positions.len());
+            if layers.is_none_or(|n| v.layer as usize >= n) {
+                return Err(invalid(
+                    format!("locked[{i}]"),
+                    format!(
+                        "vertex (column {}, layer {}) is not in the mesh",
+                        v.column, v.layer
+                    ),
+                ));
+            }
+            if i > 0 && self.locked[i - 1] >= *v {
+                return Err(invalid(
+                    format!("locked[{i}]"),
+                    "locked vertices must be sorted by column and layer, without repeats",
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// Whether automatic placement keeps this vertex where it is (see [`HairMesh::locked`]).
+    pub fn is_locked(&self, column: usize, layer: usize) -> bool {
+        let (Ok(column), Ok(layer)) = (u32::try_from(column), u32::try_from(layer)) else {
+            return false;
+        };
+        self.locked
+            .binary_search(&VertexRef { column, layer })
+            .is_ok()
+    }
+
+    /// Locks (or unlocks) `vertices`, keeping [`HairMesh::locked`] sorted without repeats.
+    /// Vertices the mesh does not have are left out.
+    pub fn set_locked(&mut self, vertices: &[VertexRef], locked: bool) {
+        let exists = |v: &VertexRef| {
+            self.columns
+                .get(v.column as usize)
+                .is_some_and(|c| (v.layer as usize) < c.positions.len())
+        };
+        let mut set: std::collections::BTreeSet<VertexRef> = self.locked.iter().copied().collect();
+        for v in vertices.iter().filter(|v| exists(v)) {
+            if locked {
+                set.insert(*v);
+            } else {
+                set.remove(v);
+            }
+        }
+        self.locked = set.into_iter().collect();
     }
 
     /// Recomputes w of every column from polyline length when `w_mode` asks for it.

@@ -62,7 +62,7 @@ impl Default for Noise {
 /// `clumps_per_uv` cells per uv unit). The pull is a compact-kernel average toward nearby
 /// centres, continuous everywhere:
 /// `Δ = Σ K_i (c_i − x) / (Σ K_i + ¼)`, `K_i = max(0, 1 − |c_i − x|² / h²)²`, `h` one cell;
-/// offset `strength · τ̂^tightening · radius_m · clumps_per_uv · (Δ.x û + Δ.y v̂)`.
+/// offset `strength · τ̂^tightening · radius_m · (Δ.x û + Δ.y v̂)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Clump {
@@ -86,7 +86,7 @@ impl Default for Clump {
     }
 }
 
-/// Frizz: a fraction of strands (those with ξ₃ < `fraction`) get high-frequency noise that
+/// Frizz: a fraction of strands (those with ξ₆ < `fraction`) get high-frequency noise that
 /// grows toward the tip: `amplitude_m · τ̂² · (n(f w + k), n(f w + k'))` in (û, v̂).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -107,7 +107,7 @@ impl Default for Frizz {
 }
 
 /// Wave: a planar wave across the strand. Offset
-/// `ramp(w) · amplitude_m · sin(2π · frequency_per_m · w + phase_spread · 2π ξ₄) · d`, with
+/// `ramp(w) · amplitude_m · sin(2π · frequency_per_m · w + phase_spread · 2π ξ₈) · d`, with
 /// `d = cos α û + sin α v̂` (`α` = `direction_rad`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]

@@ -19,7 +19,7 @@ use crate::geometry::{interior, uv};
 use crate::io::import::{ImportError, ImportOptions, import_slice};
 use crate::io::project::Project;
 use crate::model::document::{BodyMesh, Document};
-use crate::model::mesh::HairMesh;
+use crate::model::mesh::{HairMesh, VertexRef};
 use crate::model::scene::{HairMaterial, Pigment};
 use crate::model::styling::{Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Wave};
 
@@ -140,6 +140,44 @@ pub struct Growth {
     pub gravity: f64,
     /// Minimum clearance from the cranium ellipsoid at the tip, as a fraction of its size.
     pub volume: f64,
+    /// Where the tips end: a haircut line, so hair from the crown is longer than hair from
+    /// the nape (every column the same length would end in steps, one per root height).
+    /// `None`: every layer step is `step_m`.
+    pub cut: Option<Cut>,
+}
+
+/// A haircut line: the height the tips end at, from the back of the head to the face.
+#[derive(Clone, Copy, Debug)]
+pub struct Cut {
+    /// Tip height (model y, metres) of hair from the back of the head.
+    pub back_y_m: f64,
+    /// Tip height of hair from the front hairline (face-framing layers are usually shorter).
+    pub front_y_m: f64,
+}
+
+impl Cut {
+    /// The tip height for hair rooted at `root` (model space, cranium at the origin).
+    fn tip_y_m(&self, root: DVec3) -> f64 {
+        let front = (root.z / 0.09).clamp(-1.0, 1.0) * 0.5 + 0.5;
+        self.back_y_m + (self.front_y_m - self.back_y_m) * front
+    }
+
+    /// The layer step that puts the tip of a column rooted at `root` on the cut line, found
+    /// by bisection over `tip_y(step)` (tips fall lower as steps grow), within half and 1.6
+    /// times `nominal_m`.
+    fn step_for(&self, root: DVec3, nominal_m: f64, tip_y: impl Fn(f64) -> f64) -> f64 {
+        let target_y = self.tip_y_m(root);
+        let (mut low, mut high) = (0.5 * nominal_m, 1.6 * nominal_m);
+        for _ in 0..24 {
+            let mid = 0.5 * (low + high);
+            if tip_y(mid) > target_y {
+                low = mid;
+            } else {
+                high = mid;
+            }
+        }
+        0.5 * (low + high)
+    }
 }
 
 /// Grows `scalp` into a hair mesh: the first layer along the root normals, later layers
@@ -162,33 +200,81 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
     }
     let normals = root_normals(&mesh);
     for (c, column) in mesh.columns.iter_mut().enumerate() {
-        let n = normals[c];
-        let root = column.positions[0];
-        let mut previous = root;
-        for k in 1..column.positions.len() {
-            let fraction = k as f64 / growth.layers.max(1) as f64;
-            // Hair leaves the scalp and lies down soon after: bend grows fast near the root.
-            let bend = (growth.gravity * fraction.sqrt() * 1.3).min(1.0);
-            let outward = DVec3::new(n.x, 0.0, n.z).normalize_or_zero() * 0.3;
-            // Hair from the front of the scalp sweeps back instead of falling over the face.
-            let front = (root.z / radii_m.z).max(0.0);
-            let sweep_back = DVec3::new(0.0, 0.0, -3.0 * front);
-            let down = (-DVec3::Y + outward + sweep_back).normalize();
-            let direction = n.lerp(down, bend).normalize_or(n);
-            let mut p = previous + direction * growth.step_m;
-            // Keep clear of the head: push out of the inflated cranium ellipsoid.
-            let clearance = 1.0 + growth.volume * fraction.sqrt();
-            let q = p / radii_m;
-            if q.length() < clearance {
-                p = q.normalize_or(DVec3::Y) * clearance * radii_m;
-            }
-            column.positions[k] = p;
-            previous = p;
-        }
+        let (root, n) = (column.positions[0], normals[c]);
+        let layers = column.positions.len() - 1;
+        let step_m = growth.cut.map_or(growth.step_m, |cut| {
+            cut.step_for(root, growth.step_m, |step_m| {
+                comb_column(root, n, layers, step_m, &growth, radii_m)
+                    .last()
+                    .map_or(root.y, |tip| tip.y)
+            })
+        });
+        column.positions = comb_column(root, n, layers, step_m, &growth, radii_m);
     }
-    interior::place_interior(&mut mesh, None);
+    if growth.cut.is_none() {
+        interior::place_interior(&mut mesh, None);
+    } else {
+        // Hair cut to a line: every column is combed, the inner ones too, and they keep
+        // their combed places (locked). A layer's interior placed from its rim (the
+        // hairline) would not follow columns of different lengths: crown hair is longer
+        // than nape hair, so rim-placed crown columns would cut across the head.
+        let topology = crate::model::mesh::Topology::build(&mesh);
+        let interior: Vec<VertexRef> = (0..mesh.columns.len())
+            .flat_map(|c| (1..mesh.columns[c].positions.len()).map(move |k| (c, k)))
+            .filter(|&(c, k)| mesh.is_interior(&topology, c, k))
+            .map(|(c, k)| VertexRef {
+                column: c as u32,
+                layer: k as u32,
+            })
+            .collect();
+        mesh.set_locked(&interior, true);
+    }
     mesh.update_w();
     mesh
+}
+
+/// One column combed from its root (normal `n`): out along the normal, then bending toward
+/// −y by `growth.gravity`, front hair swept back, each vertex kept outside the inflated
+/// cranium ellipsoid.
+fn comb_column(
+    root: DVec3,
+    n: DVec3,
+    layers: usize,
+    step_m: f64,
+    growth: &Growth,
+    radii_m: DVec3,
+) -> Vec<DVec3> {
+    let mut positions = Vec::with_capacity(layers + 1);
+    positions.push(root);
+    let mut previous = root;
+    for k in 1..=layers {
+        let fraction = k as f64 / growth.layers.max(1) as f64;
+        // Hair leaves the scalp and lies down soon after: bend grows fast near the root.
+        let bend = (growth.gravity * fraction.sqrt() * 1.3).min(1.0);
+        let outward = DVec3::new(n.x, 0.0, n.z).normalize_or_zero() * 0.3;
+        // Hair from the front of the scalp sweeps back over the crown instead of falling
+        // over the face; long (cut) hair then turns to hang.
+        let front = (root.z / radii_m.z).max(0.0);
+        let hang = if growth.cut.is_some() {
+            0.6 * fraction.min(1.0)
+        } else {
+            0.0
+        };
+        // Crown hair with no side to fall to (root normal straight up) is combed back too.
+        let sweep = DVec3::new(0.0, 0.0, -(0.6 + 3.0 * front) * (1.0 - hang));
+        let down = (-DVec3::Y + outward + sweep).normalize();
+        let direction = n.lerp(down, bend).normalize_or(n);
+        let mut p = previous + direction * step_m;
+        // Keep clear of the head: push out of the inflated cranium ellipsoid.
+        let clearance = 1.0 + growth.volume * fraction.sqrt();
+        let q = p / radii_m;
+        if q.length() < clearance {
+            p = q.normalize_or(DVec3::Y) * clearance * radii_m;
+        }
+        positions.push(p);
+        previous = p;
+    }
+    positions
 }
 
 /// Pushes every hair-mesh vertex out of the body with the simulator's collision, holding
@@ -205,6 +291,9 @@ pub fn keep_out_of_body(mesh: &HairMesh, body: &BodyMesh) -> HairMesh {
             retention_root: 1.0,
             retention_tip: 0.6,
             volume_m_per_layer: 0.0,
+            // Strands run between the hair-mesh vertices, curving as they go: keep the
+            // vertices far enough out that no strand dips into the scalp.
+            collision_margin_m: 0.006,
             ..HairPhysics::default()
         },
         ..Motion::default()
@@ -235,7 +324,7 @@ fn root_normals(mesh: &HairMesh) -> Vec<DVec3> {
         .collect()
 }
 
-/// The three head hairstyles.
+/// The head hairstyles: a short crop, wavy shoulder-length hair and curls.
 pub const HEAD_STYLES: [(&str, Growth); 3] = [
     (
         "head_short_straight",
@@ -244,15 +333,20 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
             step_m: 0.012,
             gravity: 0.45,
             volume: 0.09,
+            cut: None,
         },
     ),
     (
         "head_long_wavy",
         Growth {
             layers: 6,
-            step_m: 0.04,
+            step_m: 0.045,
             gravity: 1.0,
             volume: 0.06,
+            cut: Some(Cut {
+                back_y_m: -0.17,
+                front_y_m: -0.13,
+            }),
         },
     ),
     (
@@ -262,6 +356,7 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
             step_m: 0.025,
             gravity: 0.65,
             volume: 0.16,
+            cut: None,
         },
     ),
 ];
@@ -351,7 +446,8 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
     Ok(HEAD_STYLES
         .iter()
         .map(|(name, growth)| {
-            let mesh = keep_out_of_body(&grow(&scalp, *growth, radii_m), &body);
+            let shaped = grow(&scalp, *growth, radii_m);
+            let mesh = keep_out_of_body(&shaped, &body);
             let mut document = Document::new(*name, mesh);
             document.styling.global = head_style(name);
             document.scene.material = head_material(name);

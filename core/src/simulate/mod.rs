@@ -22,16 +22,23 @@ pub use xpbd::HairSim;
 use std::collections::BTreeSet;
 
 use crate::edit::{EditError, EditOutcome, check_bundles};
-use crate::geometry::interior::place_interior;
 use crate::model::document::{BodyMesh, Document};
-use crate::model::mesh::{HairMesh, VertexRef};
-use crate::model::motion::{HairPhysics, Motion};
+use crate::model::mesh::{HairMesh, Topology, VertexRef};
+use crate::model::motion::{HairPhysics, Motion, SimQuality};
 
 /// The longest simulated time a drape may take before it stops settling.
 pub const DRAPE_MAX_S: f64 = 12.0;
 /// The hair is at rest when no vertex moves faster than this for [`DRAPE_REST_STEPS`] steps.
 pub const DRAPE_REST_SPEED_M_PER_S: f64 = 0.01;
 pub const DRAPE_REST_STEPS: u32 = 15;
+/// A drape is an edit, not a frame: it can afford the accuracy that keeps long columns from
+/// stretching under their own weight (at the playback default of 2 × 2, a 60 cm column hangs
+/// about 30% longer than modelled; `hairloom bench sim` measures the error by quality).
+pub const DRAPE_QUALITY: SimQuality = SimQuality {
+    rate_hz: 60.0,
+    substeps: 4,
+    iterations: 8,
+};
 
 /// How a drape went.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,9 +50,15 @@ pub struct DrapeReport {
 }
 
 /// Lets `bundles` (every active bundle when empty) fall under gravity onto `body` and
-/// settle, keeping `locked` vertices and every vertex of the other bundles where they are.
-/// Interior vertices are placed again from the draped exterior and w refreshed, as after
-/// any edit, so the result is one ordinary undo step.
+/// settle, keeping `locked` vertices, the mesh's own locked vertices and every vertex of the
+/// other bundles where they are; w is refreshed, so the result is one ordinary undo step.
+///
+/// Interior vertices keep their simulated places, and the drape locks the ones it moved:
+/// the simulation held them at their modelled distances from their neighbours, while
+/// re-placing them from each layer's rim would not (on a whole-scalp patch of long hair the
+/// rim is the hairline, which hangs far from the crown's inner layers: re-placed crown
+/// columns came out 1.5× their length). Unlocking them returns them to automatic
+/// placement.
 pub fn drape(
     mesh: &HairMesh,
     body: &BodyMesh,
@@ -64,7 +77,7 @@ pub fn drape(
         return Err(EditError::EmptySelection);
     }
     // Everything a bundle outside the selection uses stays put.
-    let mut pinned: BTreeSet<VertexRef> = locked.iter().copied().collect();
+    let mut pinned: BTreeSet<VertexRef> = locked.iter().chain(&mesh.locked).copied().collect();
     for (b, bundle) in mesh.bundles.iter().enumerate() {
         if selected.contains(&(b as u32)) || bundle.removed {
             continue;
@@ -77,6 +90,7 @@ pub fn drape(
     }
     let motion = Motion {
         physics: HairPhysics::drape(),
+        quality: DRAPE_QUALITY,
         ..Motion::default()
     };
     let pinned: Vec<VertexRef> = pinned.into_iter().collect();
@@ -102,7 +116,21 @@ pub fn drape(
         deepest_penetration_m: sim.deepest_penetration_m(),
     };
     let mut draped = sim.posed_mesh();
-    place_interior(&mut draped, None);
+    let topology = Topology::build(&draped);
+    let settled_interior: Vec<VertexRef> = selected
+        .iter()
+        .flat_map(|&b| {
+            let bundle = &draped.bundles[b as usize];
+            bundle.vertices.iter().flat_map(move |&column| {
+                (1..=bundle.layers).map(move |layer| VertexRef { column, layer })
+            })
+        })
+        .filter(|v| {
+            pinned.binary_search(v).is_err()
+                && draped.is_interior(&topology, v.column as usize, v.layer as usize)
+        })
+        .collect();
+    draped.set_locked(&settled_interior, true);
     draped.update_w();
     draped.validate()?;
     Ok((

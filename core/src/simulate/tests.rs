@@ -261,6 +261,34 @@ fn draping_a_helmet_brings_it_down_onto_the_head() {
     for (a, b) in outcome.mesh.columns.iter().zip(&mesh.columns) {
         assert_eq!(a.positions[0], b.positions[0]);
     }
+    // The interior it settled is locked (a later edit's placement keeps it) and kept its
+    // simulated column lengths: no column longer than modelled by more than 5%.
+    let topology = crate::model::mesh::Topology::build(&mesh);
+    let interior: Vec<VertexRef> = outcome
+        .mesh
+        .locked
+        .iter()
+        .copied()
+        .filter(|v| mesh.is_interior(&topology, v.column as usize, v.layer as usize))
+        .collect();
+    assert!(!interior.is_empty(), "settled interior vertices are locked");
+    let length = |m: &HairMesh, c: usize| -> f64 {
+        m.columns[c]
+            .positions
+            .windows(2)
+            .map(|w| (w[1] - w[0]).length())
+            .sum()
+    };
+    for c in 0..mesh.columns.len() {
+        let ratio = length(&outcome.mesh, c) / length(&mesh, c);
+        assert!(ratio < 1.05, "column {c} is {ratio}× its length");
+    }
+    // A lock in the mesh holds like one passed in: drape again with the tip locked in the
+    // document.
+    let mut with_lock = mesh.clone();
+    with_lock.set_locked(&[locked], true);
+    let (again, _) = drape(&with_lock, &head(), &[], &[]).expect("drape");
+    assert_eq!(again.mesh.position(locked), mesh.position(locked));
 }
 
 #[test]

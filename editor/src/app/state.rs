@@ -334,6 +334,26 @@ impl EditorState {
 
     /// What move / rotate / scale acts on: the selected vertices, or the selected bundles'
     /// exterior vertices above the scalp.
+    /// What Lock and Unlock act on: the selected vertices in vertex mode, else every vertex
+    /// above the root of the selected bundles.
+    pub fn lock_targets(&self) -> Vec<VertexRef> {
+        if self.tool.mode == SelectMode::Vertices {
+            return self.vertex_selection.iter().copied().collect();
+        }
+        let mesh = &self.project.document.hair_mesh;
+        let vertices: BTreeSet<VertexRef> = self
+            .selection
+            .iter()
+            .filter_map(|&b| mesh.bundles.get(b as usize))
+            .flat_map(|bundle| {
+                bundle.vertices.iter().flat_map(move |&column| {
+                    (1..=bundle.layers).map(move |layer| VertexRef { column, layer })
+                })
+            })
+            .collect();
+        vertices.into_iter().collect()
+    }
+
     pub fn transform_targets(&self) -> Vec<VertexRef> {
         let mesh = &self.project.document.hair_mesh;
         let topology = Topology::build(mesh);

@@ -178,6 +178,31 @@ impl ToolsPanel {
             }
             ui.label(egui::RichText::new("under gravity, onto the body").weak());
         });
+        ui.horizontal(|ui| {
+            for (label, locked, hint) in [
+                (
+                    "Lock",
+                    true,
+                    "Keep the selected vertices (or the selected bundles') where they are: \
+                     interior placement and Drape leave them alone",
+                ),
+                ("Unlock", false, "Return them to automatic placement"),
+            ] {
+                if ui.button(label).on_hover_text(hint).clicked() {
+                    let vertices = state.lock_targets();
+                    state.edit_mesh(
+                        if locked {
+                            "Lock vertices"
+                        } else {
+                            "Unlock vertices"
+                        },
+                        |mesh, _| edit::set_locked(mesh, &vertices, locked),
+                    );
+                }
+            }
+            let count = state.document().hair_mesh.locked.len();
+            ui.label(egui::RichText::new(format!("{count} locked")).weak());
+        });
         ui.separator();
         ui.heading("Wisps");
         ui.horizontal(|ui| {
