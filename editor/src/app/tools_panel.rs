@@ -176,9 +176,7 @@ impl ToolsPanel {
                     );
                 }
             }
-            ui.label(egui::RichText::new("under gravity, onto the body").weak());
-        });
-        ui.horizontal(|ui| {
+            // Lock and Unlock share Drape's row: what Drape holds still.
             for (label, locked, hint) in [
                 (
                     "Lock",
