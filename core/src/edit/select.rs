@@ -371,30 +371,39 @@ pub fn layer_vertices(
         .collect()
 }
 
-/// What moving the selected bundles moves: their exterior vertices above the root (the
-/// scalp stays where the head is).
-pub fn bundle_transform_vertices(
+/// Every vertex above the root of `bundles` (layers 1 to each bundle's top), sorted: what
+/// Lock, Drape and moving a bundle act on (the scalp stays where the head is).
+pub fn bundle_vertices_above_root<'a>(
     mesh: &HairMesh,
-    topology: &Topology,
-    bundles: &BTreeSet<u32>,
-) -> Vec<VertexRef> {
+    bundles: impl IntoIterator<Item = &'a u32>,
+) -> BTreeSet<VertexRef> {
     let mut out = BTreeSet::new();
     for &b in bundles {
         let Some(bundle) = mesh.bundles.get(b as usize) else {
             continue;
         };
-        for &c in &bundle.vertices {
+        for &column in &bundle.vertices {
             for layer in 1..=bundle.layers {
-                let v = VertexRef { column: c, layer };
-                if mesh.position(v).is_some()
-                    && !mesh.is_interior(topology, c as usize, layer as usize)
-                {
+                let v = VertexRef { column, layer };
+                if mesh.position(v).is_some() {
                     out.insert(v);
                 }
             }
         }
     }
-    out.into_iter().collect()
+    out
+}
+
+/// What moving the selected bundles moves: their exterior vertices above the root.
+pub fn bundle_transform_vertices(
+    mesh: &HairMesh,
+    topology: &Topology,
+    bundles: &BTreeSet<u32>,
+) -> Vec<VertexRef> {
+    bundle_vertices_above_root(mesh, bundles)
+        .into_iter()
+        .filter(|v| !mesh.is_interior(topology, v.column as usize, v.layer as usize))
+        .collect()
 }
 
 #[cfg(test)]

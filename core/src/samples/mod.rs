@@ -156,17 +156,24 @@ pub struct Cut {
 }
 
 impl Cut {
-    /// The tip height for hair rooted at `root` (model space, cranium at the origin).
-    fn tip_y_m(&self, root: DVec3) -> f64 {
-        let front = (root.z / 0.09).clamp(-1.0, 1.0) * 0.5 + 0.5;
+    /// The tip height for hair rooted at `root` (model space, cranium at the origin, of
+    /// front-to-back radius `radius_z_m`).
+    fn tip_y_m(&self, root: DVec3, radius_z_m: f64) -> f64 {
+        let front = (root.z / radius_z_m).clamp(-1.0, 1.0) * 0.5 + 0.5;
         self.back_y_m + (self.front_y_m - self.back_y_m) * front
     }
 
     /// The layer step that puts the tip of a column rooted at `root` on the cut line, found
     /// by bisection over `tip_y(step)` (tips fall lower as steps grow), within half and 1.6
     /// times `nominal_m`.
-    fn step_for(&self, root: DVec3, nominal_m: f64, tip_y: impl Fn(f64) -> f64) -> f64 {
-        let target_y = self.tip_y_m(root);
+    fn step_for(
+        &self,
+        root: DVec3,
+        radius_z_m: f64,
+        nominal_m: f64,
+        tip_y: impl Fn(f64) -> f64,
+    ) -> f64 {
+        let target_y = self.tip_y_m(root, radius_z_m);
         let (mut low, mut high) = (0.5 * nominal_m, 1.6 * nominal_m);
         for _ in 0..24 {
             let mid = 0.5 * (low + high);
@@ -203,7 +210,7 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
         let (root, n) = (column.positions[0], normals[c]);
         let layers = column.positions.len() - 1;
         let step_m = growth.cut.map_or(growth.step_m, |cut| {
-            cut.step_for(root, growth.step_m, |step_m| {
+            cut.step_for(root, radii_m.z, growth.step_m, |step_m| {
                 comb_column(root, n, layers, step_m, &growth, radii_m)
                     .last()
                     .map_or(root.y, |tip| tip.y)
@@ -219,13 +226,9 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
         // hairline) would not follow columns of different lengths: crown hair is longer
         // than nape hair, so rim-placed crown columns would cut across the head.
         let topology = crate::model::mesh::Topology::build(&mesh);
-        let interior: Vec<VertexRef> = (0..mesh.columns.len())
-            .flat_map(|c| (1..mesh.columns[c].positions.len()).map(move |k| (c, k)))
-            .filter(|&(c, k)| mesh.is_interior(&topology, c, k))
-            .map(|(c, k)| VertexRef {
-                column: c as u32,
-                layer: k as u32,
-            })
+        let interior: Vec<VertexRef> = crate::edit::select::bundle_vertices_above_root(&mesh, &all)
+            .into_iter()
+            .filter(|v| mesh.is_interior(&topology, v.column as usize, v.layer as usize))
             .collect();
         mesh.set_locked(&interior, true);
     }
@@ -256,13 +259,13 @@ fn comb_column(
         // over the face; long (cut) hair then turns to hang.
         let front = (root.z / radii_m.z).max(0.0);
         let hang = if growth.cut.is_some() {
-            0.6 * fraction.min(1.0)
+            fraction.min(1.0)
         } else {
             0.0
         };
         // Crown hair with no side to fall to (root normal straight up) is combed back too.
         let sweep = DVec3::new(0.0, 0.0, -(0.6 + 3.0 * front) * (1.0 - hang));
-        let down = (-DVec3::Y + outward + sweep).normalize();
+        let down = (-DVec3::Y + outward * (1.0 - hang) + sweep).normalize();
         let direction = n.lerp(down, bend).normalize_or(n);
         let mut p = previous + direction * step_m;
         // Keep clear of the head: push out of the inflated cranium ellipsoid.
