@@ -149,21 +149,18 @@ fn m3f(v: Vec3) -> String {
     m3(v.as_dvec3())
 }
 
+/// Values joined by ", ", each written by `write`.
+fn joined<T>(values: &[T], write: impl Fn(&T) -> String) -> String {
+    values.iter().map(write).collect::<Vec<_>>().join(", ")
+}
+
 /// An f32 exactly (shortest text that reads back to the same f32).
 fn exact(values: &[f32]) -> String {
-    values
-        .iter()
-        .map(|v| format!("{v}"))
-        .collect::<Vec<_>>()
-        .join(", ")
+    joined(values, |v| format!("{v}"))
 }
 
 fn hex(values: &[u32]) -> String {
-    values
-        .iter()
-        .map(|v| format!("0x{v:08X}"))
-        .collect::<Vec<_>>()
-        .join(", ")
+    joined(values, |v| format!("0x{v:08X}"))
 }
 
 fn render(tables: &[Table]) -> String {

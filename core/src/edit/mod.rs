@@ -122,15 +122,12 @@ pub(crate) fn finish(
     layers: Option<&[usize]>,
 ) -> Result<EditOutcome, EditError> {
     // A lock on a vertex an edit took away (a shorter column) goes with it.
-    let kept: Vec<VertexRef> = mesh
-        .locked
-        .iter()
-        .copied()
-        .filter(|v| mesh.position(*v).is_some())
-        .collect();
-    if kept.len() != mesh.locked.len() {
-        mesh.locked = kept;
-    }
+    let columns = &mesh.columns;
+    mesh.locked.retain(|v| {
+        columns
+            .get(v.column as usize)
+            .is_some_and(|c| (v.layer as usize) < c.positions.len())
+    });
     place_interior(&mut mesh, layers);
     mesh.update_w();
     mesh.validate()?;

@@ -220,8 +220,8 @@ fn edit_layer(
             }
         })
         .collect();
-    out.locked.clear();
-    out.set_locked(&locked, true);
+    // Shifting a column's locks above one layer keeps the list sorted.
+    out.locked = locked;
     for &b in &affected {
         let bundle = &mut out.bundles[b as usize];
         bundle.layers = bundle.layers.saturating_add_signed(layer_change);

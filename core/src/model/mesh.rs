@@ -427,13 +427,8 @@ impl HairMesh {
     /// Locks (or unlocks) `vertices`, keeping [`HairMesh::locked`] sorted without repeats.
     /// Vertices the mesh does not have are left out.
     pub fn set_locked(&mut self, vertices: &[VertexRef], locked: bool) {
-        let exists = |v: &VertexRef| {
-            self.columns
-                .get(v.column as usize)
-                .is_some_and(|c| (v.layer as usize) < c.positions.len())
-        };
         let mut set: std::collections::BTreeSet<VertexRef> = self.locked.iter().copied().collect();
-        for v in vertices.iter().filter(|v| exists(v)) {
+        for v in vertices.iter().filter(|v| self.position(**v).is_some()) {
             if locked {
                 set.insert(*v);
             } else {

@@ -493,11 +493,5 @@ mod tests {
             motion.validate().expect_err("invalid").path,
             "motion.head_animation[4].time_s"
         );
-        let mut motion = Motion::default();
-        motion.quality.substeps = 0;
-        assert_eq!(
-            motion.validate().expect_err("invalid").path,
-            "motion.quality.substeps"
-        );
     }
 }

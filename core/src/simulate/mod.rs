@@ -21,6 +21,7 @@ pub use xpbd::HairSim;
 
 use std::collections::BTreeSet;
 
+use crate::edit::select::bundle_vertices_above_root;
 use crate::edit::{EditError, EditOutcome, check_bundles};
 use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::{HairMesh, Topology, VertexRef};
@@ -117,14 +118,8 @@ pub fn drape(
     };
     let mut draped = sim.posed_mesh();
     let topology = Topology::build(&draped);
-    let settled_interior: Vec<VertexRef> = selected
-        .iter()
-        .flat_map(|&b| {
-            let bundle = &draped.bundles[b as usize];
-            bundle.vertices.iter().flat_map(move |&column| {
-                (1..=bundle.layers).map(move |layer| VertexRef { column, layer })
-            })
-        })
+    let settled_interior: Vec<VertexRef> = bundle_vertices_above_root(&draped, &selected)
+        .into_iter()
         .filter(|v| {
             pinned.binary_search(v).is_err()
                 && draped.is_interior(&topology, v.column as usize, v.layer as usize)

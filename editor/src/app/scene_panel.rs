@@ -832,49 +832,30 @@ fn motion_ui(ui: &mut egui::Ui, state: &mut EditorState) {
         .default_open(false)
         .show(ui, |ui| {
             let p = &motion.physics;
-            motion_slider(
-                ui,
-                state,
-                "Bend stiffness",
-                p.bend_stiffness,
-                0.0..=1.0,
-                |m, v| m.physics.bend_stiffness = v,
-            );
-            motion_slider(
-                ui,
-                state,
-                "Shape stiffness",
-                p.shape_stiffness,
-                0.0..=1.0,
-                |m, v| m.physics.shape_stiffness = v,
-            );
-            motion_slider(
-                ui,
-                state,
-                "Style hold at root",
-                p.retention_root,
-                0.0..=1.0,
-                |m, v| m.physics.retention_root = v,
-            );
-            motion_slider(
-                ui,
-                state,
-                "Style hold at tip",
-                p.retention_tip,
-                0.0..=1.0,
-                |m, v| m.physics.retention_tip = v,
-            );
-            motion_slider(
-                ui,
-                state,
-                "Damping /s",
-                p.damping_per_s,
-                0.0..=20.0,
-                |m, v| m.physics.damping_per_s = v,
-            );
-            motion_slider(ui, state, "Friction", p.friction, 0.0..=2.0, |m, v| {
-                m.physics.friction = v
-            });
+            type Set = fn(&mut Motion, f64);
+            let sliders: [(&str, f64, std::ops::RangeInclusive<f64>, Set); 6] = [
+                ("Bend stiffness", p.bend_stiffness, 0.0..=1.0, |m, v| {
+                    m.physics.bend_stiffness = v
+                }),
+                ("Shape stiffness", p.shape_stiffness, 0.0..=1.0, |m, v| {
+                    m.physics.shape_stiffness = v
+                }),
+                ("Style hold at root", p.retention_root, 0.0..=1.0, |m, v| {
+                    m.physics.retention_root = v
+                }),
+                ("Style hold at tip", p.retention_tip, 0.0..=1.0, |m, v| {
+                    m.physics.retention_tip = v
+                }),
+                ("Damping /s", p.damping_per_s, 0.0..=20.0, |m, v| {
+                    m.physics.damping_per_s = v
+                }),
+                ("Friction", p.friction, 0.0..=2.0, |m, v| {
+                    m.physics.friction = v
+                }),
+            ];
+            for (label, value, range, set) in sliders {
+                motion_slider(ui, state, label, value, range, set);
+            }
         });
     egui::CollapsingHeader::new("Accuracy")
         .default_open(false)

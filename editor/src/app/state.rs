@@ -340,18 +340,9 @@ impl EditorState {
         if self.tool.mode == SelectMode::Vertices {
             return self.vertex_selection.iter().copied().collect();
         }
-        let mesh = &self.project.document.hair_mesh;
-        let vertices: BTreeSet<VertexRef> = self
-            .selection
-            .iter()
-            .filter_map(|&b| mesh.bundles.get(b as usize))
-            .flat_map(|bundle| {
-                bundle.vertices.iter().flat_map(move |&column| {
-                    (1..=bundle.layers).map(move |layer| VertexRef { column, layer })
-                })
-            })
-            .collect();
-        vertices.into_iter().collect()
+        select::bundle_vertices_above_root(&self.project.document.hair_mesh, &self.selection)
+            .into_iter()
+            .collect()
     }
 
     pub fn transform_targets(&self) -> Vec<VertexRef> {
