@@ -12,15 +12,16 @@ use hairloom_core::io::import::{ImportOptions, import_file};
 use hairloom_core::io::project::write_atomic;
 use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
 use hairloom_core::io::strand_files::{glb_lines, hair_file, usda_file};
-use hairloom_core::runtime::hair::RuntimeOptions;
+use hairloom_core::runtime::hair::{LodEntry, RuntimeOptions};
 use hairloom_core::runtime::textures::Precision;
 use hairloom_core::strands::reference::{Strand, StrandContext, StrandOptions, StrandPlan};
 
 /// Strand width written to the strand files (80 µm, a typical human hair).
 pub const STRAND_WIDTH_M: f32 = 8e-5;
 
-/// Strands have 2^N + 1 vertices in exported strand files unless asked otherwise.
-pub const EXPORT_VERTICES_LOG2: u32 = 5;
+/// Strands have 2^N + 1 vertices in exported strand files and at a runtime bundle's full
+/// detail unless asked otherwise.
+pub const EXPORT_VERTICES_LOG2: u32 = hairloom_core::runtime::hair::DEFAULT_MAX_VERTICES_LOG2;
 
 /// The strand file formats, by extension.
 pub const STRAND_EXTENSIONS: [&str; 3] = ["hair", "usda", "glb"];
@@ -66,17 +67,23 @@ pub fn scalp_document(
     Ok((document, summary))
 }
 
-/// Writes the runtime bundle of `document` into `dir` (created when missing); returns a
+/// Writes the runtime bundle of `document` into `dir` (created when missing), its strands
+/// `2^vertices_log2 + 1` vertices at full detail (`lod.max_vertices_log2`); returns a
 /// one-line summary.
 pub fn write_runtime_bundle(
     document: &Document,
     dir: &Path,
     precision: Precision,
     strands_per_bundle: u32,
+    vertices_log2: u32,
 ) -> anyhow::Result<String> {
     let options = RuntimeOptions {
         precision,
         strands_per_bundle,
+        lod: LodEntry {
+            max_vertices_log2: vertices_log2,
+            ..LodEntry::default()
+        },
         ..RuntimeOptions::default()
     };
     let files = runtime_bundle(document, &options)
@@ -162,8 +169,12 @@ pub fn run(
     if runtime.is_none() && strand_files.is_empty() {
         bail!("nothing to export: give --runtime DIR and/or --strands FILE.{{hair,usda,glb}}");
     }
-    if vertices_log2 > 10 {
-        bail!("--vertices-log2 {vertices_log2} is more than 10 (1025 vertices per strand)");
+    let cap = hairloom_core::io::runtime_bundle::limits::MAX_VERTICES_LOG2;
+    if vertices_log2 > cap {
+        bail!(
+            "--vertices-log2 {vertices_log2} is more than {cap} ({} vertices per strand)",
+            (1u32 << cap) + 1
+        );
     }
     for file in strand_files {
         check_strand_file(file)?;
@@ -171,8 +182,9 @@ pub fn run(
     let project = hairloom_core::io::project::load(project_path)?;
     let document = &project.document;
     if let Some(dir) = runtime {
-        let summary = write_runtime_bundle(document, dir, precision, strands_per_bundle)
-            .with_context(|| format!("exporting {}", project_path.display()))?;
+        let summary =
+            write_runtime_bundle(document, dir, precision, strands_per_bundle, vertices_log2)
+                .with_context(|| format!("exporting {}", project_path.display()))?;
         println!("{summary}");
     }
     if !strand_files.is_empty() {

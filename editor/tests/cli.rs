@@ -222,6 +222,8 @@ fn exports_of_every_sample_pass_third_party_validators() {
         let body = runtime.join(manifest["body"].as_str().expect("a body file"));
         assert!(body.exists(), "{name}: no body file");
         assert!(stdout.contains("runtime bundle, 7 files"), "{stdout}");
+        // The bundle's full detail is what --vertices-log2 asked for, like the strand files.
+        assert_eq!(manifest["lod"]["max_vertices_log2"], 3, "{name}");
         glbs.push(body);
         // Our own reading of the .hair header: counts match what was generated.
         let hair = std::fs::read(&files[0]).expect("hair file");

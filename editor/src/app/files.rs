@@ -211,10 +211,14 @@ impl ExportJob {
         };
         std::thread::spawn(move || {
             let outcome = match target {
-                ExportTarget::Runtime { dir, precision } => {
-                    write_runtime_bundle(&document, &dir, precision, strands_per_bundle)
-                        .map_err(|e| format!("{e:#}"))
-                }
+                ExportTarget::Runtime { dir, precision } => write_runtime_bundle(
+                    &document,
+                    &dir,
+                    precision,
+                    strands_per_bundle,
+                    crate::files::EXPORT_VERTICES_LOG2,
+                )
+                .map_err(|e| format!("{e:#}")),
                 ExportTarget::Strands {
                     file,
                     vertices_log2,
