@@ -12,7 +12,8 @@ use hairloom_core::io::import::{ImportOptions, import_file};
 use hairloom_core::io::project::write_atomic;
 use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
 use hairloom_core::io::strand_files::{glb_lines, hair_file, usda_file};
-use hairloom_core::runtime::hair::{LodEntry, RuntimeOptions};
+use hairloom_core::runtime::hair::{LodEntry, RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::strand_gen::{Filtering, runtime_strands};
 use hairloom_core::runtime::textures::Precision;
 use hairloom_core::strands::reference::{Strand, StrandContext, StrandOptions, StrandPlan};
 
@@ -67,6 +68,48 @@ pub fn scalp_document(
     Ok((document, summary))
 }
 
+/// Which curves a strand file holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StrandCurve {
+    /// The exact cubic curves through the hair mesh (the f64 reference generator).
+    Exact,
+    /// The strands as the runtime generates them: the textures' piecewise quadratics at their
+    /// precision, exact filtering, f32 — to compare a game's own loader with.
+    Runtime,
+}
+
+/// `document`'s strands as a runtime bundle exported with these settings draws them at full
+/// detail.
+fn runtime_curve_strands(
+    document: &Document,
+    precision: Precision,
+    strands_per_bundle: u32,
+    vertices_log2: u32,
+) -> Vec<Strand> {
+    let hair = RuntimeHair::from_document(
+        document,
+        &runtime_options(precision, strands_per_bundle, vertices_log2),
+    );
+    runtime_strands(&hair, (1usize << vertices_log2) + 1, Filtering::Exact)
+}
+
+/// How a runtime bundle is exported: `2^vertices_log2 + 1` vertices per strand at full detail.
+fn runtime_options(
+    precision: Precision,
+    strands_per_bundle: u32,
+    vertices_log2: u32,
+) -> RuntimeOptions {
+    RuntimeOptions {
+        precision,
+        strands_per_bundle,
+        lod: LodEntry {
+            max_vertices_log2: vertices_log2,
+            ..LodEntry::default()
+        },
+        ..RuntimeOptions::default()
+    }
+}
+
 /// Writes the runtime bundle of `document` into `dir` (created when missing), its strands
 /// `2^vertices_log2 + 1` vertices at full detail (`lod.max_vertices_log2`); returns a
 /// one-line summary.
@@ -77,15 +120,7 @@ pub fn write_runtime_bundle(
     strands_per_bundle: u32,
     vertices_log2: u32,
 ) -> anyhow::Result<String> {
-    let options = RuntimeOptions {
-        precision,
-        strands_per_bundle,
-        lod: LodEntry {
-            max_vertices_log2: vertices_log2,
-            ..LodEntry::default()
-        },
-        ..RuntimeOptions::default()
-    };
+    let options = runtime_options(precision, strands_per_bundle, vertices_log2);
     let files = runtime_bundle(document, &options)
         .with_context(|| format!("exporting {}", document.name))?;
     write_bundle_folder(dir, &files, |_| {})
@@ -165,6 +200,7 @@ pub fn run(
     strands_per_bundle: u32,
     vertices_log2: u32,
     precision: Precision,
+    curve: StrandCurve,
 ) -> anyhow::Result<()> {
     if runtime.is_none() && strand_files.is_empty() {
         bail!("nothing to export: give --runtime DIR and/or --strands FILE.{{hair,usda,glb}}");
@@ -192,22 +228,29 @@ pub fn run(
         // Redrawn in place on a terminal; logs and pipes get nothing.
         let show_progress = stderr.is_terminal();
         let mut last_percent = usize::MAX;
-        let strands = generate_strands(document, strands_per_bundle, vertices_log2, &mut |done| {
-            let percent = (done * 100.0) as usize;
-            if show_progress && percent != last_percent {
-                let filled = percent / 5;
-                let _ = write!(
-                    stderr,
-                    "\rgenerating strands [{}{}] {percent:>3}%",
-                    "#".repeat(filled),
-                    " ".repeat(20 - filled)
-                );
-                last_percent = percent;
+        let strands = match curve {
+            StrandCurve::Runtime => {
+                runtime_curve_strands(document, precision, strands_per_bundle, vertices_log2)
             }
-            ControlFlow::Continue(())
-        })
-        .unwrap_or_default();
-        if show_progress {
+            StrandCurve::Exact => {
+                generate_strands(document, strands_per_bundle, vertices_log2, &mut |done| {
+                    let percent = (done * 100.0) as usize;
+                    if show_progress && percent != last_percent {
+                        let filled = percent / 5;
+                        let _ = write!(
+                            stderr,
+                            "\rgenerating strands [{}{}] {percent:>3}%",
+                            "#".repeat(filled),
+                            " ".repeat(20 - filled)
+                        );
+                        last_percent = percent;
+                    }
+                    ControlFlow::Continue(())
+                })
+                .unwrap_or_default()
+            }
+        };
+        if show_progress && curve == StrandCurve::Exact {
             let _ = writeln!(stderr);
         }
         for file in strand_files {

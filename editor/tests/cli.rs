@@ -396,3 +396,53 @@ fn simulate_writes_a_moving_sequence_and_an_animated_usd() {
         assert!(stderr.contains(flag), "{stderr}");
     }
 }
+
+/// `export --curve runtime` writes the strands as the runtime generates them (the
+/// two-quadratic split at texture precision): as many as the exact curves, from the same
+/// roots, but not the same points. (`tests/tests/texture_path.rs` checks them against the
+/// reference generator point by point.)
+#[test]
+fn export_curve_runtime_writes_the_strands_the_runtime_draws() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sample = samples()
+        .into_iter()
+        .find(|p| p.to_string_lossy().contains("head_short_straight"))
+        .expect("the short sample");
+    let read_hair = |curve: &str| {
+        let file = dir.path().join(format!("{curve}.hair"));
+        let (code, _, stderr) = run(hairloom()
+            .arg("export")
+            .arg(&sample)
+            .arg("--strands")
+            .arg(&file)
+            .args(["--strands-per-bundle", "2", "--vertices-log2", "3"])
+            .args(["--curve", curve]));
+        assert_eq!(code, 0, "{curve}: {stderr}");
+        let bytes = std::fs::read(&file).expect("hair file");
+        let count = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
+        let (strands, points) = (count(4) as usize, count(8) as usize);
+        let xyz: Vec<[f32; 3]> = bytes[128..128 + points * 12]
+            .chunks_exact(12)
+            .map(|c| {
+                let f = |i: usize| f32::from_le_bytes(c[i..i + 4].try_into().expect("4 bytes"));
+                [f(0), f(4), f(8)]
+            })
+            .collect();
+        (strands, xyz)
+    };
+    let (exact_count, exact) = read_hair("exact");
+    let (runtime_count, runtime) = read_hair("runtime");
+    assert_eq!(exact_count, runtime_count);
+    assert_eq!(exact.len(), runtime.len());
+    assert_ne!(exact, runtime, "the runtime curves are not the exact ones");
+    // Same roots (the first point of each 9-point strand), in some order.
+    let roots = |points: &[[f32; 3]]| {
+        let mut roots: Vec<[i64; 3]> = points
+            .chunks_exact(9)
+            .map(|s| s[0].map(|x| (x * 1e5).round() as i64))
+            .collect();
+        roots.sort();
+        roots
+    };
+    assert_eq!(roots(&exact), roots(&runtime));
+}

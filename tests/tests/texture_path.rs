@@ -74,3 +74,45 @@ fn styled_texture_path_matches_the_reference_generator() {
         }
     }
 }
+
+/// `export --curve runtime` writes what the runtime draws: each strand is the texture path's
+/// strand of its bundle and manifest sample, in the GPU's order, and matches the reference
+/// generator's two-quadratic strand at that root within the f32 bound above.
+#[test]
+fn runtime_strands_are_the_texture_path_strands_of_each_sample() {
+    use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+    use hairloom_core::runtime::strand_gen::runtime_strands;
+    let path = sample_paths()
+        .into_iter()
+        .find(|p| p.to_string_lossy().contains("head_short_straight"))
+        .expect("the short sample");
+    let document = hairloom_core::io::project::load(&path)
+        .expect("sample")
+        .document;
+    let options = RuntimeOptions {
+        strands_per_bundle: 3,
+        ..RuntimeOptions::default()
+    };
+    let hair = RuntimeHair::from_document(&document, &options);
+    let strands = runtime_strands(&hair, 9, Filtering::Exact);
+    assert_eq!(strands.len(), hair.textures.atlas.blocks.len() * 3);
+    let context = StrandContext::new(&document);
+    let reference_options = StrandOptions {
+        form: SegmentForm::TwoQuadratics,
+        ..StrandOptions::default()
+    };
+    let bound = 1e-5 * document.hair_mesh.size();
+    for strand in strands.iter().step_by(5) {
+        assert_eq!(strand.points.len(), 9);
+        let reference = context
+            .strand(strand.bundle as usize, strand.coord, 9, &reference_options)
+            .expect("strand");
+        for (a, b) in strand.points.iter().zip(&reference.points) {
+            assert!(
+                a.distance(*b) < bound,
+                "bundle {}: {a} against {b}",
+                strand.bundle
+            );
+        }
+    }
+}

@@ -228,6 +228,56 @@ impl StrandGen<'_> {
     }
 }
 
+/// Every strand as the runtime draws it at full detail, `vertex_count` vertices each: the
+/// piecewise quadratics of the textures at their precision, filtered by `filtering`, styled
+/// (what `hairloom export --curve runtime` writes, so a game can compare its own loader).
+/// Strands come in the GPU's order: bundle-major over the atlas blocks, `coord` holding the
+/// manifest sample each was drawn from.
+pub fn runtime_strands(
+    hair: &crate::runtime::hair::RuntimeHair,
+    vertex_count: usize,
+    filtering: Filtering,
+) -> Vec<crate::strands::reference::Strand> {
+    let generator = StrandGen {
+        textures: &hair.textures,
+        filtering,
+    };
+    let styling: Vec<&StylingParams> = std::iter::once(&hair.styling.global)
+        .chain(hair.styling.groups.iter().map(|g| &g.params))
+        .collect();
+    let per_bundle = (hair.strands_per_bundle as usize).max(1);
+    let n = vertex_count.max(2);
+    hair.strand_roots()
+        .iter()
+        .enumerate()
+        .map(|(i, root)| {
+            let block = &hair.textures.atlas.blocks[i / per_bundle];
+            let params = styling
+                .get(root.styling as usize)
+                .copied()
+                .unwrap_or(&hair.styling.global);
+            let input = generator.strand_input(root, params);
+            let samples = if crate::runtime::atlas::Atlas::is_triangle(block) {
+                &hair.samples.triangle
+            } else {
+                &hair.samples.quad
+            };
+            let sample = samples.get(i % per_bundle).copied().unwrap_or_default();
+            crate::strands::reference::Strand {
+                bundle: block.bundle,
+                coord: crate::geometry::curve::FaceCoord {
+                    s: sample[0] as f64,
+                    t: sample[1] as f64,
+                },
+                root_uv: input.root_uv,
+                points: (0..n)
+                    .map(|k| generator.styled_vertex(&input, k, n).as_dvec3())
+                    .collect(),
+            }
+        })
+        .collect()
+}
+
 /// One run over the first `root_count` roots at `vertex_count` vertices, no morphing:
 /// generation without LOD, in one batch.
 pub fn full_detail_runs(root_count: usize, vertex_count: u32) -> Vec<StrandRun> {

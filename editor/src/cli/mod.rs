@@ -81,9 +81,13 @@ enum Command {
         /// Strands have 2^N + 1 vertices.
         #[arg(long, default_value_t = files::EXPORT_VERTICES_LOG2)]
         vertices_log2: u32,
-        /// Runtime texture precision.
+        /// Runtime texture precision (also of `--curve runtime` strands).
         #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
         precision: PrecisionArg,
+        /// What the strand files hold: the exact cubic curves, or the strands as the runtime
+        /// generates them from the textures (quadratics, precision) to compare a loader with.
+        #[arg(long, value_enum, default_value_t = files::StrandCurve::Exact)]
+        curve: files::StrandCurve,
     },
     /// Render a project, or an exported runtime bundle folder, headless to a PNG: strands
     /// generated on the GPU from the runtime textures, lit by the scene (its lights,
@@ -200,6 +204,7 @@ pub fn main() -> ExitCode {
             strands_per_bundle,
             vertices_log2,
             precision,
+            curve,
         }) => files::run(
             &project,
             runtime.as_deref(),
@@ -207,6 +212,7 @@ pub fn main() -> ExitCode {
             strands_per_bundle,
             vertices_log2,
             precision.into(),
+            curve,
         ),
         Some(Command::Render {
             input,
