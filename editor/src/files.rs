@@ -11,7 +11,8 @@ use hairloom_core::Document;
 use hairloom_core::io::import::{ImportOptions, import_file};
 use hairloom_core::io::project::write_atomic;
 use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
-use hairloom_core::io::strand_files::{glb_lines, hair_file, usda_file};
+use hairloom_core::io::strand_files::{ScalpMesh, glb_lines, hair_file, usda_file};
+use hairloom_core::model::mesh::HairMesh;
 use hairloom_core::runtime::hair::{LodEntry, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, runtime_strands};
 use hairloom_core::runtime::textures::Precision;
@@ -172,12 +173,17 @@ pub fn generate_strands(
     Some(strands)
 }
 
-/// Writes `strands` in the format `file`'s extension names; returns a one-line summary.
-pub fn write_strand_file(strands: &[Strand], file: &Path) -> anyhow::Result<String> {
+/// Writes `strands`, grown from `hair_mesh`, in the format `file`'s extension names; returns
+/// a one-line summary.
+pub fn write_strand_file(
+    strands: &[Strand],
+    hair_mesh: &HairMesh,
+    file: &Path,
+) -> anyhow::Result<String> {
     check_strand_file(file)?;
     let bytes = match file.extension().and_then(|e| e.to_str()) {
         Some("hair") => hair_file(strands, STRAND_WIDTH_M, [0.35, 0.22, 0.12]),
-        Some("usda") => usda_file(strands, STRAND_WIDTH_M).into_bytes(),
+        Some("usda") => usda_file(strands, &ScalpMesh::of(hair_mesh), STRAND_WIDTH_M).into_bytes(),
         _ => glb_lines(strands),
     };
     write_atomic(file, &bytes, |_| {}).with_context(|| format!("writing {}", file.display()))?;
@@ -254,7 +260,10 @@ pub fn run(
             let _ = writeln!(stderr);
         }
         for file in strand_files {
-            println!("{}", write_strand_file(&strands, file)?);
+            println!(
+                "{}",
+                write_strand_file(&strands, &document.hair_mesh, file)?
+            );
         }
     }
     Ok(())

@@ -25,13 +25,42 @@ for path in sys.argv[1:]:
     if len(samples) > 1:
         animated_ok = animated_ok and any(s != samples[0] for s in samples[1:])
         animated_ok = animated_ok and stage.GetEndTimeCode() == times[-1]
-    st = UsdGeom.PrimvarsAPI(prim).GetPrimvar("st").Get()
+    primvars = UsdGeom.PrimvarsAPI(prim)
+    st = primvars.GetPrimvar("st").Get()
+    surface_uv = primvars.GetPrimvar("surface_uv_coordinate").Get()
+    # Boundable: an extent at every time the points have, holding every point.
+    extent_attr = curves.GetExtentAttr()
+    extents = [extent_attr.Get(t) for t in times] if times else [extent_attr.Get()]
+    extent_ok = all(
+        e is not None
+        and all(e[0][k] <= p[k] <= e[1][k] for p in s for k in range(3))
+        for e, s in zip(extents, samples)
+    )
+    # The scalp the curves grow from: a mesh whose face-varying st holds every root uv.
+    scalp = UsdGeom.Mesh(stage.GetPrimAtPath("/Scalp"))
+    scalp_ok = scalp.GetPrim().IsValid()
+    if scalp_ok:
+        face_counts = scalp.GetFaceVertexCountsAttr().Get()
+        face_indices = scalp.GetFaceVertexIndicesAttr().Get()
+        scalp_points = scalp.GetPointsAttr().Get(times[0] if times else Usd.TimeCode.Default())
+        scalp_st = UsdGeom.PrimvarsAPI(scalp.GetPrim()).GetPrimvar("st").Get()
+        lo = [min(uv[k] for uv in scalp_st) - 1e-5 for k in range(2)]
+        hi = [max(uv[k] for uv in scalp_st) + 1e-5 for k in range(2)]
+        scalp_ok = (
+            sum(face_counts) == len(face_indices) == len(scalp_st)
+            and all(0 <= i < len(scalp_points) for i in face_indices)
+            and all(lo[k] <= uv[k] <= hi[k] for uv in st for k in range(2))
+        )
     ok = (
         prim.GetTypeName() == "BasisCurves"
         and counts is not None
         and points is not None
         and sum(counts) == len(points)
         and len(st) == len(counts)
+        and surface_uv is not None
+        and list(surface_uv) == list(st)
+        and extent_ok
+        and scalp_ok
         and all(c >= 2 for c in counts)
         and UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y
         and animated_ok

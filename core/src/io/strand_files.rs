@@ -2,6 +2,7 @@
 //! LINES, and the body as a triangle GLB. Every function builds bytes in memory; writing
 //! them is the caller's job (atomically, see [`crate::io::project::write_atomic`]).
 
+use crate::model::mesh::HairMesh;
 use crate::strands::reference::Strand;
 
 /// Cem Yuksel's `.hair` format (cyHair): a 128-byte header then the point array (and a
@@ -48,32 +49,117 @@ pub fn hair_file(strands: &[Strand], thickness_m: f32, color: [f32; 3]) -> Vec<u
     out
 }
 
-/// A USD stage with one `BasisCurves` prim (`/Hair`, linear curves, metres, y up), constant
-/// width and the root uv as a uniform `primvars:st`.
-pub fn usda_file(strands: &[Strand], width_m: f32) -> String {
+/// The scalp the strands grow from, as a polygon mesh: one face per root face of the hair
+/// mesh (removed bundles included: they are still scalp), the columns' root positions, and
+/// each face corner's styling uv, the uv space the strands' root uv lives in, so a tool can
+/// re-attach the curves to the surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalpMesh {
+    pub positions: Vec<[f32; 3]>,
+    /// Corners per face: 3 or 4.
+    pub face_vertex_counts: Vec<u32>,
+    /// Into `positions`, counter-clockwise seen from outside.
+    pub face_vertex_indices: Vec<u32>,
+    /// One per entry of `face_vertex_indices` (face-varying: a uv seam splits a vertex).
+    pub face_uvs: Vec<[f32; 2]>,
+}
+
+impl ScalpMesh {
+    pub fn of(mesh: &HairMesh) -> Self {
+        let positions = mesh
+            .columns
+            .iter()
+            .map(|c| c.positions[0].as_vec3().to_array())
+            .collect();
+        let face_vertex_counts = mesh
+            .bundles
+            .iter()
+            .map(|b| b.vertices.len() as u32)
+            .collect();
+        let face_vertex_indices = mesh
+            .bundles
+            .iter()
+            .flat_map(|b| b.vertices.iter().copied())
+            .collect();
+        let face_uvs = mesh
+            .bundles
+            .iter()
+            .flat_map(|b| b.uvs.iter().map(|uv| uv.as_vec2().to_array()))
+            .collect();
+        Self {
+            positions,
+            face_vertex_counts,
+            face_vertex_indices,
+            face_uvs,
+        }
+    }
+}
+
+/// A USD stage with the strands as one `BasisCurves` prim (`/Hair`, linear curves, metres,
+/// y up, with its `extent`), constant width, and the root uv as a uniform primvar, under two
+/// names: `st` (USD's convention) and `surface_uv_coordinate` (the attribute Blender's hair
+/// tools use to attach curves to a surface); and the scalp as a `Mesh` (`/Scalp`) whose
+/// face-varying `st` is the space of those root uvs.
+pub fn usda_file(strands: &[Strand], scalp: &ScalpMesh, width_m: f32) -> String {
+    let mut out = usda_header("", "Exported by Hairloom");
     let points = format!("    point3f[] points = {}\n", usda_points(strands));
-    usda_stage("", "Exported by Hairloom", strands, &points, width_m)
+    let extent = format!("    float3[] extent = {}\n", usda_extent(strands, width_m));
+    usda_curves(&mut out, strands, &points, &extent, width_m);
+    let scalp_points = format!("    point3f[] points = {}\n", usda_vec3s(&scalp.positions));
+    usda_scalp(&mut out, scalp, &scalp_points);
+    out
 }
 
 /// `[(x, y, z), …]`: every strand's points in order, as USD writes a `point3f[]`.
 fn usda_points(strands: &[Strand]) -> String {
-    let points: Vec<String> = strands
+    let points: Vec<[f32; 3]> = strands
         .iter()
         .flat_map(|s| s.points.iter())
-        .map(|p| format!("({}, {}, {})", p.x as f32, p.y as f32, p.z as f32))
+        .map(|p| p.as_vec3().to_array())
         .collect();
-    format!("[{}]", points.join(", "))
+    usda_vec3s(&points)
 }
 
-/// The stage around the `/Hair` prim: `metadata` lines join the stage's, `points` is the
-/// prim's points attribute (a value or time samples); counts and uv come from `strands`.
-fn usda_stage(metadata: &str, doc: &str, strands: &[Strand], points: &str, width_m: f32) -> String {
+fn usda_vec3s(values: &[[f32; 3]]) -> String {
+    let values: Vec<String> = values
+        .iter()
+        .map(|[x, y, z]| format!("({x}, {y}, {z})"))
+        .collect();
+    format!("[{}]", values.join(", "))
+}
+
+/// `[(min), (max)]` of every point, widened by half the strand width (a Boundable's extent
+/// covers what it draws).
+fn usda_extent(strands: &[Strand], width_m: f32) -> String {
+    let (lo, hi) = strand_bounds(strands, width_m);
+    usda_vec3s(&[lo, hi])
+}
+
+/// The box around every point of `strands`, widened by half of `width_m`; zero when there
+/// are no points.
+pub fn strand_bounds(strands: &[Strand], width_m: f32) -> ([f32; 3], [f32; 3]) {
+    let mut points = strands
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .map(|p| p.as_vec3());
+    let Some(first) = points.next() else {
+        return ([0.0; 3], [0.0; 3]);
+    };
+    let (lo, hi) = points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    let pad = glam::Vec3::splat(0.5 * width_m);
+    ((lo - pad).to_array(), (hi + pad).to_array())
+}
+
+fn usda_header(metadata: &str, doc: &str) -> String {
+    format!(
+        "#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n{metadata}    doc = \"{doc}\"\n)\n\n"
+    )
+}
+
+/// The `/Hair` prim: `points` and `extent` are its attributes (a value or time samples);
+/// counts and uv come from `strands`.
+fn usda_curves(out: &mut String, strands: &[Strand], points: &str, extent: &str, width_m: f32) {
     use std::fmt::Write;
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "#usda 1.0\n(\n    defaultPrim = \"Hair\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n{metadata}    doc = \"{doc}\"\n)\n"
-    );
     let _ = writeln!(
         out,
         "def BasisCurves \"Hair\"\n{{\n    uniform token type = \"linear\"\n    uniform token wrap = \"nonperiodic\""
@@ -81,6 +167,7 @@ fn usda_stage(metadata: &str, doc: &str, strands: &[Strand], points: &str, width
     let counts: Vec<String> = strands.iter().map(|s| s.points.len().to_string()).collect();
     let _ = writeln!(out, "    int[] curveVertexCounts = [{}]", counts.join(", "));
     out.push_str(points);
+    out.push_str(extent);
     let _ = writeln!(
         out,
         "    float[] widths = [{width_m}] (\n        interpolation = \"constant\"\n    )"
@@ -89,20 +176,63 @@ fn usda_stage(metadata: &str, doc: &str, strands: &[Strand], points: &str, width
         .iter()
         .map(|s| format!("({}, {})", s.root_uv.x as f32, s.root_uv.y as f32))
         .collect();
-    let _ = writeln!(
-        out,
-        "    texCoord2f[] primvars:st = [{}] (\n        interpolation = \"uniform\"\n    )",
-        uvs.join(", ")
-    );
-    let _ = writeln!(out, "}}");
-    out
+    let uvs = uvs.join(", ");
+    for (kind, name) in [("texCoord2f", "st"), ("float2", "surface_uv_coordinate")] {
+        let _ = writeln!(
+            out,
+            "    {kind}[] primvars:{name} = [{uvs}] (\n        interpolation = \"uniform\"\n    )"
+        );
+    }
+    let _ = writeln!(out, "}}\n");
 }
 
-/// An animated USD stage: the same `BasisCurves` prim as [`usda_file`], its points sampled at
-/// each frame (`points.timeSamples`, time codes = frame numbers at `frames_per_second`).
-/// Every frame must hold the same curves (counts) as the first; an empty list is refused.
+/// The `/Scalp` prim: `points` is its points attribute (a value or time samples).
+fn usda_scalp(out: &mut String, scalp: &ScalpMesh, points: &str) {
+    use std::fmt::Write;
+    let join = |values: &[u32]| {
+        values
+            .iter()
+            .map(u32::to_string)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let _ = writeln!(out, "def Mesh \"Scalp\"\n{{");
+    let _ = writeln!(
+        out,
+        "    int[] faceVertexCounts = [{}]",
+        join(&scalp.face_vertex_counts)
+    );
+    let _ = writeln!(
+        out,
+        "    int[] faceVertexIndices = [{}]",
+        join(&scalp.face_vertex_indices)
+    );
+    out.push_str(points);
+    let uvs: Vec<String> = scalp
+        .face_uvs
+        .iter()
+        .map(|[u, v]| format!("({u}, {v})"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "    texCoord2f[] primvars:st = [{}] (\n        interpolation = \"faceVarying\"\n    )",
+        uvs.join(", ")
+    );
+    let _ = writeln!(out, "    uniform token subdivisionScheme = \"none\"\n}}");
+}
+
+/// One frame of an animated export: the strands and the scalp they grow from.
+pub struct UsdFrame {
+    pub strands: Vec<Strand>,
+    pub scalp: ScalpMesh,
+}
+
+/// An animated USD stage: the same prims as [`usda_file`], the points and extent of the
+/// curves and the scalp's points sampled at each frame (time codes = frame numbers at
+/// `frames_per_second`). Every frame must hold the same curves (counts) and scalp faces as
+/// the first; an empty list is refused.
 pub fn usda_animation(
-    frames: &[Vec<Strand>],
+    frames: &[UsdFrame],
     width_m: f32,
     frames_per_second: f64,
 ) -> Result<String, String> {
@@ -116,31 +246,40 @@ pub fn usda_animation(
         ));
     }
     for (i, frame) in frames.iter().enumerate() {
-        if frame.len() != first.len()
+        if frame.strands.len() != first.strands.len()
             || frame
+                .strands
                 .iter()
-                .zip(first)
+                .zip(&first.strands)
                 .any(|(s, f)| s.points.len() != f.points.len())
         {
             return Err(format!("frame {i} has other curves than frame 0"));
+        }
+        if frame.scalp.face_vertex_indices != first.scalp.face_vertex_indices
+            || frame.scalp.positions.len() != first.scalp.positions.len()
+        {
+            return Err(format!("frame {i} has another scalp than frame 0"));
         }
     }
     let metadata = format!(
         "    startTimeCode = 0\n    endTimeCode = {}\n    timeCodesPerSecond = {frames_per_second}\n    framesPerSecond = {frames_per_second}\n",
         frames.len() - 1
     );
-    let mut points = String::from("    point3f[] points.timeSamples = {\n");
-    for (i, frame) in frames.iter().enumerate() {
-        let _ = writeln!(points, "        {i}: {},", usda_points(frame));
-    }
-    points.push_str("    }\n");
-    Ok(usda_stage(
-        &metadata,
-        "Simulated by Hairloom",
-        first,
-        &points,
-        width_m,
-    ))
+    let sampled = |name: &str, value: &dyn Fn(&UsdFrame) -> String| {
+        let mut text = format!("    {name}.timeSamples = {{\n");
+        for (i, frame) in frames.iter().enumerate() {
+            let _ = writeln!(text, "        {i}: {},", value(frame));
+        }
+        text.push_str("    }\n");
+        text
+    };
+    let mut out = usda_header(&metadata, "Simulated by Hairloom");
+    let points = sampled("point3f[] points", &|f| usda_points(&f.strands));
+    let extent = sampled("float3[] extent", &|f| usda_extent(&f.strands, width_m));
+    usda_curves(&mut out, &first.strands, &points, &extent, width_m);
+    let scalp_points = sampled("point3f[] points", &|f| usda_vec3s(&f.scalp.positions));
+    usda_scalp(&mut out, &first.scalp, &scalp_points);
+    Ok(out)
 }
 
 /// Binary glTF with one mesh of LINES (glTF has no curve primitive): every strand segment
@@ -255,7 +394,7 @@ mod tests {
         assert_eq!(&hair[..4], b"HAIR");
         assert_eq!(u32::from_le_bytes([hair[4], hair[5], hair[6], hair[7]]), 20);
         assert_eq!(hair.len(), 128 + 20 * 9 * 12);
-        let usda = usda_file(&strands, 1e-4);
+        let usda = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), 1e-4);
         assert!(usda.starts_with("#usda 1.0") && usda.matches("(").count() > 180);
         let glb = glb_lines(&strands);
         let gltf = gltf::Gltf::from_slice(&glb).expect("valid glb");

@@ -236,7 +236,8 @@ impl ExportJob {
                         .ok_or_else(|| "cancelled".to_string())
                     })
                     .and_then(|strands| {
-                        write_strand_file(&strands, &file).map_err(|e| format!("{e:#}"))
+                        write_strand_file(&strands, &document.hair_mesh, &file)
+                            .map_err(|e| format!("{e:#}"))
                     }),
             };
             progress.store(1_000_000, Ordering::Relaxed);

@@ -10,7 +10,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 use glam::Vec3;
-use hairloom_core::io::strand_files::usda_animation;
+use hairloom_core::io::strand_files::{ScalpMesh, UsdFrame, usda_animation};
 use hairloom_core::model::motion::{Motion, Wind};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::simulate::{posed_document, simulator};
@@ -206,7 +206,10 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
                 &mut |_| std::ops::ControlFlow::Continue(()),
             )
             .unwrap_or_default();
-            strand_frames.push(strands);
+            strand_frames.push(UsdFrame {
+                strands,
+                scalp: ScalpMesh::of(&posed.hair_mesh),
+            });
         }
         let depth_mm = 1e3 * sim.deepest_penetration_m();
         println!(
@@ -229,7 +232,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
             "{}: {} frames of {} strands, {:.1} MiB",
             path.display(),
             strand_frames.len(),
-            strand_frames.first().map_or(0, Vec::len),
+            strand_frames.first().map_or(0, |f| f.strands.len()),
             text.len() as f64 / (1 << 20) as f64
         );
     }
