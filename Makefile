@@ -17,9 +17,12 @@ APT_PACKAGES := mesa-vulkan-drivers libvulkan1
 # A virtual X display and a screenshot tool for the editor's window smoke test.
 DISPLAY_PACKAGES := xvfb x11-apps
 # Third-party validators of the exports: Khronos glTF-Validator and ktx-parse (npm, pinned in
-# tools/validate/package-lock.json) and Pixar's USD (PyPI usd-core) in a private venv.
+# tools/validate/package-lock.json), Pixar's USD (PyPI usd-core) and the Alembic library (PyPI
+# alembic3d) in a private venv.
 VALIDATE_VENV := target/validate-venv
 USD_CORE := usd-core==26.11
+# The Alembic C++ library's Python bindings, to read .abc grooms back.
+ALEMBIC3D := alembic3d==1.8.12.1
 
 .PHONY: run test deps gpu-deps toolchain lint samples bench fuzz
 
@@ -55,8 +58,8 @@ deps: gpu-deps
 	  echo "installing:$$tools"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$tools >/dev/null; \
 	fi
 	@[ -d tools/validate/node_modules/gltf-validator ] || (cd tools/validate && npm ci --no-audit --no-fund --loglevel=error)
-	@$(VALIDATE_VENV)/bin/python -c 'import pxr' 2>/dev/null || \
-	  { python3 -m venv $(VALIDATE_VENV) && $(VALIDATE_VENV)/bin/pip install -q --disable-pip-version-check $(USD_CORE); }
+	@$(VALIDATE_VENV)/bin/python -c 'import pxr, alembic3d' 2>/dev/null || \
+	  { python3 -m venv $(VALIDATE_VENV) && $(VALIDATE_VENV)/bin/pip install -q --disable-pip-version-check $(USD_CORE) $(ALEMBIC3D); }
 
 RENDER_OUT ?= out/$(notdir $(SAMPLE:.hairloom=.png))
 

@@ -8,11 +8,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use hairloom_core::Document;
+use hairloom_core::io::alembic::{groom::Groom, groom_file};
 use hairloom_core::io::import::{ImportOptions, import_file};
 use hairloom_core::io::project::write_atomic;
 use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
 use hairloom_core::io::strand_files::{ScalpMesh, glb_lines, hair_file, usda_file};
-use hairloom_core::model::mesh::HairMesh;
 use hairloom_core::runtime::hair::{LodEntry, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, runtime_strands};
 use hairloom_core::runtime::textures::Precision;
@@ -26,7 +26,7 @@ pub const STRAND_WIDTH_M: f32 = 8e-5;
 pub const EXPORT_VERTICES_LOG2: u32 = hairloom_core::runtime::hair::DEFAULT_MAX_VERTICES_LOG2;
 
 /// The strand file formats, by extension.
-pub const STRAND_EXTENSIONS: [&str; 3] = ["hair", "usda", "glb"];
+pub const STRAND_EXTENSIONS: [&str; 4] = ["hair", "usda", "glb", "abc"];
 
 /// A document made from a glTF/GLB scalp (every face becomes a bare bundle, the whole mesh
 /// the body), and a one-line summary of what was read.
@@ -140,7 +140,7 @@ pub fn check_strand_file(file: &Path) -> anyhow::Result<()> {
     let extension = file.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !STRAND_EXTENSIONS.contains(&extension) {
         bail!(
-            "{}: unknown strand format (use .hair, .usda or .glb)",
+            "{}: unknown strand format (use .hair, .usda, .glb or .abc)",
             file.display()
         );
     }
@@ -173,17 +173,20 @@ pub fn generate_strands(
     Some(strands)
 }
 
-/// Writes `strands`, grown from `hair_mesh`, in the format `file`'s extension names; returns
+/// Writes `strands`, grown from `document`, in the format `file`'s extension names; returns
 /// a one-line summary.
 pub fn write_strand_file(
     strands: &[Strand],
-    hair_mesh: &HairMesh,
+    document: &Document,
     file: &Path,
 ) -> anyhow::Result<String> {
     check_strand_file(file)?;
     let bytes = match file.extension().and_then(|e| e.to_str()) {
         Some("hair") => hair_file(strands, STRAND_WIDTH_M, [0.35, 0.22, 0.12]),
-        Some("usda") => usda_file(strands, &ScalpMesh::of(hair_mesh), STRAND_WIDTH_M).into_bytes(),
+        Some("usda") => {
+            usda_file(strands, &ScalpMesh::of(&document.hair_mesh), STRAND_WIDTH_M).into_bytes()
+        }
+        Some("abc") => groom_file(&Groom::new(document, strands, STRAND_WIDTH_M)),
         _ => glb_lines(strands),
     };
     write_atomic(file, &bytes, |_| {}).with_context(|| format!("writing {}", file.display()))?;
@@ -209,7 +212,7 @@ pub fn run(
     curve: StrandCurve,
 ) -> anyhow::Result<()> {
     if runtime.is_none() && strand_files.is_empty() {
-        bail!("nothing to export: give --runtime DIR and/or --strands FILE.{{hair,usda,glb}}");
+        bail!("nothing to export: give --runtime DIR and/or --strands FILE.{{hair,usda,glb,abc}}");
     }
     let cap = hairloom_core::io::runtime_bundle::limits::MAX_VERTICES_LOG2;
     if vertices_log2 > cap {
@@ -260,10 +263,7 @@ pub fn run(
             let _ = writeln!(stderr);
         }
         for file in strand_files {
-            println!(
-                "{}",
-                write_strand_file(&strands, &document.hair_mesh, file)?
-            );
+            println!("{}", write_strand_file(&strands, document, file)?);
         }
     }
     Ok(())

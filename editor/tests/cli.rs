@@ -183,13 +183,14 @@ fn exports_of_every_sample_pass_third_party_validators() {
     let mut glbs = Vec::new();
     let mut ktx2s = Vec::new();
     let mut usdas = Vec::new();
+    let mut abcs = Vec::new();
     for (i, sample) in samples().iter().enumerate() {
         let name = sample
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         let runtime = dir.path().join(format!("{name}_runtime"));
-        let files: Vec<PathBuf> = ["hair", "usda", "glb"]
+        let files: Vec<PathBuf> = ["hair", "usda", "glb", "abc"]
             .iter()
             .map(|e| dir.path().join(format!("{name}.{e}")))
             .collect();
@@ -236,6 +237,7 @@ fn exports_of_every_sample_pass_third_party_validators() {
         assert_eq!(hair.len(), 128 + points * 12);
         usdas.push(files[1].clone());
         glbs.push(files[2].clone());
+        abcs.push(files[3].clone());
         for texture in ["hair_mesh", "uv", "w", "u", "v"] {
             let file = manifest[texture]["file"].as_str().expect("a texture file");
             ktx2s.push(runtime.join(file));
@@ -253,9 +255,13 @@ fn exports_of_every_sample_pass_third_party_validators() {
     let mut usd_args: Vec<&Path> = vec![Path::new("check_usd.py")];
     usd_args.extend(usdas.iter().map(PathBuf::as_path));
     let usd = validator(&python, &usd_args, &tools);
+    let mut abc_args: Vec<&Path> = vec![Path::new("check_abc.py")];
+    abc_args.extend(abcs.iter().map(PathBuf::as_path));
+    let abc = validator(&python, &abc_args, &tools);
     for (what, result) in [
         ("glTF-Validator/ktx-parse (npm)", node),
         ("usd-core (PyPI)", usd),
+        ("alembic3d (PyPI)", abc),
     ] {
         match result {
             Some((code, text)) => {
@@ -349,7 +355,7 @@ fn simulate_writes_a_moving_sequence_and_an_animated_usd() {
         .arg(dir.path())
         .args(["--motion", "head-turn", "--seconds", "1", "--fps", "3"])
         .args(["--size", "96x96", "--effects", "none", "--view", "front"])
-        .args(["--strands-per-bundle", "2", "--usda"]));
+        .args(["--strands-per-bundle", "2", "--usda", "--abc"]));
     if code != 0
         && stderr.contains("no GPU adapter")
         && hairloom_render::device::skip_test_without_gpu("simulate", &stderr)
@@ -374,15 +380,22 @@ fn simulate_writes_a_moving_sequence_and_an_animated_usd() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let tools = root.join("tools/validate");
     let python = root.join("target/validate-venv/bin/python");
-    match validator(&python, &[Path::new("check_usd.py"), &usda], &tools) {
-        Some((code, text)) => {
-            assert_eq!(code, 0, "usd-core rejected the animation:\n{text}");
-            assert!(text.contains("4 time sample(s)"), "{text}");
+    // And the Alembic groom opens in the Alembic library with a sample per frame.
+    let abc = dir.path().join("hair.abc");
+    for (what, script, file, expected) in [
+        ("usd-core", "check_usd.py", &usda, "4 time sample(s)"),
+        ("alembic3d", "check_abc.py", &abc, "4 sample(s)"),
+    ] {
+        match validator(&python, &[Path::new(script), file], &tools) {
+            Some((code, text)) => {
+                assert_eq!(code, 0, "{what} rejected the animation:\n{text}");
+                assert!(text.contains(expected), "{text}");
+            }
+            None if std::env::var("HAIRLOOM_REQUIRE_VALIDATORS").as_deref() == Ok("1") => {
+                panic!("{what} is not installed; `make test` installs it (make deps)")
+            }
+            None => eprintln!("skipped {what}: not installed (run `make deps`)"),
         }
-        None if std::env::var("HAIRLOOM_REQUIRE_VALIDATORS").as_deref() == Ok("1") => {
-            panic!("usd-core is not installed; `make test` installs it (make deps)")
-        }
-        None => eprintln!("skipped usd-core: not installed (run `make deps`)"),
     }
     // Hostile numbers are refused by name.
     for (flag, value) in [("--seconds", "1e9"), ("--fps", "0"), ("--seconds", "NaN")] {

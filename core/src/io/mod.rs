@@ -1,6 +1,7 @@
 //! Files in and out: project files, glTF scalp import, and the exports (the runtime bundle
-//! with its KTX2 textures, and strand files for other tools).
+//! with its KTX2 textures, and strand files for other tools, Alembic grooms among them).
 
+pub mod alembic;
 pub mod import;
 pub mod input_files;
 pub mod ktx2;

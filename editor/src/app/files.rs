@@ -33,7 +33,7 @@ impl FileRequest {
             Self::SaveProjectAs => "Save project as",
             Self::ImportScalp => "Import scalp (glTF / GLB)",
             Self::ExportRuntime => "Export runtime bundle to folder",
-            Self::ExportStrands => "Export strands (.hair, .usda, .glb)",
+            Self::ExportStrands => "Export strands (.hair, .usda, .glb, .abc)",
         }
     }
 
@@ -236,8 +236,7 @@ impl ExportJob {
                         .ok_or_else(|| "cancelled".to_string())
                     })
                     .and_then(|strands| {
-                        write_strand_file(&strands, &document.hair_mesh, &file)
-                            .map_err(|e| format!("{e:#}"))
+                        write_strand_file(&strands, &document, &file).map_err(|e| format!("{e:#}"))
                     }),
             };
             progress.store(1_000_000, Ordering::Relaxed);

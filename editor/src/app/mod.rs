@@ -507,7 +507,7 @@ impl HairloomApp {
             && !files::is_strand_file(file)
         {
             self.state.message = format!(
-                "export failed: {}: unknown strand format (use .hair, .usda or .glb)",
+                "export failed: {}: unknown strand format (use .hair, .usda, .glb or .abc)",
                 file.display()
             );
             return;

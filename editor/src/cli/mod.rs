@@ -72,7 +72,8 @@ enum Command {
         /// Folder for the runtime bundle.
         #[arg(long)]
         runtime: Option<PathBuf>,
-        /// Strand file; the format follows the extension: .hair, .usda or .glb.
+        /// Strand file; the format follows the extension: .hair, .usda, .glb or .abc (an Alembic
+        /// groom with guides, for Unreal and Unity).
         #[arg(long)]
         strands: Vec<PathBuf>,
         /// Strands per bundle (at most 4096, the runtime bundle's cap).
@@ -140,7 +141,7 @@ enum Command {
         time: f64,
     },
     /// Simulate a project's motion and write the frames as a PNG sequence (and, with
-    /// --usda, the strands animated over time).
+    /// --usda / --abc, the strands animated over time).
     Simulate(simulate::SimulateSettings),
     /// List the GPU adapters wgpu can use and the one Hairloom would pick.
     Adapters,

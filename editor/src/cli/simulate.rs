@@ -1,5 +1,5 @@
 //! `hairloom simulate`: the scene's motion (or a preset) simulated at its fixed rate and
-//! written as a PNG sequence, and with `--usda` as strands animated over time.
+//! written as a PNG sequence, and with `--usda` / `--abc` as strands animated over time.
 //!
 //! The simulator steps at the scene's rate whatever `--fps` is: a frame shows the state at
 //! its time, rounded to whole steps.
@@ -10,10 +10,12 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 use glam::Vec3;
+use hairloom_core::io::alembic::{groom::Groom, groom_animation};
 use hairloom_core::io::strand_files::{ScalpMesh, UsdFrame, usda_animation};
 use hairloom_core::model::motion::{Motion, Wind};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::simulate::{posed_document, simulator};
+use hairloom_editor::files::STRAND_WIDTH_M;
 use hairloom_render::device::{GpuContext, describe};
 
 use super::render::{
@@ -86,13 +88,17 @@ pub struct SimulateSettings {
     /// Override the scene's optional effects (as for render).
     #[arg(long)]
     pub effects: Option<String>,
-    /// Strands per bundle drawn (and written with --usda).
+    /// Strands per bundle drawn (and written with --usda / --abc).
     #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub strands_per_bundle: u32,
     /// Also write OUT/hair.usda: the strands at every frame as USD time samples.
     #[arg(long)]
     pub usda: bool,
-    /// Write the strands only (with --usda), no pictures.
+    /// Also write OUT/hair.abc: an Alembic groom (strands and guides) whose points are
+    /// time samples, one per frame.
+    #[arg(long)]
+    pub abc: bool,
+    /// Write the strands only (with --usda / --abc), no pictures.
     #[arg(long)]
     pub no_render: bool,
 }
@@ -109,20 +115,21 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
     if frame_count > MAX_FRAMES {
         bail!("{frame_count} frames are more than the {MAX_FRAMES} one command writes");
     }
-    if settings.usda {
+    let keep_strands = settings.usda || settings.abc;
+    if keep_strands {
         // Every frame's strands are held until the file is written: bound them.
         let points = frame_count as f64
             * (settings.strands_per_bundle as f64)
             * ((1u64 << USDA_VERTICES_LOG2) + 1) as f64;
         if points > MAX_USDA_POINTS_PER_BUNDLE {
             bail!(
-                "--usda: {frame_count} frames × {} strands per bundle is too much to hold; lower --strands-per-bundle, --fps or --seconds",
+                "--usda / --abc: {frame_count} frames × {} strands per bundle is too much to hold; lower --strands-per-bundle, --fps or --seconds",
                 settings.strands_per_bundle
             );
         }
     }
-    if settings.no_render && !settings.usda {
-        bail!("nothing to write: --no-render without --usda");
+    if settings.no_render && !keep_strands {
+        bail!("nothing to write: --no-render without --usda or --abc");
     }
     let (width, height) = parse_size(&settings.size)?;
     let project = hairloom_core::io::project::load(&settings.project)?;
@@ -179,6 +186,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
     );
     let mut simulate_s = 0.0;
     let mut strand_frames = Vec::new();
+    let mut grooms = Vec::new();
     for i in 0..frame_count {
         let time_s = i as f64 / fps;
         let before = Instant::now();
@@ -198,7 +206,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
             let path = settings.out.join(format!("frame_{i:04}.png"));
             write_png(&path, &pixels, width, height)?;
         }
-        if settings.usda {
+        if keep_strands {
             let strands = hairloom_editor::files::generate_strands(
                 &posed,
                 settings.strands_per_bundle,
@@ -206,10 +214,15 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
                 &mut |_| std::ops::ControlFlow::Continue(()),
             )
             .unwrap_or_default();
-            strand_frames.push(UsdFrame {
-                strands,
-                scalp: ScalpMesh::of(&posed.hair_mesh),
-            });
+            if settings.abc {
+                grooms.push(Groom::new(&posed, &strands, STRAND_WIDTH_M));
+            }
+            if settings.usda {
+                strand_frames.push(UsdFrame {
+                    strands,
+                    scalp: ScalpMesh::of(&posed.hair_mesh),
+                });
+            }
         }
         let depth_mm = 1e3 * sim.deepest_penetration_m();
         println!(
@@ -223,8 +236,8 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         );
     }
     if settings.usda {
-        let text = usda_animation(&strand_frames, hairloom_editor::files::STRAND_WIDTH_M, fps)
-            .map_err(anyhow::Error::msg)?;
+        let text =
+            usda_animation(&strand_frames, STRAND_WIDTH_M, fps).map_err(anyhow::Error::msg)?;
         let path = settings.out.join("hair.usda");
         hairloom_core::io::project::write_atomic(&path, text.as_bytes(), |_| {})
             .with_context(|| format!("writing {}", path.display()))?;
@@ -234,6 +247,20 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
             strand_frames.len(),
             strand_frames.first().map_or(0, |f| f.strands.len()),
             text.len() as f64 / (1 << 20) as f64
+        );
+    }
+    if settings.abc {
+        let bytes = groom_animation(&grooms, fps).map_err(anyhow::Error::msg)?;
+        let path = settings.out.join("hair.abc");
+        hairloom_core::io::project::write_atomic(&path, &bytes, |_| {})
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!(
+            "{}: {} frames of {} strands and {} guides, {:.1} MiB",
+            path.display(),
+            grooms.len(),
+            grooms.first().map_or(0, |g| g.strands.vertex_counts.len()),
+            grooms.first().map_or(0, |g| g.guides.vertex_counts.len()),
+            bytes.len() as f64 / (1 << 20) as f64
         );
     }
     println!(

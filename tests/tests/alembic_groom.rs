@@ -1,0 +1,363 @@
+//! Alembic grooms read back by an independent reader (`ogawa-rs`, written against the C++
+//! library's files): objects, counts, points, bounds and every `groom_*` attribute, and the
+//! guides each strand names really are its bundle's corner columns.
+
+use hairloom_core::io::alembic::groom::{GUIDE_POINTS_PER_LAYER, Groom};
+use hairloom_core::io::alembic::{GROOM_VERSION, groom_animation, groom_file, to_file_axes};
+use hairloom_core::io::project;
+use hairloom_core::model::document::Document;
+use hairloom_core::model::styling::StylingGroup;
+use hairloom_core::strands::reference::{StrandOptions, generate};
+use hairloom_tests::sample_paths;
+use ogawa_rs::{
+    Archive, ArchiveReader, FileReader, ObjectReader, PodArray, PropertyReader, Schema,
+};
+
+const WIDTH_M: f32 = 8e-5;
+
+fn sample(name: &str) -> Document {
+    let path = sample_paths()
+        .into_iter()
+        .find(|p| p.to_string_lossy().contains(name))
+        .expect("sample");
+    project::load(&path).expect("sample loads").document
+}
+
+/// The curly sample with its first 40 bundles in a styling group of their own, so the
+/// groom has two groups.
+fn grouped_sample() -> Document {
+    let mut document = sample("head_curly");
+    let params = document.styling.global.clone();
+    document.styling.groups.push(StylingGroup {
+        name: "fringe".into(),
+        bundles: (0..40).collect(),
+        params,
+    });
+    document
+}
+
+struct Read {
+    counts: Vec<i32>,
+    points: Vec<[f32; 3]>,
+    bounds: [f64; 6],
+    width: Vec<f32>,
+    arb: std::collections::BTreeMap<String, (Option<String>, PodArray)>,
+    user: std::collections::BTreeMap<String, String>,
+}
+
+fn read_curves(obj: &ObjectReader, r: &mut dyn ArchiveReader, archive: &Archive) -> Read {
+    let Ok(Schema::Curves(curves)) = Schema::parse(obj, r, archive) else {
+        panic!("{} is not an ICurves", obj.header.full_name);
+    };
+    let counts = curves.load_n_vertices_sample(0, r).expect("nVertices");
+    let points = curves.load_positions_sample(0, r).expect("P");
+    let (kind, wrap, basis) = curves.load_curve_type_sample(0, r).expect("type");
+    assert_eq!(
+        format!("{kind:?}/{wrap:?}/{basis:?}"),
+        "Linear/NonPeriodic/None"
+    );
+    let width = curves
+        .load_widths_sample(0, r)
+        .expect("width")
+        .expect("width present");
+    let props = obj.properties().expect("properties");
+    let Some(PropertyReader::Compound(geom)) = props
+        .load_sub_property_by_name(".geom", r, archive)
+        .expect(".geom")
+    else {
+        panic!(".geom")
+    };
+    let Some(PropertyReader::Scalar(bounds)) = geom
+        .load_sub_property_by_name(".selfBnds", r, archive)
+        .expect(".selfBnds")
+    else {
+        panic!(".selfBnds")
+    };
+    let PodArray::F64(b) = bounds.load_sample(0, r).expect("bounds") else {
+        panic!("bounds are f64")
+    };
+    let mut arb = std::collections::BTreeMap::new();
+    let Some(PropertyReader::Compound(params)) = geom
+        .load_sub_property_by_name(".arbGeomParams", r, archive)
+        .expect(".arbGeomParams")
+    else {
+        panic!(".arbGeomParams")
+    };
+    for i in 0..params.sub_property_count() {
+        if let PropertyReader::Array(a) = params.load_sub_property(i, r, archive).expect("param") {
+            let scope = a.header.meta_data.tokens.get("geoScope").cloned();
+            arb.insert(
+                a.name().to_string(),
+                (scope, a.load_sample(0, r).expect("sample")),
+            );
+        }
+    }
+    let mut user = std::collections::BTreeMap::new();
+    let Some(PropertyReader::Compound(props)) = geom
+        .load_sub_property_by_name(".userProperties", r, archive)
+        .expect(".userProperties")
+    else {
+        panic!(".userProperties")
+    };
+    for i in 0..props.sub_property_count() {
+        if let PropertyReader::Scalar(s) = props.load_sub_property(i, r, archive).expect("user") {
+            user.insert(
+                s.name().to_string(),
+                format!("{:?}", s.load_sample(0, r).expect("value")),
+            );
+        }
+    }
+    Read {
+        counts,
+        points,
+        bounds: b.try_into().expect("6 bounds"),
+        width,
+        arb,
+        user,
+    }
+}
+
+fn read_file(bytes: Vec<u8>) -> (Read, Read, String) {
+    let mut file = tempfile::tempfile().expect("temp file");
+    std::io::Write::write_all(&mut file, &bytes).expect("write");
+    let mut reader = FileReader::new(file).expect("reader");
+    let archive = Archive::new(&mut reader).expect("ogawa-rs opens the file");
+    let root = archive.load_root_object(&mut reader).expect("root");
+    assert_eq!(root.child_count(), 2);
+    let mut objects = Vec::new();
+    for i in 0..root.child_count() {
+        let child = root
+            .load_child(
+                i,
+                &mut reader,
+                &archive.indexed_meta_data,
+                &archive.time_samplings,
+            )
+            .expect("child");
+        assert_eq!(
+            child
+                .header
+                .meta_data
+                .tokens
+                .get("schemaObjTitle")
+                .map(String::as_str),
+            Some("AbcGeom_Curve_v2:.geom"),
+            "Unreal recognises curves by schemaObjTitle"
+        );
+        objects.push((
+            child.header.name.clone(),
+            read_curves(&child, &mut reader, &archive),
+        ));
+    }
+    let names: Vec<&str> = objects.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["hair", "guides"]);
+    let guides = objects.pop().expect("guides").1;
+    let hair = objects.pop().expect("hair").1;
+    (hair, guides, archive.root_header.meta_data.serialize())
+}
+
+fn i32s(read: &Read, name: &str, scope: &str) -> Vec<i32> {
+    match read.arb.get(name) {
+        Some((Some(s), PodArray::I32(v))) if s == scope => v.clone(),
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+fn f32s(read: &Read, name: &str, scope: &str) -> Vec<f32> {
+    match read.arb.get(name) {
+        Some((Some(s), PodArray::F32(v))) if s == scope => v.clone(),
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+#[test]
+fn groom_reads_back_with_every_attribute() {
+    let document = grouped_sample();
+    let strands = generate(
+        &document,
+        &StrandOptions {
+            strands_per_bundle: 6,
+            vertices_log2: 3,
+            ..StrandOptions::default()
+        },
+    );
+    let groom = Groom::new(&document, &strands, WIDTH_M);
+    let (hair, guides, archive_metadata) = read_file(groom_file(&groom));
+    assert!(
+        archive_metadata.contains("_ai_Application=Hairloom"),
+        "{archive_metadata}"
+    );
+
+    // Strands: counts, points (in the file's z-up axes), bounds.
+    assert_eq!(hair.counts.len(), strands.len());
+    assert!(
+        hair.counts
+            .iter()
+            .zip(&strands)
+            .all(|(&c, s)| c as usize == s.points.len())
+    );
+    let expected: Vec<[f32; 3]> = strands
+        .iter()
+        .flat_map(|s| {
+            s.points
+                .iter()
+                .map(|p| to_file_axes(p.as_vec3().to_array()))
+        })
+        .collect();
+    assert_eq!(hair.points, expected);
+    for k in 0..3 {
+        let lo = hair
+            .points
+            .iter()
+            .map(|p| p[k])
+            .fold(f32::INFINITY, f32::min);
+        let hi = hair
+            .points
+            .iter()
+            .map(|p| p[k])
+            .fold(f32::NEG_INFINITY, f32::max);
+        assert_eq!(
+            (hair.bounds[k], hair.bounds[k + 3]),
+            (f64::from(lo), f64::from(hi))
+        );
+    }
+    // z up: the file's z range is the model's vertical (y) range.
+    let model_y = strands
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.y as f32));
+    let (lo_y, hi_y) = model_y.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), y| {
+        (lo.min(y), hi.max(y))
+    });
+    assert_eq!(
+        (hair.bounds[2], hair.bounds[5]),
+        (f64::from(lo_y), f64::from(hi_y))
+    );
+    assert_eq!(hair.width, vec![WIDTH_M]);
+    assert!(
+        f32s(&hair, "groom_width", "uni")
+            .iter()
+            .all(|&w| w == WIDTH_M)
+    );
+    assert!(i32s(&hair, "groom_guide", "uni").iter().all(|&g| g == 0));
+    let uvs = f32s(&hair, "groom_root_uv", "uni");
+    assert_eq!(uvs.len(), 2 * strands.len());
+    assert!(
+        strands
+            .iter()
+            .enumerate()
+            .all(|(i, s)| uvs[2 * i] == s.root_uv.x as f32 && uvs[2 * i + 1] == s.root_uv.y as f32)
+    );
+    let groups = i32s(&hair, "groom_group_id", "uni");
+    assert!(
+        strands
+            .iter()
+            .zip(&groups)
+            .all(|(s, &g)| g == i32::from(s.bundle < 40))
+    );
+    for (name, value) in [
+        ("groom_version_major", GROOM_VERSION.0),
+        ("groom_version_minor", GROOM_VERSION.1),
+    ] {
+        assert_eq!(
+            hair.user.get(name),
+            Some(&format!("I16([{value}])")),
+            "{name}"
+        );
+    }
+    assert!(hair.user["groom_tool"].contains("Hairloom"));
+
+    // Guides: one curve per (group, column), ids before the strands', flagged as guides.
+    assert!(i32s(&guides, "groom_guide", "uni").iter().all(|&g| g == 1));
+    let guide_ids = i32s(&guides, "groom_id", "uni");
+    let strand_ids = i32s(&hair, "groom_id", "uni");
+    assert_eq!(
+        guide_ids,
+        (0..guides.counts.len() as i32).collect::<Vec<_>>()
+    );
+    assert_eq!(strand_ids[0], guides.counts.len() as i32);
+    let guide_groups = i32s(&guides, "groom_group_id", "uni");
+    assert!(guide_groups.contains(&1) && guide_groups.contains(&0));
+
+    // Each strand's guides are in its group, their weights sum to one, and blending the
+    // guides' roots by them puts the strand's root inside its root face.
+    let closest = i32s(&hair, "groom_closest_guides", "uni");
+    let weights = f32s(&hair, "groom_guide_weights", "uni");
+    let mut guide_start = vec![0usize];
+    for &c in &guides.counts {
+        guide_start.push(guide_start.last().copied().unwrap_or(0) + c as usize);
+    }
+    for (i, strand) in strands.iter().enumerate() {
+        let ids = &closest[3 * i..3 * i + 3];
+        let w = &weights[3 * i..3 * i + 3];
+        assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{w:?}");
+        assert!(ids.iter().all(|&g| guide_groups[g as usize] == groups[i]));
+        let root = glam::Vec3::from(to_file_axes(strand.points[0].as_vec3().to_array()));
+        let blended: glam::Vec3 = ids
+            .iter()
+            .zip(w)
+            .map(|(&g, &w)| glam::Vec3::from(guides.points[guide_start[g as usize]]) * w)
+            .sum();
+        let bundle = &document.hair_mesh.bundles[strand.bundle as usize];
+        let edge = bundle
+            .vertices
+            .windows(2)
+            .map(|c| {
+                (document.hair_mesh.columns[c[0] as usize].positions[0]
+                    - document.hair_mesh.columns[c[1] as usize].positions[0])
+                    .length()
+            })
+            .fold(0.0, f64::max) as f32;
+        assert!(
+            (blended - root).length() <= 0.5 * edge,
+            "strand {i}: guides blend to {blended}, root {root}, face edge {edge}"
+        );
+    }
+    // Guides follow their columns: the first point is the column root, and there are
+    // GUIDE_POINTS_PER_LAYER points per layer.
+    assert!(
+        guides
+            .counts
+            .iter()
+            .all(|&c| (c - 1) % GUIDE_POINTS_PER_LAYER as i32 == 0)
+    );
+}
+
+/// An animated groom stores the first frame where `ogawa-rs` reads it (it reads only the
+/// first sample of an array: a known limitation of that crate), and refuses frames whose
+/// curves differ.
+#[test]
+fn animated_groom_reads_back_its_first_frame_and_refuses_mismatched_frames() {
+    let document = sample("head_short");
+    let options = StrandOptions {
+        strands_per_bundle: 2,
+        vertices_log2: 2,
+        ..StrandOptions::default()
+    };
+    let strands = generate(&document, &options);
+    let first = Groom::new(&document, &strands, WIDTH_M);
+    let mut moved = first.clone();
+    for p in moved
+        .strands
+        .points
+        .iter_mut()
+        .chain(moved.guides.points.iter_mut())
+    {
+        p[0] += 0.01;
+    }
+    let bytes = groom_animation(&[first.clone(), moved.clone()], 24.0).expect("animation");
+    let (hair, _, metadata) = read_file(bytes);
+    assert!(metadata.contains("_ai_DCC_FPS=24.000000"), "{metadata}");
+    let expected: Vec<[f32; 3]> = first
+        .strands
+        .points
+        .iter()
+        .map(|&p| to_file_axes(p))
+        .collect();
+    assert_eq!(hair.points, expected);
+
+    let mut fewer = moved;
+    fewer.strands.vertex_counts.pop();
+    assert!(groom_animation(&[first.clone(), fewer], 24.0).is_err());
+    assert!(groom_animation(&[], 24.0).is_err());
+    assert!(groom_animation(&[first], f64::NAN).is_err());
+}
