@@ -3,11 +3,14 @@
 //! for — shadow maps, body shadows, dual-scattering tables, order-independent coverage — each
 //! named after its shader), a view that keeps its render targets (`view`), the frame that
 //! composes them from the scene's effects (`preview`), the registry of every labelled GPU
-//! resource (`resources`) and the measurements of the GPU path (`measure`). A runtime asset
+//! resource (`resources`) and the measurements of the GPU path (`measure`); and `game`, the
+//! drop-in runtime a wgpu game uses to draw a runtime bundle into its own render pass
+//! (`cargo run --example game`). A runtime asset
 //! (`hairloom_core::runtime::hair::RuntimeHair`) becomes GPU resources only here. Every GPU
 //! stage has a CPU mirror in `hairloom_core::runtime` that tests compare against.
 
 pub mod device;
+pub mod game;
 pub mod measure;
 pub mod preview;
 pub mod renderer;

@@ -87,10 +87,31 @@ pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgp
     )
 }
 
-/// The view's depth test: nearer wins, written when `write`.
-pub(crate) fn view_depth(write: bool) -> wgpu::DepthStencilState {
+/// The formats and sample count of the targets a renderer's pipelines draw into: our
+/// [`crate::view::View`]'s, or a game's own (see [`crate::game`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Targets {
+    pub color: wgpu::TextureFormat,
+    /// A depth format (the depth test is "nearer wins": smaller values are nearer).
+    pub depth: wgpu::TextureFormat,
+    pub sample_count: u32,
+}
+
+impl Targets {
+    /// The view's targets at `sample_count` samples.
+    pub fn view(sample_count: u32) -> Self {
+        Self {
+            color: COLOR_FORMAT,
+            depth: DEPTH_FORMAT,
+            sample_count,
+        }
+    }
+}
+
+/// The depth test: nearer wins, written when `write`.
+pub(crate) fn view_depth(targets: &Targets, write: bool) -> wgpu::DepthStencilState {
     wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
+        format: targets.depth,
         depth_write_enabled: Some(write),
         depth_compare: Some(wgpu::CompareFunction::Less),
         stencil: Default::default(),
@@ -98,9 +119,9 @@ pub(crate) fn view_depth(write: bool) -> wgpu::DepthStencilState {
     }
 }
 
-/// The view's colour target, opaque.
-pub(crate) fn view_color_target() -> [Option<wgpu::ColorTargetState>; 1] {
-    [Some(COLOR_FORMAT.into())]
+/// The colour target, opaque.
+pub(crate) fn view_color_target(targets: &Targets) -> [Option<wgpu::ColorTargetState>; 1] {
+    [Some(targets.color.into())]
 }
 
 /// A uniform-buffer layout entry at `binding`, read by both stages.

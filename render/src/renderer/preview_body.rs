@@ -7,7 +7,9 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::device::GpuContext;
 use crate::renderer::scene_lighting::{ShaderKey, body_shader};
-use crate::renderer::{PipelineSpec, pipeline, uniform_entry, view_color_target, view_depth};
+use crate::renderer::{
+    PipelineSpec, Targets, pipeline, uniform_entry, view_color_target, view_depth,
+};
 use crate::resources::Tracked;
 
 /// Keep in sync with `shaders/preview_body.wgsl` (`BodyUniforms`).
@@ -90,7 +92,7 @@ pub(crate) const BODY_VERTEX_LAYOUT: [Option<wgpu::VertexBufferLayout<'static>>;
 pub struct BodyRenderer {
     layout: wgpu::BindGroupLayout,
     uniform_stride: u64,
-    sample_count: u32,
+    targets: Targets,
     pipeline: Option<(ShaderKey, Tracked<wgpu::RenderPipeline>)>,
 }
 
@@ -101,7 +103,13 @@ pub struct PreparedBody {
 }
 
 impl BodyRenderer {
+    /// Drawing into the view's targets at `sample_count` samples.
     pub fn new(context: &GpuContext, sample_count: u32) -> Self {
+        Self::with_targets(context, Targets::view(sample_count))
+    }
+
+    /// Drawing into targets of other formats (a game's).
+    pub fn with_targets(context: &GpuContext, targets: Targets) -> Self {
         let device = &context.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("preview_body"),
@@ -111,7 +119,7 @@ impl BodyRenderer {
         Self {
             layout,
             uniform_stride: (size_of::<BodyUniforms>() as u64).div_ceil(alignment) * alignment,
-            sample_count,
+            targets,
             pipeline: None,
         }
     }
@@ -151,9 +159,9 @@ impl BodyRenderer {
                 buffers: &BODY_VERTEX_LAYOUT,
                 vertex_entry: "vs_main",
                 fragment_entry: Some("fs_main"),
-                targets: &view_color_target(),
-                depth: Some(view_depth(true)),
-                sample_count: self.sample_count,
+                targets: &view_color_target(&self.targets),
+                depth: Some(view_depth(&self.targets, true)),
+                sample_count: self.targets.sample_count,
             },
         );
         self.pipeline = Some((key, made));

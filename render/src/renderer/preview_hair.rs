@@ -9,7 +9,9 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::device::GpuContext;
 use crate::renderer::scene_lighting::{ActiveEffects, ShaderKey, hair_shader};
-use crate::renderer::{PipelineSpec, pipeline, uniform_entry, view_color_target, view_depth};
+use crate::renderer::{
+    PipelineSpec, Targets, pipeline, uniform_entry, view_color_target, view_depth,
+};
 use crate::resources::Tracked;
 
 /// The default variant's source (Marschner, deep opacity maps, body shadows, dual
@@ -57,7 +59,7 @@ pub struct HairRenderer {
     draw_layout: wgpu::BindGroupLayout,
     /// Bytes between two uniform entries (the adapter's dynamic-offset alignment).
     uniform_stride: u64,
-    sample_count: u32,
+    targets: Targets,
     pipelines: Option<HairPipelines>,
 }
 
@@ -69,7 +71,13 @@ pub struct PreparedHair {
 }
 
 impl HairRenderer {
+    /// Drawing into the view's targets at `sample_count` samples.
     pub fn new(context: &GpuContext, sample_count: u32) -> Self {
+        Self::with_targets(context, Targets::view(sample_count))
+    }
+
+    /// Drawing into targets of other formats (a game's).
+    pub fn with_targets(context: &GpuContext, targets: Targets) -> Self {
         let device = &context.device;
         let storage = |binding: u32, size: u64| wgpu::BindGroupLayoutEntry {
             binding,
@@ -97,9 +105,14 @@ impl HairRenderer {
         Self {
             draw_layout,
             uniform_stride: (size_of::<HairUniforms>() as u64).div_ceil(alignment) * alignment,
-            sample_count,
+            targets,
             pipelines: None,
         }
+    }
+
+    /// The formats and sample count the pipelines draw into.
+    pub fn targets(&self) -> Targets {
+        self.targets
     }
 
     /// Group 0 of every pipeline that draws ribbons.
@@ -134,12 +147,12 @@ impl HairRenderer {
                 fragment_entry: Some("fs_depth"),
                 // The view's colour target, untouched (the pass has it attached).
                 targets: &[Some(wgpu::ColorTargetState {
-                    format: crate::view::COLOR_FORMAT,
+                    format: self.targets.color,
                     blend: None,
                     write_mask: wgpu::ColorWrites::empty(),
                 })],
-                depth: Some(view_depth(true)),
-                sample_count: self.sample_count,
+                depth: Some(view_depth(&self.targets, true)),
+                sample_count: self.targets.sample_count,
             },
         );
         let main = pipeline(
@@ -151,12 +164,12 @@ impl HairRenderer {
                 buffers: &[],
                 vertex_entry: "vs_main",
                 fragment_entry: Some("fs_main"),
-                targets: &view_color_target(),
+                targets: &view_color_target(&self.targets),
                 depth: Some(wgpu::DepthStencilState {
                     depth_compare: Some(wgpu::CompareFunction::Equal),
-                    ..view_depth(false)
+                    ..view_depth(&self.targets, false)
                 }),
-                sample_count: self.sample_count,
+                sample_count: self.targets.sample_count,
             },
         );
         let oit = key.1.then(|| {
@@ -199,8 +212,8 @@ impl HairRenderer {
                     ],
                     // Behind opaque strands and the body; transparent strands do not hide
                     // each other.
-                    depth: Some(view_depth(false)),
-                    sample_count: self.sample_count,
+                    depth: Some(view_depth(&self.targets, false)),
+                    sample_count: self.targets.sample_count,
                 },
             )
         });

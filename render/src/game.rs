@@ -1,0 +1,416 @@
+//! The drop-in runtime for wgpu games: load a runtime bundle, and each frame record strand
+//! generation into the game's command encoder and the lit hair into the game's own render
+//! pass, with the game's camera, colour and depth targets and lights. No editor and no
+//! window of ours: [`GameHair`] borrows the game's device and queue.
+//!
+//! ```no_run
+//! # fn frame(device: &wgpu::Device, queue: &wgpu::Queue, adapter: &wgpu::Adapter,
+//! #          color: &wgpu::TextureView, depth: &wgpu::TextureView, camera: hairloom_render::game::GameCamera)
+//! #          -> Result<(), Box<dyn std::error::Error>> {
+//! use hairloom_render::game::{GameHair, HairTargets};
+//! let bundle = hairloom_core::io::runtime_bundle::load_runtime_bundle("hair_bundle".as_ref())?;
+//! let targets = HairTargets {
+//!     color: wgpu::TextureFormat::Bgra8UnormSrgb,
+//!     depth: wgpu::TextureFormat::Depth32Float,
+//!     sample_count: 1,
+//! };
+//! let mut hair = GameHair::new(adapter, device, queue, &bundle, targets)?;
+//! // Every frame:
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! hair.prepare(&mut encoder, &camera); // culling, LOD and generation (compute)
+//! {
+//!     let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+//!         label: Some("game"),
+//!         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+//!             view: color, depth_slice: None, resolve_target: None,
+//!             ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+//!         })],
+//!         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+//!             view: depth,
+//!             depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+//!             stencil_ops: None,
+//!         }),
+//!         timestamp_writes: None, occlusion_query_set: None, multiview_mask: None,
+//!     });
+//!     // … the game's own draws …
+//!     hair.draw(&mut pass); // depth-tested against what the game drew
+//! }
+//! queue.submit([encoder.finish()]);
+//! # Ok(()) }
+//! ```
+//!
+//! What the game path draws: the bundle's shading model (Kajiya-Kay or Marschner) and dual
+//! scattering, under the bundle's lights or the game's ([`GameHair::set_lighting`]), and
+//! optionally the bundle's body. Effects that need passes of their own — shadow maps, body
+//! shadows, width-based transparency — are left to the game's renderer (it owns the pass
+//! structure); [`game_scene`] says exactly which scene the game path draws, and the editor's
+//! preview draws the same picture for it (tested).
+
+use glam::{Mat4, Vec3};
+use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere};
+use hairloom_core::model::scene::{Coverage, Scene, SelfShadowing};
+use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
+use hairloom_core::runtime::hair::RuntimeHair;
+use hairloom_core::runtime::strand_gen::Filtering;
+
+use crate::device::GpuContext;
+use crate::preview::default_strand_width_m;
+use crate::renderer::Targets;
+use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody, PreparedBody};
+use crate::renderer::preview_hair::{HairRenderer, HairUniforms, PreparedHair};
+use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effect_entries};
+use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer};
+use crate::resources::Tracked;
+
+/// The game's targets: the formats and sample count of the pass [`GameHair::draw`] records
+/// into.
+pub type HairTargets = Targets;
+
+/// The game's camera for a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GameCamera {
+    /// World to clip space, depth in `[0, 1]` with nearer smaller (wgpu's convention).
+    pub view_projection: Mat4,
+    pub eye: Vec3,
+    /// Vertical field of view; level of detail measures sizes in pixels with it.
+    pub fov_y_rad: f32,
+    /// Height of the viewport in pixels.
+    pub viewport_height_px: u32,
+}
+
+/// What one frame drew.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GameFrameStats {
+    /// Strands and vertices generated after culling and level of detail.
+    pub strands: usize,
+    pub vertices: usize,
+    /// Bundles outside the view, skipped.
+    pub culled_bundles: usize,
+    /// Strands planned but not drawn: more vertices than one storage binding of the
+    /// game's device holds (raise its `max_storage_buffer_binding_size`, or let LOD
+    /// drop strands).
+    pub strands_over_limit: usize,
+}
+
+/// The scene the game path draws for `scene`: the same lights and material, the shading
+/// model and dual scattering, and none of the effects that need passes of their own.
+pub fn game_scene(scene: &Scene) -> Scene {
+    let mut scene = scene.clone();
+    scene.effects.self_shadowing = SelfShadowing::None;
+    scene.effects.body_shadows = false;
+    scene.effects.coverage = Coverage::Msaa;
+    scene
+}
+
+/// A runtime bundle on the game's GPU, drawn into the game's passes.
+pub struct GameHair {
+    context: GpuContext,
+    generator: StrandGenRenderer,
+    gpu: GpuHair,
+    lighting: SceneLighting,
+    hair: HairRenderer,
+    body_renderer: BodyRenderer,
+    body: GpuBody,
+    draw_body: bool,
+    scene: Scene,
+    active: ActiveEffects,
+    effects_group: Option<wgpu::BindGroup>,
+    bounds: (Vec3, Vec3),
+    strand_width_m: f32,
+    lod: LodSettings,
+    filtering: Filtering,
+    vertex_count: u32,
+    frame: Option<PreparedFrame>,
+}
+
+/// One frame's GPU state between [`GameHair::prepare`] and [`GameHair::draw`].
+struct PreparedFrame {
+    hair: PreparedHair,
+    body: PreparedBody,
+    segments: u32,
+    _runs: wgpu::Buffer,
+    _scratch: Tracked<wgpu::Buffer>,
+}
+
+/// Why a bundle could not be put on the game's GPU.
+#[derive(Debug, thiserror::Error)]
+pub enum GameHairError {
+    #[error(transparent)]
+    Generation(#[from] StrandGenError),
+    #[error("the bundle grows no hair")]
+    NoHair,
+    #[error("{0}")]
+    EffectLimit(String),
+}
+
+impl GameHair {
+    /// Uploads `hair` (its five textures, placements, samples and styling: nothing per
+    /// strand) to the game's device and makes the pipelines for `targets`. The bundle's
+    /// body is drawn too unless [`Self::set_draw_body`] turns it off.
+    pub fn new(
+        adapter: &wgpu::Adapter,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        hair: &RuntimeHair,
+        targets: HairTargets,
+    ) -> Result<Self, GameHairError> {
+        let context = GpuContext::from_parts(adapter.clone(), device.clone(), queue.clone());
+        let generator = StrandGenRenderer::new(&context);
+        let gpu = generator.upload(&context, hair)?;
+        let bounds = hair.textures.hair_bounds().ok_or(GameHairError::NoHair)?;
+        let max_log2 = hair.lod.max_vertices_log2.min(8);
+        let mut this = Self {
+            lighting: SceneLighting::new(&context),
+            hair: HairRenderer::with_targets(&context, targets),
+            body_renderer: BodyRenderer::with_targets(&context, targets),
+            body: GpuBody::upload(&context, &hair.body),
+            draw_body: true,
+            scene: game_scene(&hair.scene),
+            active: ActiveEffects::none(),
+            effects_group: None,
+            bounds,
+            strand_width_m: default_strand_width_m(bounds.0, bounds.1),
+            lod: LodSettings {
+                alpha_strands: hair.lod.alpha_strands,
+                alpha_vertices: hair.lod.alpha_vertices,
+                lambda: hair.lod.lambda,
+                ..LodSettings::default()
+            },
+            filtering: Filtering::Exact,
+            vertex_count: (1u32 << max_log2) + 1,
+            frame: None,
+            generator,
+            gpu,
+            context,
+        };
+        let scene = this.scene.clone();
+        this.set_lighting(&scene)?;
+        Ok(this)
+    }
+
+    /// Lights, material and shading from `scene` (the game's lights, or the bundle's own:
+    /// [`RuntimeHair::scene`]); the effects it names that need passes of their own are
+    /// left out (see [`game_scene`]).
+    pub fn set_lighting(&mut self, scene: &Scene) -> Result<(), GameHairError> {
+        let scene = game_scene(scene);
+        let active = ActiveEffects::new(&scene, false);
+        crate::preview::check_effect_limits(&self.context.device.limits(), &active)
+            .map_err(|e| GameHairError::EffectLimit(e.to_string()))?;
+        self.lighting.sync(&self.context, &active, &scene.material);
+        let entries = effect_entries(&active);
+        let effects_layout = (!entries.is_empty()).then(|| {
+            self.context
+                .device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("game_effects"),
+                    entries: &entries,
+                })
+        });
+        // Pipelines are made against the layouts, so new layouts mean new renderers.
+        let targets = self.hair.targets();
+        self.hair = HairRenderer::with_targets(&self.context, targets);
+        self.body_renderer = BodyRenderer::with_targets(&self.context, targets);
+        self.hair.ensure(
+            &self.context,
+            &active,
+            &self.lighting.scene_layout,
+            effects_layout.as_ref(),
+        );
+        self.body_renderer.ensure(
+            &self.context,
+            active.shader_key(),
+            &self.lighting.scene_layout,
+            effects_layout.as_ref(),
+        );
+        self.effects_group = effects_layout.as_ref().map(|layout| {
+            let mut entries = Vec::new();
+            if let Some(ds) = &self.lighting.dual_scattering {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: binding::TABLE_SAMPLER,
+                    resource: wgpu::BindingResource::Sampler(&self.lighting.table_sampler),
+                });
+                entries.push(wgpu::BindGroupEntry {
+                    binding: binding::DS_PROFILE,
+                    resource: wgpu::BindingResource::TextureView(&ds.profile_view),
+                });
+                entries.push(wgpu::BindGroupEntry {
+                    binding: binding::DS_LOBES,
+                    resource: wgpu::BindingResource::TextureView(&ds.lobes_view),
+                });
+            }
+            self.context
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("game_effects"),
+                    layout,
+                    entries: &entries,
+                })
+        });
+        self.scene = scene;
+        self.active = active;
+        Ok(())
+    }
+
+    /// Whether [`Self::draw`] draws the bundle's body (on by default; a game that draws its
+    /// own character turns it off).
+    pub fn set_draw_body(&mut self, draw: bool) {
+        self.draw_body = draw;
+    }
+
+    /// Level of detail and culling (the bundle's settings by default).
+    pub fn set_lod(&mut self, lod: LodSettings) {
+        self.lod = lod;
+    }
+
+    /// Vertices per strand at full detail: `2^log2 + 1` (the bundle's
+    /// `lod.max_vertices_log2` by default; at most 8).
+    pub fn set_vertices_log2(&mut self, log2: u32) {
+        self.vertex_count = (1u32 << log2.clamp(1, 8)) + 1;
+    }
+
+    /// Ribbon width at the root, metres (default: a little over a thousandth of the hair's
+    /// size, as `hairloom render` draws).
+    pub fn set_strand_width_m(&mut self, width_m: f32) {
+        self.strand_width_m = width_m;
+    }
+
+    /// The box around the hair (to frame a camera).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    /// The scene being drawn.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Plans the frame for `camera` (culling, strand and vertex LOD), writes its uniforms
+    /// and records the strands' generation into `encoder`, before the game's render pass.
+    pub fn prepare(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        camera: &GameCamera,
+    ) -> GameFrameStats {
+        let context = &self.context;
+        let height_px = camera.viewport_height_px.max(1);
+        let lod_camera = LodCamera {
+            eye: camera.eye,
+            view_projection: camera.view_projection,
+            fov_y_rad: camera.fov_y_rad,
+            resolution_px: height_px as f32,
+        };
+        // One batch, so generation runs once before the pass: as many vertices as one
+        // storage binding holds.
+        let binding_vertices =
+            (context.device.limits().max_storage_buffer_binding_size / 16).max(1) as usize;
+        let mut plan = plan_frame(
+            &self.gpu.bundles,
+            self.gpu.per_bundle,
+            self.vertex_count.saturating_sub(1).max(1).ilog2(),
+            &lod_camera,
+            &self.lod,
+            binding_vertices,
+        );
+        let mut stats = GameFrameStats {
+            strands: plan.strands,
+            vertices: plan.vertices,
+            culled_bundles: plan.culled_bundles,
+            strands_over_limit: 0,
+        };
+        if plan.batches.len() > 1 {
+            let first = plan.batches.swap_remove(0);
+            let dropped: usize = plan
+                .batches
+                .iter()
+                .flatten()
+                .map(|r| r.strand_count as usize)
+                .sum();
+            plan.batches = vec![first];
+            stats.strands_over_limit = dropped;
+            stats.strands -= dropped;
+            stats.vertices = FramePlan::batch_vertices(&plan.batches[0]);
+        }
+        let runs = self.generator.upload_runs(context, &plan);
+        let scratch = self.generator.scratch(context, &plan);
+        let segments = plan
+            .batches
+            .first()
+            .map_or(0, |b| FramePlan::batch_segments(b) as u32);
+        if let Some(batch) = plan.batches.first() {
+            self.generator.encode(
+                context,
+                encoder,
+                &self.gpu,
+                &runs,
+                0,
+                batch,
+                self.filtering,
+                &scratch,
+                None,
+            );
+        }
+        let (_, radius) = bounding_sphere(self.bounds.0, self.bounds.1);
+        let mean_forward = self
+            .lighting
+            .sync(context, &self.active, &self.scene.material);
+        let tables = self.lighting.dual_scattering.as_ref().map(|ds| &ds.tables);
+        let uniforms = SceneUniforms::new(
+            &self.scene,
+            &[],
+            tables,
+            mean_forward,
+            radius,
+            self.strand_width_m,
+        );
+        self.lighting.write(context, &uniforms);
+        let view_projection = camera.view_projection.to_cols_array_2d();
+        let eye = camera.eye.extend(1.0).to_array();
+        let pixel_at_unit = 2.0 * (camera.fov_y_rad * 0.5).tan() / height_px as f32;
+        let views = [HairUniforms {
+            view_projection,
+            eye,
+            width: [self.strand_width_m, pixel_at_unit, 0.0, 0.0],
+            batch: [0; 4],
+        }];
+        let ranges = [[0, plan.batches.first().map_or(0, Vec::len) as u32]];
+        let hair = self.hair.prepare(context, &views, &ranges, &scratch, &runs);
+        let body = self.body_renderer.prepare(
+            context,
+            &[BodyUniforms {
+                view_projection,
+                camera_position: eye,
+            }],
+        );
+        self.frame = Some(PreparedFrame {
+            hair,
+            body,
+            segments,
+            _runs: runs,
+            _scratch: scratch,
+        });
+        stats
+    }
+
+    /// Records the body (when on) and the lit hair into the game's pass, depth-tested
+    /// against what the game drew before: a depth pre-pass of the ribbons, then the lit
+    /// ribbons where they are nearest, so each visible sample is shaded once. Draws nothing
+    /// before the first [`Self::prepare`].
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        let Some(frame) = &self.frame else {
+            return;
+        };
+        pass.set_bind_group(1, &self.lighting.scene_group, &[]);
+        if let Some(group) = &self.effects_group {
+            pass.set_bind_group(2, group, &[]);
+        }
+        if self.draw_body {
+            self.body_renderer.draw(pass, &frame.body, &self.body);
+        }
+        for pipeline in [self.hair.depth_pipeline(), self.hair.main_pipeline()]
+            .into_iter()
+            .flatten()
+        {
+            HairRenderer::draw_with(pass, pipeline, &frame.hair, 0, 0, frame.segments);
+        }
+    }
+}

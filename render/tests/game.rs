@@ -1,0 +1,206 @@
+//! The drop-in game runtime draws what `hairloom render` draws: a runtime bundle recorded
+//! through `GameHair` into a render pass the test owns (its own targets, camera and clear)
+//! matches the editor's preview of the same bundle and scene.
+
+use glam::Vec3;
+use hairloom_core::model::scene::Shading;
+use hairloom_core::runtime::frame_plan::LodSettings;
+use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_render::device::headless_for_test;
+use hairloom_render::game::{GameCamera, GameHair, game_scene};
+use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
+use hairloom_render::renderer::Targets;
+use hairloom_render::renderer::preview_body::GpuBody;
+use hairloom_render::renderer::strand_gen::StrandGenRenderer;
+use hairloom_render::view::View;
+
+const SIZE: u32 = 160;
+const VERTICES_LOG2: u32 = 4;
+
+fn bundle() -> RuntimeHair {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/samples/head_short_straight.hairloom");
+    let document = hairloom_core::io::project::load(&path)
+        .expect("sample")
+        .document;
+    let mut hair = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 8,
+            ..RuntimeOptions::default()
+        },
+    );
+    // Marschner with dual scattering: the shading the game path keeps, at its dearest.
+    hair.scene.effects.shading = Shading::Marschner;
+    hair
+}
+
+fn mean_abs_difference(a: &[u8], b: &[u8]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(&x, &y)| (x as f64 - y as f64).abs())
+        .sum::<f64>()
+        / a.len() as f64
+}
+
+#[test]
+fn game_runtime_draws_what_the_preview_draws() {
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let hair = bundle();
+    let scene = game_scene(&hair.scene);
+    let (lo, hi) = hair.textures.hair_bounds().expect("hair");
+    let camera = Camera::framing(lo, hi, Vec3::new(0.75, 0.25, 1.0));
+    let lod = LodSettings::default();
+
+    // The editor's preview of the bundle, with the scene the game path draws.
+    let generator = StrandGenRenderer::new(&context);
+    let gpu_hair = generator.upload(&context, &hair).expect("upload");
+    let body = GpuBody::upload(&context, &hair.body);
+    let preview = PreviewRenderer::new(&context);
+    let preview_scene = default_scene(
+        &body,
+        HairSource::Generated {
+            generator: &generator,
+            hair: &gpu_hair,
+            filtering: Filtering::Exact,
+            lod,
+        },
+        (1 << VERTICES_LOG2) + 1,
+        (lo, hi),
+        camera,
+        &scene,
+    );
+    let plan = preview.plan(&preview_scene, SIZE, SIZE);
+    let expected = preview
+        .render(&context, &preview_scene, &plan, SIZE, SIZE)
+        .expect("preview");
+
+    // The same bundle through the game API, into targets and a pass the test owns.
+    let sample_count = preview.sample_count;
+    let view = View::new(&context, SIZE, SIZE, sample_count);
+    let mut game = GameHair::new(
+        &context.adapter,
+        &context.device,
+        &context.queue,
+        &hair,
+        Targets::view(sample_count),
+    )
+    .expect("the bundle loads");
+    game.set_lod(lod);
+    game.set_vertices_log2(VERTICES_LOG2);
+    let mut encoder = context
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("game"),
+        });
+    let stats = game.prepare(
+        &mut encoder,
+        &GameCamera {
+            view_projection: camera.view_projection(1.0),
+            eye: camera.eye,
+            fov_y_rad: camera.fov_y_rad,
+            viewport_height_px: SIZE,
+        },
+    );
+    assert_eq!(stats.strands, plan.strands);
+    assert_eq!(stats.vertices, plan.vertices);
+    assert_eq!(stats.strands_over_limit, 0);
+    {
+        let (target, resolve) = view.attachments();
+        let [r, g, b] = scene.background;
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("game"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: resolve,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: r as f64,
+                        g: g as f64,
+                        b: b as f64,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: view.depth(),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        game.draw(&mut pass);
+    }
+    let drawn = View::read_back(&context, view.color(), encoder).expect("read back");
+
+    let hair_pixels = expected
+        .chunks_exact(4)
+        .zip(drawn.chunks_exact(4))
+        .filter(|(a, _)| a[..3] != expected[..3])
+        .count();
+    assert!(
+        hair_pixels > (SIZE * SIZE / 20) as usize,
+        "the preview drew almost nothing ({hair_pixels} pixels differ from the corner)"
+    );
+    let difference = mean_abs_difference(&expected, &drawn);
+    assert!(
+        difference < 0.5,
+        "game runtime vs preview: mean difference {difference:.3} per channel"
+    );
+
+    // Without the body the picture loses it: the switch is real.
+    game.set_draw_body(false);
+    let mut encoder = context
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("game"),
+        });
+    game.prepare(
+        &mut encoder,
+        &GameCamera {
+            view_projection: camera.view_projection(1.0),
+            eye: camera.eye,
+            fov_y_rad: camera.fov_y_rad,
+            viewport_height_px: SIZE,
+        },
+    );
+    {
+        let (target, resolve) = view.attachments();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("game"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: resolve,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: view.depth(),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        game.draw(&mut pass);
+    }
+    let hair_only = View::read_back(&context, view.color(), encoder).expect("read back");
+    assert!(mean_abs_difference(&hair_only, &drawn) > 1.0);
+}
