@@ -11,12 +11,14 @@
 //! | [`simulate`] | hair that moves: the body's distance field, wind, XPBD on the hair-mesh vertices, drape |
 //! | [`light`] | the scene's light on the CPU: fibre material, the Marschner model, dual-scattering tables, opacity-map math, the reference path tracer |
 //! | [`runtime`] | the runtime asset ([`runtime::hair::RuntimeHair`]: textures, samples, placements, styling) and the CPU mirror of every shader |
-//! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) and strand exports |
+//! | [`cards`] | hair cards from bundles: card strips with the strands baked into an atlas |
+//! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) strand exports, Alembic grooms and card glTF |
 //! | [`samples`] | the bundled sample projects, built by code |
 //!
 //! This crate has no GPU or UI dependency; the f64 code here is the reference every faster
 //! path is measured against.
 
+pub mod cards;
 pub mod edit;
 pub mod geometry;
 pub mod io;

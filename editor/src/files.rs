@@ -212,7 +212,9 @@ pub fn run(
     curve: StrandCurve,
 ) -> anyhow::Result<()> {
     if runtime.is_none() && strand_files.is_empty() {
-        bail!("nothing to export: give --runtime DIR and/or --strands FILE.{{hair,usda,glb,abc}}");
+        bail!(
+            "nothing to export: give --runtime DIR, --strands FILE.{{hair,usda,glb,abc}} and/or --cards DIR"
+        );
     }
     let cap = hairloom_core::io::runtime_bundle::limits::MAX_VERTICES_LOG2;
     if vertices_log2 > cap {
@@ -267,4 +269,111 @@ pub fn run(
         }
     }
     Ok(())
+}
+
+/// A PNG of `pixels` (`kind`: 1, 3 or 4 channels of 8 bits).
+fn encode_png(pixels: &[u8], width: u32, height: u32, channels: u8) -> anyhow::Result<Vec<u8>> {
+    let kind = match channels {
+        1 => image::ExtendedColorType::L8,
+        3 => image::ExtendedColorType::Rgb8,
+        _ => image::ExtendedColorType::Rgba8,
+    };
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
+        pixels,
+        width,
+        height,
+        kind,
+    )
+    .context("encoding PNG")?;
+    Ok(png)
+}
+
+/// `hairloom export --cards DIR`: hair cards of `document`'s bundles, baked from
+/// `strands_per_bundle` strands per bundle with `2^vertices_log2 + 1` vertices: one GLB per
+/// level of detail (`cards_lod0.glb` …, the albedo atlas embedded), the atlas's maps as PNG
+/// and `cards.json` describing them. Returns a one-line summary.
+pub fn write_cards(
+    document: &Document,
+    dir: &Path,
+    strands_per_bundle: u32,
+    vertices_log2: u32,
+) -> anyhow::Result<String> {
+    use hairloom_core::cards::{CardOptions, hair_cards};
+    use hairloom_core::io::cards_gltf::{CARD_MAPS, card_glb};
+    let strands = generate_strands(document, strands_per_bundle, vertices_log2, &mut |_| {
+        ControlFlow::Continue(())
+    })
+    .unwrap_or_default();
+    let options = CardOptions::default();
+    let cards = hair_cards(document, &strands, &options);
+    if cards.cards == 0 {
+        bail!("no cards to export: no bundle grows hair");
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let atlas = &cards.atlas;
+    let (w, h) = (atlas.width, atlas.height);
+    let write = |name: &str, bytes: &[u8]| -> anyhow::Result<()> {
+        let path = dir.join(name);
+        write_atomic(&path, bytes, |_| {}).with_context(|| format!("writing {}", path.display()))
+    };
+    let albedo = encode_png(&atlas.albedo, w, h, 4)?;
+    write("albedo.png", &albedo)?;
+    let maps: [(&str, &[u8], u8); 5] = [
+        ("coverage", &atlas.coverage, 1),
+        ("depth", &atlas.depth, 1),
+        ("flow", &atlas.flow, 3),
+        ("root_to_tip", &atlas.root_to_tip, 1),
+        ("id", &atlas.id, 1),
+    ];
+    debug_assert_eq!(maps.map(|m| m.0), CARD_MAPS);
+    let mut map_files = Vec::new();
+    for (name, pixels, channels) in maps {
+        let file = format!("{name}.png");
+        write(&file, &encode_png(pixels, w, h, channels)?)?;
+        map_files.push((name, file));
+    }
+    let mut levels = Vec::new();
+    for (level, mesh) in cards.levels.iter().enumerate() {
+        let file = format!("cards_lod{level}.glb");
+        write(
+            &file,
+            &card_glb(&format!("hair_cards_lod{level}"), mesh, &albedo, &map_files),
+        )?;
+        levels.push(serde_json::json!({
+            "file": file,
+            "triangles": mesh.triangles(),
+            "vertices": mesh.positions.len(),
+        }));
+    }
+    let manifest = serde_json::json!({
+        "generator": format!("hairloom {}", env!("CARGO_PKG_VERSION")),
+        "cards": cards.cards,
+        "levels": levels,
+        "atlas": {
+            "width": w, "height": h,
+            "albedo": "albedo.png",
+            "maps": map_files.iter().map(|(k, v)| (k.to_string(), serde_json::Value::from(v.clone()))).collect::<serde_json::Map<_, _>>(),
+            "depth_range_m": cards.depth_range_m,
+            "tile_px": options.tile_px,
+        },
+        "baked_from": {"strands": strands.len(), "points": cards.baked_points, "points_outside_cards": cards.points_outside},
+    });
+    write(
+        "cards.json",
+        &serde_json::to_vec_pretty(&manifest).context("writing the card manifest")?,
+    )?;
+    let triangles: Vec<String> = cards
+        .levels
+        .iter()
+        .map(|m| m.triangles().to_string())
+        .collect();
+    Ok(format!(
+        "{}: {} cards, levels of {} triangles, {w}×{h} atlas baked from {} strands",
+        dir.display(),
+        cards.cards,
+        triangles.join(" / "),
+        strands.len()
+    ))
 }

@@ -201,6 +201,11 @@ fn exports_of_every_sample_pass_third_party_validators() {
             .arg(sample)
             .arg("--runtime")
             .arg(&runtime);
+        // Hair cards of the first sample: GLBs for glTF-Validator, the atlas beside them.
+        let cards = (i == 0).then(|| dir.path().join(format!("{name}_cards")));
+        if let Some(cards) = &cards {
+            command.arg("--cards").arg(cards);
+        }
         for file in &files {
             command.arg("--strands").arg(file);
         }
@@ -226,6 +231,31 @@ fn exports_of_every_sample_pass_third_party_validators() {
         // The bundle's full detail is what --vertices-log2 asked for, like the strand files.
         assert_eq!(manifest["lod"]["max_vertices_log2"], 3, "{name}");
         glbs.push(body);
+        if let Some(cards) = &cards {
+            let manifest: serde_json::Value = serde_json::from_slice(
+                &std::fs::read(cards.join("cards.json")).expect("cards.json"),
+            )
+            .expect("cards.json is JSON");
+            let levels = manifest["levels"].as_array().expect("levels");
+            assert_eq!(levels.len(), 3, "{manifest}");
+            let triangles: Vec<u64> = levels
+                .iter()
+                .map(|l| l["triangles"].as_u64().expect("triangles"))
+                .collect();
+            assert!(triangles.windows(2).all(|w| w[1] < w[0]), "{triangles:?}");
+            assert_eq!(manifest["baked_from"]["points_outside_cards"], 0);
+            let (w, h) = (
+                manifest["atlas"]["width"].as_u64().expect("width") as u32,
+                manifest["atlas"]["height"].as_u64().expect("height") as u32,
+            );
+            for map in ["albedo", "coverage", "depth", "flow", "root_to_tip", "id"] {
+                let png = image::open(cards.join(format!("{map}.png"))).expect("a map");
+                assert_eq!((png.width(), png.height()), (w, h), "{map}");
+            }
+            for level in levels {
+                glbs.push(cards.join(level["file"].as_str().expect("file")));
+            }
+        }
         // Our own reading of the .hair header: counts match what was generated.
         let hair = std::fs::read(&files[0]).expect("hair file");
         assert_eq!(&hair[..4], b"HAIR");

@@ -2,6 +2,7 @@
 //! with its KTX2 textures, and strand files for other tools, Alembic grooms among them).
 
 pub mod alembic;
+pub mod cards_gltf;
 pub mod import;
 pub mod input_files;
 pub mod ktx2;

@@ -66,7 +66,8 @@ enum Command {
         #[arg(long)]
         max_vertices: Option<usize>,
     },
-    /// Export the runtime bundle (manifest + KTX2 textures) and/or strands for other tools.
+    /// Export the runtime bundle (manifest + KTX2 textures), strands for other tools and/or
+    /// hair cards.
     Export {
         project: PathBuf,
         /// Folder for the runtime bundle.
@@ -89,6 +90,11 @@ enum Command {
         /// generates them from the textures (quadratics, precision) to compare a loader with.
         #[arg(long, value_enum, default_value_t = files::StrandCurve::Exact)]
         curve: files::StrandCurve,
+        /// Folder for hair cards: one GLB per level of detail and the baked atlas (albedo,
+        /// coverage, depth, flow, root-to-tip, id) as PNG, from the strands of
+        /// --strands-per-bundle and --vertices-log2.
+        #[arg(long)]
+        cards: Option<PathBuf>,
     },
     /// Render a project, or an exported runtime bundle folder, headless to a PNG: strands
     /// generated on the GPU from the runtime textures, lit by the scene (its lights,
@@ -206,15 +212,28 @@ pub fn main() -> ExitCode {
             vertices_log2,
             precision,
             curve,
-        }) => files::run(
-            &project,
-            runtime.as_deref(),
-            &strands,
-            strands_per_bundle,
-            vertices_log2,
-            precision.into(),
-            curve,
-        ),
+            cards,
+        }) => (|| -> anyhow::Result<()> {
+            if runtime.is_some() || !strands.is_empty() || cards.is_none() {
+                files::run(
+                    &project,
+                    runtime.as_deref(),
+                    &strands,
+                    strands_per_bundle,
+                    vertices_log2,
+                    precision.into(),
+                    curve,
+                )?;
+            }
+            if let Some(dir) = cards {
+                let document = hairloom_core::io::project::load(&project)?.document;
+                println!(
+                    "{}",
+                    files::write_cards(&document, &dir, strands_per_bundle, vertices_log2)?
+                );
+            }
+            Ok(())
+        })(),
         Some(Command::Render {
             input,
             out,

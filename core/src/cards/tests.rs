@@ -1,0 +1,132 @@
+use super::*;
+use crate::model::mesh::test_meshes::grid;
+use crate::strands::reference::{StrandOptions, generate};
+
+fn grid_cards(options: &CardOptions) -> (Document, Vec<Strand>, HairCards) {
+    let mut document = Document::new("grid", grid(3, 2, 3, 0.5));
+    // Curls carry strands beyond their bundle: the cards must widen to hold them.
+    document.styling.global.curl.radius_m = 0.3;
+    document.styling.global.curl.turns_per_m = 1.0;
+    let strands = generate(
+        &document,
+        &StrandOptions {
+            strands_per_bundle: 24,
+            vertices_log2: 4,
+            ..StrandOptions::default()
+        },
+    );
+    let cards = hair_cards(&document, &strands, options);
+    (document, strands, cards)
+}
+
+#[test]
+fn every_bundle_becomes_a_card_with_its_strands_inside() {
+    let (document, strands, cards) = grid_cards(&CardOptions::default());
+    let bundles = document.hair_mesh.bundles.len();
+    assert_eq!(cards.cards, bundles);
+    assert_eq!(
+        cards.baked_points,
+        strands.iter().map(|s| s.points.len()).sum::<usize>()
+    );
+    assert_eq!(cards.points_outside, 0);
+    // Levels: 4, 2 and 1 segments per layer, two triangles each.
+    let layers: usize = document
+        .hair_mesh
+        .bundles
+        .iter()
+        .map(|b| b.layers as usize)
+        .sum();
+    let triangles: Vec<usize> = cards.levels.iter().map(CardMesh::triangles).collect();
+    assert_eq!(triangles, [8 * layers, 4 * layers, 2 * layers]);
+    for level in &cards.levels {
+        assert_eq!(level.positions.len(), level.uvs.len());
+        assert!(
+            level
+                .indices
+                .iter()
+                .all(|&i| (i as usize) < level.positions.len())
+        );
+        assert!(level.positions.iter().flatten().all(|c| c.is_finite()));
+        assert!(
+            level
+                .uvs
+                .iter()
+                .flatten()
+                .all(|&c| (0.0..=1.0).contains(&c))
+        );
+        assert!(
+            level
+                .normals
+                .iter()
+                .all(|n| (Vec3::from(*n).length() - 1.0).abs() < 1e-4)
+        );
+    }
+    // Every card's tile has strands in it, and nothing is drawn between tiles' edges that
+    // no card covers.
+    let atlas = &cards.atlas;
+    assert_eq!(
+        atlas.albedo.len(),
+        (atlas.width * atlas.height * 4) as usize
+    );
+    let [tw, th] = CardOptions::default().tile_px;
+    let columns = (atlas.width / tw) as usize;
+    for c in 0..cards.cards {
+        let (x0, y0) = ((c % columns) as u32 * tw, (c / columns) as u32 * th);
+        let covered = (y0..y0 + th)
+            .flat_map(|y| (x0..x0 + tw).map(move |x| (y * atlas.width + x) as usize))
+            .filter(|&i| atlas.coverage[i] > 0)
+            .count();
+        assert!(
+            covered > (tw * th / 8) as usize,
+            "card {c}: {covered} texels covered"
+        );
+    }
+    for c in cards.cards..columns * (atlas.height / th) as usize {
+        let (x0, y0) = ((c % columns) as u32 * tw, (c / columns) as u32 * th);
+        assert!(
+            (y0..y0 + th)
+                .flat_map(|y| (x0..x0 + tw).map(move |x| (y * atlas.width + x) as usize))
+                .all(|i| atlas.coverage[i] == 0),
+            "empty tile {c} has coverage"
+        );
+    }
+    // Albedo alpha is the coverage; root-to-tip grows down the tile.
+    assert!(
+        atlas
+            .coverage
+            .iter()
+            .zip(atlas.albedo.chunks_exact(4))
+            .all(|(&c, rgba)| rgba[3] == c)
+    );
+    let mean_row = |y: u32| -> f64 {
+        let row = (0..tw).map(|x| atlas.root_to_tip[(y * atlas.width + x) as usize] as f64);
+        row.sum::<f64>() / tw as f64
+    };
+    assert!(mean_row(th - 8) > mean_row(8) + 100.0);
+}
+
+#[test]
+fn a_collapsed_bundle_and_no_strands_still_give_finite_cards() {
+    let mut document = Document::new("grid", grid(2, 1, 2, 0.5));
+    // Collapse the first bundle's root face onto one point and its columns onto one line.
+    let corners = document.hair_mesh.bundles[0].vertices.clone();
+    let target = document.hair_mesh.columns[corners[0] as usize].clone();
+    for &c in &corners {
+        document.hair_mesh.columns[c as usize] = target.clone();
+    }
+    let cards = hair_cards(&document, &[], &CardOptions::default());
+    assert_eq!(cards.baked_points, 0);
+    assert!(cards.atlas.coverage.iter().all(|&c| c == 0));
+    for level in &cards.levels {
+        assert!(level.positions.iter().flatten().all(|c| c.is_finite()));
+        assert!(level.normals.iter().flatten().all(|c| c.is_finite()));
+    }
+    // Many more cards than one atlas row holds at the asked tile size: tiles shrink to fit.
+    let many = hair_cards(
+        &Document::new("grid", grid(80, 80, 1, 0.1)),
+        &[],
+        &CardOptions::default(),
+    );
+    assert_eq!(many.cards, 6400);
+    assert!(many.atlas.width <= MAX_ATLAS_PX && many.atlas.height <= MAX_ATLAS_PX);
+}
