@@ -271,8 +271,8 @@ pub fn run(
     Ok(())
 }
 
-/// A PNG of `pixels` (`kind`: 1, 3 or 4 channels of 8 bits).
-fn encode_png(pixels: &[u8], width: u32, height: u32, channels: u8) -> anyhow::Result<Vec<u8>> {
+/// A PNG of `pixels` (`channels`: 1, 3 or 4 of 8 bits each).
+pub fn encode_png(pixels: &[u8], width: u32, height: u32, channels: u8) -> anyhow::Result<Vec<u8>> {
     let kind = match channels {
         1 => image::ExtendedColorType::L8,
         3 => image::ExtendedColorType::Rgb8,

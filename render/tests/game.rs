@@ -8,7 +8,7 @@ use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::headless_for_test;
-use hairloom_render::game::{GameCamera, GameHair, game_scene};
+use hairloom_render::game::{GameCamera, GameFrameStats, GameHair, game_scene};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::Targets;
 use hairloom_render::renderer::preview_body::GpuBody;
@@ -42,6 +42,52 @@ fn mean_abs_difference(a: &[u8], b: &[u8]) -> f64 {
         .map(|(&x, &y)| (x as f64 - y as f64).abs())
         .sum::<f64>()
         / a.len() as f64
+}
+
+/// One frame through the game API into `view`, cleared to `background`, in a pass this
+/// test owns; returns what `prepare` planned and the pixels.
+fn draw(
+    context: &hairloom_render::device::GpuContext,
+    game: &mut GameHair,
+    view: &View,
+    camera: &GameCamera,
+    background: wgpu::Color,
+) -> (GameFrameStats, Vec<u8>) {
+    let mut encoder = context
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("game"),
+        });
+    let stats = game.prepare(&mut encoder, camera);
+    {
+        let (target, resolve) = view.attachments();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("game"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: resolve,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(background),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: view.depth(),
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        game.draw(&mut pass);
+    }
+    let pixels = View::read_back(context, view.color(), encoder).expect("read back");
+    (stats, pixels)
 }
 
 #[test]
@@ -91,57 +137,23 @@ fn game_runtime_draws_what_the_preview_draws() {
     .expect("the bundle loads");
     game.set_lod(lod);
     game.set_vertices_log2(VERTICES_LOG2);
-    let mut encoder = context
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("game"),
-        });
-    let stats = game.prepare(
-        &mut encoder,
-        &GameCamera {
-            view_projection: camera.view_projection(1.0),
-            eye: camera.eye,
-            fov_y_rad: camera.fov_y_rad,
-            viewport_height_px: SIZE,
-        },
-    );
+    let game_camera = GameCamera {
+        view_projection: camera.view_projection(1.0),
+        eye: camera.eye,
+        fov_y_rad: camera.fov_y_rad,
+        viewport_height_px: SIZE,
+    };
+    let [r, g, b] = scene.background;
+    let background = wgpu::Color {
+        r: r as f64,
+        g: g as f64,
+        b: b as f64,
+        a: 1.0,
+    };
+    let (stats, drawn) = draw(&context, &mut game, &view, &game_camera, background);
     assert_eq!(stats.strands, plan.strands);
     assert_eq!(stats.vertices, plan.vertices);
     assert_eq!(stats.strands_over_limit, 0);
-    {
-        let (target, resolve) = view.attachments();
-        let [r, g, b] = scene.background;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("game"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: resolve,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: r as f64,
-                        g: g as f64,
-                        b: b as f64,
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: view.depth(),
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        game.draw(&mut pass);
-    }
-    let drawn = View::read_back(&context, view.color(), encoder).expect("read back");
 
     let hair_pixels = expected
         .chunks_exact(4)
@@ -153,6 +165,7 @@ fn game_runtime_draws_what_the_preview_draws() {
         "the preview drew almost nothing ({hair_pixels} pixels differ from the corner)"
     );
     let difference = mean_abs_difference(&expected, &drawn);
+    eprintln!("game runtime vs preview: mean difference {difference:.4} per channel");
     assert!(
         difference < 0.5,
         "game runtime vs preview: mean difference {difference:.3} per channel"
@@ -160,47 +173,6 @@ fn game_runtime_draws_what_the_preview_draws() {
 
     // Without the body the picture loses it: the switch is real.
     game.set_draw_body(false);
-    let mut encoder = context
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("game"),
-        });
-    game.prepare(
-        &mut encoder,
-        &GameCamera {
-            view_projection: camera.view_projection(1.0),
-            eye: camera.eye,
-            fov_y_rad: camera.fov_y_rad,
-            viewport_height_px: SIZE,
-        },
-    );
-    {
-        let (target, resolve) = view.attachments();
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("game"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: resolve,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: view.depth(),
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        game.draw(&mut pass);
-    }
-    let hair_only = View::read_back(&context, view.color(), encoder).expect("read back");
+    let (_, hair_only) = draw(&context, &mut game, &view, &game_camera, background);
     assert!(mean_abs_difference(&hair_only, &drawn) > 1.0);
 }

@@ -221,6 +221,20 @@ fn usda_scalp(out: &mut String, scalp: &ScalpMesh, points: &str) {
     let _ = writeln!(out, "    uniform token subdivisionScheme = \"none\"\n}}");
 }
 
+/// The first of an animation's `frames`, once they and their rate are checked: an empty
+/// list and a rate that is not a positive number are refused (every animated export).
+pub fn first_frame<T>(frames: &[T], frames_per_second: f64) -> Result<&T, String> {
+    let Some(first) = frames.first() else {
+        return Err("an animation needs at least one frame".into());
+    };
+    if !(frames_per_second.is_finite() && frames_per_second > 0.0) {
+        return Err(format!(
+            "{frames_per_second} frames per second is not a rate"
+        ));
+    }
+    Ok(first)
+}
+
 /// One frame of an animated export: the strands and the scalp they grow from.
 pub struct UsdFrame {
     pub strands: Vec<Strand>,
@@ -237,14 +251,7 @@ pub fn usda_animation(
     frames_per_second: f64,
 ) -> Result<String, String> {
     use std::fmt::Write;
-    let Some(first) = frames.first() else {
-        return Err("an animation needs at least one frame".into());
-    };
-    if !(frames_per_second.is_finite() && frames_per_second > 0.0) {
-        return Err(format!(
-            "{frames_per_second} frames per second is not a rate"
-        ));
-    }
+    let first = first_frame(frames, frames_per_second)?;
     for (i, frame) in frames.iter().enumerate() {
         if frame.strands.len() != first.strands.len()
             || frame

@@ -242,15 +242,7 @@ pub fn render_pixels(
 
 /// RGBA8 pixels as a PNG file, written atomically.
 pub fn write_png(out: &Path, pixels: &[u8], width: u32, height: u32) -> anyhow::Result<()> {
-    let mut png = Vec::new();
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new(&mut png),
-        pixels,
-        width,
-        height,
-        image::ExtendedColorType::Rgba8,
-    )
-    .context("encoding PNG")?;
+    let png = hairloom_editor::files::encode_png(pixels, width, height, 4)?;
     if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)
             .with_context(|| format!("creating {}", parent.display()))?;

@@ -36,14 +36,7 @@ pub fn groom_file(groom: &Groom) -> Vec<u8> {
 /// samples at `frames_per_second`; everything else from the first frame. Every frame must
 /// have the curves of the first (counts); an empty list is refused.
 pub fn groom_animation(frames: &[Groom], frames_per_second: f64) -> Result<Vec<u8>, String> {
-    let Some(first) = frames.first() else {
-        return Err("an animation needs at least one frame".into());
-    };
-    if !(frames_per_second.is_finite() && frames_per_second > 0.0) {
-        return Err(format!(
-            "{frames_per_second} frames per second is not a rate"
-        ));
-    }
+    let first = crate::io::strand_files::first_frame(frames, frames_per_second)?;
     for (i, frame) in frames.iter().enumerate() {
         if frame.strands.vertex_counts != first.strands.vertex_counts
             || frame.guides.vertex_counts != first.guides.vertex_counts
