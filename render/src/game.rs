@@ -39,26 +39,29 @@
 //! # Ok(()) }
 //! ```
 //!
-//! What the game path draws: the bundle's shading model (Kajiya-Kay or Marschner) and dual
-//! scattering, under the bundle's lights or the game's ([`GameHair::set_lighting`]), and
-//! optionally the bundle's body. Effects that need passes of their own — shadow maps, body
-//! shadows, width-based transparency — are left to the game's renderer (it owns the pass
-//! structure); [`game_scene`] says exactly which scene the game path draws, and the editor's
-//! preview draws the same picture for it (tested).
+//! What the game path draws: everything the bundle's scene names (or the game's own lights:
+//! [`GameHair::set_lighting`]) — Kajiya-Kay or Marschner shading, dual scattering, and the
+//! shadow passes (opacity shadow maps or deep opacity maps, body shadows from the bundle's
+//! body), which `prepare` records into the game's encoder before its pass — except
+//! width-based transparency, which needs targets of its own in the game's pass. [`game_scene`]
+//! says exactly which scene the game path draws; the editor's preview draws the same picture
+//! for it (tested pixel for pixel).
 
 use glam::{Mat4, Vec3};
-use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere};
+use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere, shadow_views};
 use hairloom_core::model::scene::{Coverage, Scene, SelfShadowing};
 use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
 use hairloom_core::runtime::hair::RuntimeHair;
 use hairloom_core::runtime::strand_gen::Filtering;
 
 use crate::device::GpuContext;
-use crate::preview::default_strand_width_m;
+use crate::preview::{default_strand_width_m, effects_bind_group, frame_views};
 use crate::renderer::Targets;
-use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody, PreparedBody};
+use crate::renderer::body_shadow::BodyShadowRenderer;
+use crate::renderer::hair_shadow::HairShadowRenderer;
+use crate::renderer::preview_body::{BodyRenderer, GpuBody, PreparedBody};
 use crate::renderer::preview_hair::{HairRenderer, HairUniforms, PreparedHair};
-use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effect_entries};
+use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, effect_entries};
 use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer};
 use crate::resources::Tracked;
 
@@ -92,12 +95,11 @@ pub struct GameFrameStats {
     pub strands_over_limit: usize,
 }
 
-/// The scene the game path draws for `scene`: the same lights and material, the shading
-/// model and dual scattering, and none of the effects that need passes of their own.
+/// The scene the game path draws for `scene`: the same lights, material and effects, but
+/// multisampled coverage in place of width-based transparency (whose accumulation targets
+/// would have to live in the game's pass).
 pub fn game_scene(scene: &Scene) -> Scene {
     let mut scene = scene.clone();
-    scene.effects.self_shadowing = SelfShadowing::None;
-    scene.effects.body_shadows = false;
     scene.effects.coverage = Coverage::Msaa;
     scene
 }
@@ -112,6 +114,8 @@ pub struct GameHair {
     body_renderer: BodyRenderer,
     body: GpuBody,
     draw_body: bool,
+    hair_shadow: Option<HairShadowRenderer>,
+    body_shadow: Option<BodyShadowRenderer>,
     scene: Scene,
     active: ActiveEffects,
     effects_group: Option<wgpu::BindGroup>,
@@ -165,6 +169,8 @@ impl GameHair {
             body_renderer: BodyRenderer::with_targets(&context, targets),
             body: GpuBody::upload(&context, &hair.body),
             draw_body: true,
+            hair_shadow: None,
+            body_shadow: None,
             scene: game_scene(&hair.scene),
             active: ActiveEffects::none(),
             effects_group: None,
@@ -193,13 +199,14 @@ impl GameHair {
     /// left out (see [`game_scene`]).
     pub fn set_lighting(&mut self, scene: &Scene) -> Result<(), GameHairError> {
         let scene = game_scene(scene);
-        let active = ActiveEffects::new(&scene, false);
+        let active = ActiveEffects::new(&scene, !self.body.is_empty());
         crate::preview::check_effect_limits(&self.context.device.limits(), &active)
             .map_err(|e| GameHairError::EffectLimit(e.to_string()))?;
-        self.lighting.sync(&self.context, &active, &scene.material);
+        let context = &self.context;
+        self.lighting.sync(context, &active, &scene.material);
         let entries = effect_entries(&active);
         let effects_layout = (!entries.is_empty()).then(|| {
-            self.context
+            context
                 .device
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                     label: Some("game_effects"),
@@ -208,43 +215,45 @@ impl GameHair {
         });
         // Pipelines are made against the layouts, so new layouts mean new renderers.
         let targets = self.hair.targets();
-        self.hair = HairRenderer::with_targets(&self.context, targets);
-        self.body_renderer = BodyRenderer::with_targets(&self.context, targets);
-        self.hair.ensure(
-            &self.context,
-            &active,
-            &self.lighting.scene_layout,
-            effects_layout.as_ref(),
-        );
+        self.hair = HairRenderer::with_targets(context, targets);
+        self.body_renderer = BodyRenderer::with_targets(context, targets);
+        let scene_layout = &self.lighting.scene_layout;
+        self.hair
+            .ensure(context, &active, scene_layout, effects_layout.as_ref());
         self.body_renderer.ensure(
-            &self.context,
+            context,
             active.shader_key(),
-            &self.lighting.scene_layout,
+            scene_layout,
             effects_layout.as_ref(),
         );
+        let slots = active.shadow_slots;
+        self.hair_shadow = (active.opacity_maps != SelfShadowing::None && slots > 0).then(|| {
+            HairShadowRenderer::new(
+                context,
+                &self.hair,
+                scene_layout,
+                active.opacity_maps,
+                active.opacity_layers,
+                active.shadow_resolution,
+                slots,
+            )
+        });
+        self.body_shadow = (active.body_shadows && slots > 0).then(|| {
+            BodyShadowRenderer::new(
+                context,
+                &self.body_renderer,
+                active.shadow_resolution,
+                slots,
+            )
+        });
         self.effects_group = effects_layout.as_ref().map(|layout| {
-            let mut entries = Vec::new();
-            if let Some(ds) = &self.lighting.dual_scattering {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: binding::TABLE_SAMPLER,
-                    resource: wgpu::BindingResource::Sampler(&self.lighting.table_sampler),
-                });
-                entries.push(wgpu::BindGroupEntry {
-                    binding: binding::DS_PROFILE,
-                    resource: wgpu::BindingResource::TextureView(&ds.profile_view),
-                });
-                entries.push(wgpu::BindGroupEntry {
-                    binding: binding::DS_LOBES,
-                    resource: wgpu::BindingResource::TextureView(&ds.lobes_view),
-                });
-            }
-            self.context
-                .device
-                .create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("game_effects"),
-                    layout,
-                    entries: &entries,
-                })
+            effects_bind_group(
+                context,
+                layout,
+                self.hair_shadow.as_ref(),
+                self.body_shadow.as_ref(),
+                &self.lighting,
+            )
         });
         self.scene = scene;
         self.active = active;
@@ -349,38 +358,61 @@ impl GameHair {
                 None,
             );
         }
-        let (_, radius) = bounding_sphere(self.bounds.0, self.bounds.1);
+        let (centre, radius) = bounding_sphere(self.bounds.0, self.bounds.1);
+        let shadow_views = if self.active.shadow_slots > 0 {
+            shadow_views(&self.scene, centre, radius)
+        } else {
+            Vec::new()
+        };
         let mean_forward = self
             .lighting
             .sync(context, &self.active, &self.scene.material);
         let tables = self.lighting.dual_scattering.as_ref().map(|ds| &ds.tables);
         let uniforms = SceneUniforms::new(
             &self.scene,
-            &[],
+            &shadow_views,
             tables,
             mean_forward,
             radius,
             self.strand_width_m,
         );
         self.lighting.write(context, &uniforms);
-        let view_projection = camera.view_projection.to_cols_array_2d();
-        let eye = camera.eye.extend(1.0).to_array();
         let pixel_at_unit = 2.0 * (camera.fov_y_rad * 0.5).tan() / height_px as f32;
-        let views = [HairUniforms {
-            view_projection,
-            eye,
-            width: [self.strand_width_m, pixel_at_unit, 0.0, 0.0],
-            batch: [0; 4],
-        }];
-        let ranges = [[0, plan.batches.first().map_or(0, Vec::len) as u32]];
-        let hair = self.hair.prepare(context, &views, &ranges, &scratch, &runs);
-        let body = self.body_renderer.prepare(
-            context,
-            &[BodyUniforms {
-                view_projection,
-                camera_position: eye,
-            }],
+        let (hair_views, body_views) = frame_views(
+            HairUniforms {
+                view_projection: camera.view_projection.to_cols_array_2d(),
+                eye: camera.eye.extend(1.0).to_array(),
+                width: [self.strand_width_m, pixel_at_unit, 0.0, 0.0],
+                batch: [0; 4],
+            },
+            &shadow_views,
         );
+        let ranges = [[0, plan.batches.first().map_or(0, Vec::len) as u32]];
+        let hair = self
+            .hair
+            .prepare(context, &hair_views, &ranges, &scratch, &runs);
+        let body = self.body_renderer.prepare(context, &body_views);
+        // Shadow passes, per shadow-casting light, into the shadow maps (not the game's
+        // targets): the body's depth, the first hair's depth, then the opacity layers.
+        for slot in 0..shadow_views.len() {
+            if let Some(body_shadow) = &self.body_shadow {
+                body_shadow.encode(encoder, &body, &self.body, slot);
+            }
+            if let Some(hair_shadow) = &self.hair_shadow {
+                if hair_shadow.kind == SelfShadowing::DeepOpacityMaps {
+                    hair_shadow.encode_depth(encoder, &hair, slot, 0, segments, true);
+                }
+                hair_shadow.encode_opacity(
+                    encoder,
+                    &hair,
+                    &self.lighting.scene_group,
+                    slot,
+                    0,
+                    segments,
+                    true,
+                );
+            }
+        }
         self.frame = Some(PreparedFrame {
             hair,
             body,

@@ -17,6 +17,7 @@
 use std::sync::Mutex;
 
 use glam::{Mat4, Vec3};
+use hairloom_core::light::opacity_maps::ShadowView;
 use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere, shadow_views};
 use hairloom_core::model::scene::{Scene, SelfShadowing};
 use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
@@ -390,7 +391,15 @@ impl PreviewRenderer {
             .effects_layout
             .as_ref()
             .and_then(|(_, layout)| layout.as_ref())
-            .map(|layout| effects_bind_group(context, layout, state));
+            .map(|layout| {
+                effects_bind_group(
+                    context,
+                    layout,
+                    state.hair_shadow.as_ref(),
+                    state.body_shadow.as_ref(),
+                    &state.lighting,
+                )
+            });
         let generator = match &scene.hair {
             HairSource::Generated {
                 generator,
@@ -459,37 +468,20 @@ impl PreviewRenderer {
         // The hair's views: the camera, then each shadow-casting light (ribbons at least a
         // texel wide there, and a pixel wide for the camera with width-based coverage).
         let pixel_at_unit = 2.0 * (scene.camera.fov_y_rad * 0.5).tan() / view.height as f32;
-        let mut hair_views = vec![HairUniforms {
-            view_projection,
-            eye: camera_position,
-            width: [
-                scene.strand_width_m,
-                pixel_at_unit,
-                if active.width_oit { 1.0 } else { 0.0 },
-                0.0,
-            ],
-            batch: [0; 4],
-        }];
-        let mut body_views = vec![BodyUniforms {
-            view_projection,
-            camera_position,
-        }];
-        for (slot, light_view) in shadow_views.iter().enumerate() {
-            let view_projection = light_view.view_projection.to_cols_array_2d();
-            hair_views.push(HairUniforms {
+        let (hair_views, body_views) = frame_views(
+            HairUniforms {
                 view_projection,
-                eye: light_view
-                    .eye
-                    .extend(if light_view.perspective { 1.0 } else { 0.0 })
-                    .to_array(),
-                width: [scene.strand_width_m, light_view.texel_size, 1.0, 0.0],
-                batch: [0, 0, slot as u32, 0],
-            });
-            body_views.push(BodyUniforms {
-                view_projection,
-                camera_position: light_view.eye.extend(1.0).to_array(),
-            });
-        }
+                eye: camera_position,
+                width: [
+                    scene.strand_width_m,
+                    pixel_at_unit,
+                    if active.width_oit { 1.0 } else { 0.0 },
+                    0.0,
+                ],
+                batch: [0; 4],
+            },
+            &shadow_views,
+        );
         let prepared_hair = state
             .hair
             .prepare(context, &hair_views, &ranges, strands, &runs);
@@ -707,34 +699,69 @@ impl PreviewRenderer {
     }
 }
 
-/// The group-2 bind group of the lit shaders from the effect renderers that exist.
-fn effects_bind_group(
+/// The views a frame draws the hair and the body from: `camera`, then each shadow-casting
+/// light of `shadow_views` (ribbons at least a shadow texel wide there), in the order the
+/// renderers index them (view `slot + 1` is light `slot`).
+pub(crate) fn frame_views(
+    camera: HairUniforms,
+    shadow_views: &[ShadowView],
+) -> (Vec<HairUniforms>, Vec<BodyUniforms>) {
+    let strand_width_m = camera.width[0];
+    let mut hair_views = vec![camera];
+    let mut body_views = vec![BodyUniforms {
+        view_projection: camera.view_projection,
+        camera_position: camera.eye,
+    }];
+    for (slot, light_view) in shadow_views.iter().enumerate() {
+        let view_projection = light_view.view_projection.to_cols_array_2d();
+        hair_views.push(HairUniforms {
+            view_projection,
+            eye: light_view
+                .eye
+                .extend(if light_view.perspective { 1.0 } else { 0.0 })
+                .to_array(),
+            width: [strand_width_m, light_view.texel_size, 1.0, 0.0],
+            batch: [0, 0, slot as u32, 0],
+        });
+        body_views.push(BodyUniforms {
+            view_projection,
+            camera_position: light_view.eye.extend(1.0).to_array(),
+        });
+    }
+    (hair_views, body_views)
+}
+
+/// The group-2 bind group of the lit shaders from the effect renderers that exist (the
+/// preview's frame and the game runtime's).
+pub(crate) fn effects_bind_group(
     context: &GpuContext,
     layout: &wgpu::BindGroupLayout,
-    state: &FrameState,
+    hair_shadow: Option<&HairShadowRenderer>,
+    body_shadow: Option<&BodyShadowRenderer>,
+    lighting: &SceneLighting,
 ) -> wgpu::BindGroup {
     let mut entries = Vec::new();
     let view = |binding, view| wgpu::BindGroupEntry {
         binding,
         resource: wgpu::BindingResource::TextureView(view),
     };
-    if let Some(hair_shadow) = &state.hair_shadow {
+    if let Some(hair_shadow) = hair_shadow {
         entries.push(view(binding::OPACITY_LAYERS, &hair_shadow.opacity_view));
         if let Some(first_hair) = hair_shadow.first_hair_view() {
             entries.push(view(binding::FIRST_HAIR_DEPTH, first_hair));
         }
     }
-    if let Some(body_shadow) = &state.body_shadow {
+    if let Some(body_shadow) = body_shadow {
         entries.push(view(binding::BODY_DEPTH, &body_shadow.array_view));
         entries.push(wgpu::BindGroupEntry {
             binding: binding::BODY_DEPTH_SAMPLER,
-            resource: wgpu::BindingResource::Sampler(&state.lighting.depth_sampler),
+            resource: wgpu::BindingResource::Sampler(&lighting.depth_sampler),
         });
     }
-    if let Some(ds) = &state.lighting.dual_scattering {
+    if let Some(ds) = &lighting.dual_scattering {
         entries.push(wgpu::BindGroupEntry {
             binding: binding::TABLE_SAMPLER,
-            resource: wgpu::BindingResource::Sampler(&state.lighting.table_sampler),
+            resource: wgpu::BindingResource::Sampler(&lighting.table_sampler),
         });
         entries.push(view(binding::DS_PROFILE, &ds.profile_view));
         entries.push(view(binding::DS_LOBES, &ds.lobes_view));

@@ -3,7 +3,7 @@
 //! matches the editor's preview of the same bundle and scene.
 
 use glam::Vec3;
-use hairloom_core::model::scene::Shading;
+use hairloom_core::model::scene::{SelfShadowing, Shading};
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
@@ -97,6 +97,9 @@ fn game_runtime_draws_what_the_preview_draws() {
     };
     let hair = bundle();
     let scene = game_scene(&hair.scene);
+    // The sample's scene casts shadows: the game path records those passes too.
+    assert_eq!(scene.effects.self_shadowing, SelfShadowing::DeepOpacityMaps);
+    assert!(scene.effects.body_shadows);
     let (lo, hi) = hair.textures.hair_bounds().expect("hair");
     let camera = Camera::framing(lo, hi, Vec3::new(0.75, 0.25, 1.0));
     let lod = LodSettings::default();
