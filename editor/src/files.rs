@@ -186,7 +186,8 @@ pub fn write_strand_file(
         Some("usda") => {
             usda_file(strands, &ScalpMesh::of(&document.hair_mesh), STRAND_WIDTH_M).into_bytes()
         }
-        Some("abc") => groom_file(&Groom::new(document, strands, STRAND_WIDTH_M)),
+        Some("abc") => groom_file(&Groom::new(document, strands, STRAND_WIDTH_M))
+            .map_err(anyhow::Error::msg)?,
         _ => glb_lines(strands),
     };
     write_atomic(file, &bytes, |_| {}).with_context(|| format!("writing {}", file.display()))?;
@@ -216,13 +217,7 @@ pub fn run(
             "nothing to export: give --runtime DIR, --strands FILE.{{hair,usda,glb,abc}} and/or --cards DIR"
         );
     }
-    let cap = hairloom_core::io::runtime_bundle::limits::MAX_VERTICES_LOG2;
-    if vertices_log2 > cap {
-        bail!(
-            "--vertices-log2 {vertices_log2} is more than {cap} ({} vertices per strand)",
-            (1u32 << cap) + 1
-        );
-    }
+    check_vertices_log2(vertices_log2)?;
     for file in strand_files {
         check_strand_file(file)?;
     }
@@ -271,6 +266,19 @@ pub fn run(
     Ok(())
 }
 
+/// Refuses strands of more than `2^MAX_VERTICES_LOG2 + 1` vertices (the runtime bundle's
+/// cap, which every export shares), naming the flag.
+fn check_vertices_log2(vertices_log2: u32) -> anyhow::Result<()> {
+    let cap = hairloom_core::io::runtime_bundle::limits::MAX_VERTICES_LOG2;
+    if vertices_log2 > cap {
+        bail!(
+            "--vertices-log2 {vertices_log2} is more than {cap} ({} vertices per strand)",
+            (1u32 << cap) + 1
+        );
+    }
+    Ok(())
+}
+
 /// A PNG of `pixels` (`channels`: 1, 3 or 4 of 8 bits each).
 pub fn encode_png(pixels: &[u8], width: u32, height: u32, channels: u8) -> anyhow::Result<Vec<u8>> {
     let kind = match channels {
@@ -302,6 +310,7 @@ pub fn write_cards(
 ) -> anyhow::Result<String> {
     use hairloom_core::cards::{CardOptions, hair_cards};
     use hairloom_core::io::cards_gltf::{CARD_MAPS, card_glb};
+    check_vertices_log2(vertices_log2)?;
     let strands = generate_strands(document, strands_per_bundle, vertices_log2, &mut |_| {
         ControlFlow::Continue(())
     })
@@ -358,7 +367,7 @@ pub fn write_cards(
             "depth_range_m": cards.depth_range_m,
             "tile_px": options.tile_px,
         },
-        "baked_from": {"strands": strands.len(), "points": cards.baked_points, "points_outside_cards": cards.points_outside},
+        "baked_from": {"strands": strands.len(), "points": cards.baked_points},
     });
     write(
         "cards.json",

@@ -243,7 +243,6 @@ fn exports_of_every_sample_pass_third_party_validators() {
                 .map(|l| l["triangles"].as_u64().expect("triangles"))
                 .collect();
             assert!(triangles.windows(2).all(|w| w[1] < w[0]), "{triangles:?}");
-            assert_eq!(manifest["baked_from"]["points_outside_cards"], 0);
             let (w, h) = (
                 manifest["atlas"]["width"].as_u64().expect("width") as u32,
                 manifest["atlas"]["height"].as_u64().expect("height") as u32,
@@ -488,4 +487,22 @@ fn export_curve_runtime_writes_the_strands_the_runtime_draws() {
         roots
     };
     assert_eq!(roots(&exact), roots(&runtime));
+}
+
+/// `--cards` alone still honours the strand caps: an oversized `--vertices-log2` is refused
+/// by name before anything is generated or written.
+#[test]
+fn export_cards_refuses_oversized_strands_by_name() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sample = samples().into_iter().next().expect("a sample");
+    let cards = dir.path().join("cards");
+    let (code, _, stderr) = run(hairloom()
+        .arg("export")
+        .arg(&sample)
+        .arg("--cards")
+        .arg(&cards)
+        .args(["--vertices-log2", "16"]));
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("--vertices-log2 16"), "{stderr}");
+    assert!(!cards.exists());
 }

@@ -89,9 +89,10 @@ pub struct GameFrameStats {
     pub vertices: usize,
     /// Bundles outside the view, skipped.
     pub culled_bundles: usize,
-    /// Strands planned but not drawn: more vertices than one storage binding of the
-    /// game's device holds (raise its `max_storage_buffer_binding_size`, or let LOD
-    /// drop strands).
+    /// Strands planned but not drawn: more vertices than one generation dispatch of the
+    /// game's device holds (its `max_storage_buffer_binding_size` / 16 B and
+    /// `max_compute_workgroups_per_dimension` × 64; let LOD drop strands, or raise the
+    /// binding limit when the device was created).
     pub strands_over_limit: usize,
 }
 
@@ -143,8 +144,8 @@ pub enum GameHairError {
     Generation(#[from] StrandGenError),
     #[error("the bundle grows no hair")]
     NoHair,
-    #[error("{0}")]
-    EffectLimit(String),
+    #[error(transparent)]
+    EffectLimit(#[from] crate::preview::PreviewError),
 }
 
 impl GameHair {
@@ -201,7 +202,7 @@ impl GameHair {
         let scene = game_scene(scene);
         let active = ActiveEffects::new(&scene, !self.body.is_empty());
         crate::preview::check_effect_limits(&self.context.device.limits(), &active)
-            .map_err(|e| GameHairError::EffectLimit(e.to_string()))?;
+            .map_err(GameHairError::EffectLimit)?;
         let context = &self.context;
         self.lighting.sync(context, &active, &scene.material);
         let entries = effect_entries(&active);
@@ -294,7 +295,11 @@ impl GameHair {
     }
 
     /// Plans the frame for `camera` (culling, strand and vertex LOD), writes its uniforms
-    /// and records the strands' generation into `encoder`, before the game's render pass.
+    /// and records the strands' generation and the shadow passes into `encoder`, before the
+    /// game's render pass. Once per frame: a second call before the encoder is submitted
+    /// overwrites the first camera's uniforms. The frame's transient buffers (runs and
+    /// scratch) are made here each frame. The depth test is "nearer is smaller"
+    /// (`Less`); reversed-Z depth buffers are not supported yet.
     pub fn prepare(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -309,9 +314,11 @@ impl GameHair {
             resolution_px: height_px as f32,
         };
         // One batch, so generation runs once before the pass: as many vertices as one
-        // storage binding holds.
-        let binding_vertices =
-            (context.device.limits().max_storage_buffer_binding_size / 16).max(1) as usize;
+        // storage binding holds (16 B each) and one row of 64-wide workgroups reaches.
+        let limits = context.device.limits();
+        let binding_vertices = (limits.max_storage_buffer_binding_size / 16)
+            .min(limits.max_compute_workgroups_per_dimension as u64 * 64)
+            .max(2) as usize;
         let mut plan = plan_frame(
             &self.gpu.bundles,
             self.gpu.per_bundle,

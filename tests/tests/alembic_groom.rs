@@ -182,7 +182,8 @@ fn groom_reads_back_with_every_attribute() {
         },
     );
     let groom = Groom::new(&document, &strands, WIDTH_M);
-    let (hair, guides, archive_metadata) = read_file(groom_file(&groom));
+    let (hair, guides, archive_metadata) =
+        read_file(groom_file(&groom).expect("a consistent groom"));
     assert!(
         archive_metadata.contains("_ai_Application=Hairloom"),
         "{archive_metadata}"
@@ -312,14 +313,43 @@ fn groom_reads_back_with_every_attribute() {
             "strand {i}: guides blend to {blended}, root {root}, face edge {edge}"
         );
     }
-    // Guides follow their columns: the first point is the column root, and there are
-    // GUIDE_POINTS_PER_LAYER points per layer.
-    assert!(
-        guides
-            .counts
+    // One guide per (group, column) of the bundles that grow hair: counted from the
+    // document, per group.
+    for group in [0, 1] {
+        let mut columns: Vec<u32> = document
+            .hair_mesh
+            .bundles
             .iter()
-            .all(|&c| (c - 1) % GUIDE_POINTS_PER_LAYER as i32 == 0)
-    );
+            .enumerate()
+            .filter(|(b, bundle)| {
+                !bundle.removed && bundle.layers > 0 && i32::from(*b < 40) == group
+            })
+            .flat_map(|(_, bundle)| bundle.vertices.iter().copied())
+            .collect();
+        columns.sort_unstable();
+        columns.dedup();
+        let guides_in_group = guide_groups.iter().filter(|&&g| g == group).count();
+        assert_eq!(guides_in_group, columns.len(), "group {group}");
+    }
+    // Each guide is its column's curve, GUIDE_POINTS_PER_LAYER points per layer, from the
+    // column's root.
+    let roots: Vec<[f32; 3]> = document
+        .hair_mesh
+        .columns
+        .iter()
+        .map(|c| to_file_axes(c.positions[0].as_vec3().to_array()))
+        .collect();
+    for (g, &start) in guide_start[..guides.counts.len()].iter().enumerate() {
+        assert!(
+            roots.contains(&guides.points[start]),
+            "guide {g} does not start at a column root"
+        );
+        assert_eq!((guides.counts[g] - 1) % GUIDE_POINTS_PER_LAYER as i32, 0);
+    }
+    // A groom whose arrays disagree is refused by name, not written.
+    let mut broken = groom.clone();
+    broken.strands.root_uv.pop();
+    assert!(groom_file(&broken).is_err_and(|e| e.contains("root_uv")));
 }
 
 /// An animated groom stores the first frame where `ogawa-rs` reads it (it reads only the

@@ -43,7 +43,9 @@ for path in sys.argv[1:]:
         face_counts = scalp.GetFaceVertexCountsAttr().Get()
         face_indices = scalp.GetFaceVertexIndicesAttr().Get()
         scalp_points = scalp.GetPointsAttr().Get(times[0] if times else Usd.TimeCode.Default())
-        scalp_st = UsdGeom.PrimvarsAPI(scalp.GetPrim()).GetPrimvar("st").Get()
+        scalp_st = UsdGeom.PrimvarsAPI(scalp.GetPrim()).GetPrimvar("st").Get() or []
+        if not scalp_st:
+            scalp_st = [(0.0, 0.0)]
         lo = [min(uv[k] for uv in scalp_st) - 1e-5 for k in range(2)]
         hi = [max(uv[k] for uv in scalp_st) + 1e-5 for k in range(2)]
         scalp_ok = (

@@ -35,8 +35,10 @@ pub struct CardOptions {
     /// Levels of detail (1 to 4).
     pub levels: u32,
     /// Texels of one card's tile, across × along. Halved (across first) when the cards would
-    /// not fit [`MAX_ATLAS_PX`].
+    /// not fit `max_atlas_px`.
     pub tile_px: [u32; 2],
+    /// Largest atlas side (at most [`MAX_ATLAS_PX`]).
+    pub max_atlas_px: u32,
     /// Opacity one strand gives a texel it crosses.
     pub strand_alpha: f32,
 }
@@ -47,12 +49,13 @@ impl Default for CardOptions {
             segments_per_layer: 4,
             levels: 3,
             tile_px: [32, 128],
+            max_atlas_px: MAX_ATLAS_PX,
             strand_alpha: 0.35,
         }
     }
 }
 
-/// Largest atlas side.
+/// Largest atlas side we make (what every engine loads).
 pub const MAX_ATLAS_PX: u32 = 4096;
 
 /// One level of detail: every card as triangles.
@@ -97,10 +100,8 @@ pub struct HairCards {
     pub depth_range_m: f32,
     /// Cards made (bundles that grow hair).
     pub cards: usize,
-    /// Strand points baked, and how many fell outside their card's tile (0 by construction;
-    /// reported so tests and users can check).
+    /// Strand points baked.
     pub baked_points: usize,
-    pub points_outside: usize,
 }
 
 /// A card's frame along its centre curve.
@@ -117,8 +118,8 @@ struct Card {
     layers: f64,
     /// Frames at `t = k / FRAME_STEPS_PER_LAYER`.
     frames: Vec<CardFrame>,
-    /// Half-width at each frame, metres.
-    half_width: Vec<f64>,
+    /// Half-width at each frame.
+    half_width_m: Vec<f64>,
 }
 
 const FRAME_STEPS_PER_LAYER: usize = 8;
@@ -155,7 +156,7 @@ impl Card {
         let steps = b.layers as usize * FRAME_STEPS_PER_LAYER;
         let dt = 1.0 / FRAME_STEPS_PER_LAYER as f64;
         let mut frames = Vec::with_capacity(steps + 1);
-        let mut half_width = Vec::with_capacity(steps + 1);
+        let mut half_width_m = Vec::with_capacity(steps + 1);
         let mut last_across = DVec3::X;
         for k in 0..=steps {
             let t = k as f64 * dt;
@@ -173,13 +174,13 @@ impl Card {
                 across,
                 normal: across.cross(along).normalize_or(DVec3::Z),
             });
-            half_width.push(0.5 * span.length());
+            half_width_m.push(0.5 * span.length());
         }
         Some(Self {
             bundle,
             layers: b.layers as f64,
             frames,
-            half_width,
+            half_width_m,
         })
     }
 
@@ -239,7 +240,7 @@ pub fn hair_cards(document: &Document, strands: &[Strand], options: &CardOptions
             });
         }
         for point in &points {
-            let w = &mut card.half_width[point.frame];
+            let w = &mut card.half_width_m[point.frame];
             *w = w.max(point.across_m.abs() * 1.02);
         }
         placed.push((c, index, points));
@@ -247,9 +248,9 @@ pub fn hair_cards(document: &Document, strands: &[Strand], options: &CardOptions
     // A smooth outline: each frame's half-width is at least its neighbours' within half a
     // layer, so one stray strand makes a bulge, not a spike.
     for card in &mut cards {
-        let raw = card.half_width.clone();
+        let raw = card.half_width_m.clone();
         let reach = FRAME_STEPS_PER_LAYER / 2;
-        for (k, w) in card.half_width.iter_mut().enumerate() {
+        for (k, w) in card.half_width_m.iter_mut().enumerate() {
             let lo = k.saturating_sub(reach);
             let hi = (k + reach).min(raw.len() - 1);
             *w = raw[lo..=hi].iter().copied().fold(1e-5, f64::max);
@@ -257,11 +258,12 @@ pub fn hair_cards(document: &Document, strands: &[Strand], options: &CardOptions
     }
 
     // The atlas: one tile per card, shrunk until the cards fit.
-    let mut tile = options.tile_px.map(|v| v.max(2));
+    let max_px = options.max_atlas_px.clamp(16, MAX_ATLAS_PX);
+    let mut tile = options.tile_px.map(|v| v.clamp(2, max_px));
     let (columns, rows) = loop {
-        let columns = (MAX_ATLAS_PX / tile[0]).max(1) as usize;
+        let columns = (max_px / tile[0]).max(1) as usize;
         let rows = cards.len().div_ceil(columns).max(1);
-        if rows as u32 * tile[1] <= MAX_ATLAS_PX || tile[1] <= 4 {
+        if rows as u32 * tile[1] <= max_px || tile[1] <= 2 {
             break (columns.min(cards.len().max(1)), rows);
         }
         if tile[0] >= tile[1] / 4 && tile[0] > 2 {
@@ -297,30 +299,19 @@ pub fn hair_cards(document: &Document, strands: &[Strand], options: &CardOptions
         options.strand_alpha,
     );
     let baked_points = placed.iter().map(|(_, _, p)| p.len()).sum();
-    let points_outside = placed
-        .iter()
-        .map(|(c, _, points)| {
-            let card = &cards[*c];
-            points
-                .iter()
-                .filter(|p| p.across_m.abs() > card.half_width[p.frame] + 1e-9)
-                .count()
-        })
-        .sum();
     HairCards {
         levels,
         atlas,
         depth_range_m: depth_range_m as f32,
         cards: cards.len(),
         baked_points,
-        points_outside,
     }
 }
 
 /// Texel position of a card point: x across the tile, y from root (0) to tip.
 fn texel(card: &Card, point: &CardPoint, tile: [u32; 2]) -> (f64, f64) {
     // The same mapping as the mesh's uvs: texel centres 0.5 … size − 0.5.
-    let u = 0.5 + 0.5 * point.across_m / card.half_width[point.frame];
+    let u = 0.5 + 0.5 * point.across_m / card.half_width_m[point.frame];
     (
         0.5 + u * (tile[0] as f64 - 1.0),
         0.5 + point.along * (tile[1] as f64 - 1.0),
@@ -342,14 +333,15 @@ fn card_mesh(
         for j in 0..=segments {
             let t = j as f64 / per_layer as f64;
             let (k, frame) = card.frame(t);
-            let h = card.half_width[k];
+            let h = card.half_width_m[k];
             for side in [-1.0, 1.0] {
                 let p = frame.centre + frame.across * (side * h);
                 mesh.positions.push(p.as_vec3().to_array());
                 mesh.normals.push(frame.normal.as_vec3().to_array());
                 let a: Vec3 = frame.across.as_vec3();
                 mesh.tangents.push([a.x, a.y, a.z, 1.0]);
-                // Texel centres at the tile's edges, so filtering never reads a neighbour.
+                // Texel centres at the tile's edges, so filtering at full resolution never reads a
+                // neighbour (see the sampler in `io::cards_gltf`).
                 let u = if side < 0.0 {
                     0.5
                 } else {

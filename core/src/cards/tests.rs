@@ -28,7 +28,6 @@ fn every_bundle_becomes_a_card_with_its_strands_inside() {
         cards.baked_points,
         strands.iter().map(|s| s.points.len()).sum::<usize>()
     );
-    assert_eq!(cards.points_outside, 0);
     // Levels: 4, 2 and 1 segments per layer, two triangles each.
     let layers: usize = document
         .hair_mesh
@@ -122,11 +121,13 @@ fn a_collapsed_bundle_and_no_strands_still_give_finite_cards() {
         assert!(level.normals.iter().flatten().all(|c| c.is_finite()));
     }
     // Many more cards than one atlas row holds at the asked tile size: tiles shrink to fit.
-    let many = hair_cards(
-        &Document::new("grid", grid(80, 80, 1, 0.1)),
-        &[],
-        &CardOptions::default(),
-    );
-    assert_eq!(many.cards, 6400);
-    assert!(many.atlas.width <= MAX_ATLAS_PX && many.atlas.height <= MAX_ATLAS_PX);
+    let small = CardOptions {
+        max_atlas_px: 256,
+        ..CardOptions::default()
+    };
+    let many = hair_cards(&Document::new("grid", grid(40, 40, 1, 0.1)), &[], &small);
+    assert_eq!(many.cards, 1600);
+    assert!(many.atlas.width <= 256 && many.atlas.height <= 256);
+    let [tw, th] = [many.atlas.width, many.atlas.height];
+    assert!(tw * th >= 1600 * 2 * 2, "{tw}×{th} cannot hold 1,600 tiles");
 }

@@ -99,7 +99,9 @@ pub fn card_glb(
             "extras": {"hairloom_maps": extras}
         }],
         "textures": [{"source": 0, "sampler": 0}],
-        "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 33071, "wrapT": 33071}],
+        // Linear without mipmaps: tiles meet edge to edge, so coarser mip levels would blend
+        // neighbouring cards (an engine that builds mipmaps should stop at the tile size).
+        "samplers": [{"magFilter": 9729, "minFilter": 9729, "wrapS": 33071, "wrapT": 33071}],
         "images": [{"bufferView": image, "mimeType": "image/png"}],
         "accessors": [
             {"bufferView": positions, "componentType": 5126, "count": count, "type": "VEC3", "min": lo, "max": hi},

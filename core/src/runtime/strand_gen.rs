@@ -11,7 +11,9 @@ use crate::model::styling::StylingParams;
 use crate::runtime::gpu_types::{StrandRoot, StrandRun};
 use crate::runtime::hair::strand_root;
 use crate::runtime::textures::{RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
-use crate::strands::styling::{StylingInput, strand_length_fraction, styling_offset, twist};
+use crate::strands::styling::{
+    StrandStyling, StylingInput, strand_length_fraction, styling_offset_of, twist,
+};
 
 /// The per-strand values `strand_gen.wgsl` computes once before a strand's vertices.
 #[derive(Clone, Copy, Debug)]
@@ -21,6 +23,8 @@ pub struct StrandInput<'p> {
     pub root_uv: glam::DVec2,
     /// Fraction of the bundle's length this strand keeps (length variation).
     pub length_fraction: f64,
+    /// The styling ops' per-strand values (random phases and keys, clump pull).
+    pub styling: StrandStyling,
 }
 
 /// Texture filtering as the texture-path mirror performs it.
@@ -116,8 +120,10 @@ impl StrandGen<'_> {
         self.styled_strand(&root, vertex_count, params)
     }
 
-    /// What `strand_gen.wgsl` computes once per strand before its vertices (its
-    /// `StrandInput`): the root uv and the length fraction. The root uv seeds every
+    /// What a strand's vertices share, computed once: the root uv, the length fraction and
+    /// the styling ops' random values and clump pull (`strand_gen.wgsl` recomputes them per
+    /// vertex: splitting them into a per-strand pass measured no faster on lavapipe, where
+    /// the textures' fetches dominate). The root uv seeds every
     /// per-strand random value, so it is always filtered exactly (manual bilinear in the
     /// shader), even in hardware mode: 8-bit weights must not shift a strand's curl phase or
     /// clump.
@@ -136,6 +142,7 @@ impl StrandGen<'_> {
             params,
             root_uv,
             length_fraction: strand_length_fraction(params, root_uv),
+            styling: StrandStyling::new(params, root_uv),
         }
     }
 
@@ -183,7 +190,7 @@ impl StrandGen<'_> {
             w,
             along,
         };
-        (p + styling_offset(params, &styling)).as_vec3()
+        (p + styling_offset_of(params, &input.styling, &styling)).as_vec3()
     }
 
     /// The styled strand of `root` at `vertex_count` vertices (at least 2).

@@ -6,7 +6,7 @@
 //! units), `τ_max = layers · length_fraction`. At each vertex after the root:
 //! 1. the unstyled point comes from [`ReferenceStrand`];
 //! 2. twist rotates it about the bundle's centre strand (same `τ`) around ŵ;
-//! 3. the styling offset ([`styling_offset`]) is added, in the frame blended from the
+//! 3. the styling offset ([`styling_offset`](crate::strands::styling::styling_offset)) is added, in the frame blended from the
 //!    per-vertex frames of the bundle's corners (bilinear across the face, linear between
 //!    layers — what sampling the u- and v-textures computes) and with w blended likewise.
 
@@ -17,7 +17,9 @@ use crate::geometry::frames::{Frame, fallback_frame, layer_frames};
 use crate::model::document::Document;
 use crate::model::styling::StylingParams;
 use crate::strands::roots::{SampleDomain, progressive_samples};
-use crate::strands::styling::{StylingInput, strand_length_fraction, styling_offset, twist};
+use crate::strands::styling::{
+    StrandStyling, StylingInput, strand_length_fraction, styling_offset_of, twist,
+};
 
 /// What to generate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -126,6 +128,8 @@ impl<'a> StrandContext<'a> {
             .then(|| ReferenceStrand::new(mesh, bundle, centre_coord))
             .flatten();
         let tau_max = b.layers as f64 * strand_length_fraction(params, reference.root_uv);
+        // What styling needs of this strand at every vertex, computed once.
+        let strand_styling = StrandStyling::new(params, reference.root_uv);
         let vertex_count = vertex_count.max(2);
         let points = (0..vertex_count)
             .map(|k| {
@@ -148,7 +152,7 @@ impl<'a> StrandContext<'a> {
                     w,
                     along,
                 };
-                p + styling_offset(params, &input)
+                p + styling_offset_of(params, &strand_styling, &input)
             })
             .collect();
         Some(Strand {

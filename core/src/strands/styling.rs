@@ -97,32 +97,86 @@ pub struct StylingInput {
     pub along: f64,
 }
 
+/// What the styling ops need of a strand that is the same at every one of its vertices: its
+/// random values (phases, keys, radius jitter, whether it frizzes) and its clump pull. The
+/// CPU generators compute this once per strand, not once per vertex; the values are the same
+/// expressions [`styling_offset`] evaluates, so the split changes no result. Ops that are
+/// off leave their fields zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StrandStyling {
+    /// `2π ξ₁`: the curl's phase at w = 0.
+    pub curl_phase_rad: f64,
+    /// The curl radius with this strand's jitter, metres.
+    pub curl_radius_m: f64,
+    /// Where this strand reads the two noise curves (`NOISE_KEY_SPAN · ξ₃`, `· ξ₄`).
+    pub noise_key_u: f64,
+    pub noise_key_v: f64,
+    /// The clump pull at the strand's root (clump-cell units).
+    pub clump_pull: DVec2,
+    /// Whether the strand frizzes (`ξ₆ < fraction`), and where it reads the frizz noise.
+    pub frizz: bool,
+    pub frizz_key: f64,
+    /// `phase_spread · 2π · ξ₈`: the wave's phase offset.
+    pub wave_phase_rad: f64,
+}
+
+impl StrandStyling {
+    pub fn new(params: &StylingParams, root_uv: DVec2) -> Self {
+        let mut strand = Self::default();
+        let curl = &params.curl;
+        if curl.radius_m != 0.0 {
+            strand.curl_phase_rad = TAU * strand_random(params, root_uv, 1);
+            strand.curl_radius_m = curl.radius_m
+                * (1.0 + curl.radius_jitter * (2.0 * strand_random(params, root_uv, 2) - 1.0));
+        }
+        if params.noise.amplitude_m != 0.0 {
+            strand.noise_key_u = NOISE_KEY_SPAN * strand_random(params, root_uv, 3);
+            strand.noise_key_v = NOISE_KEY_SPAN * strand_random(params, root_uv, 4);
+        }
+        let clump = &params.clump;
+        if clump.strength != 0.0 && clump.clumps_per_uv > 0.0 {
+            strand.clump_pull = clump_pull(root_uv * clump.clumps_per_uv, params.seed);
+        }
+        let frizz = &params.frizz;
+        if frizz.amplitude_m != 0.0 && strand_random(params, root_uv, 6) < frizz.fraction {
+            strand.frizz = true;
+            strand.frizz_key = NOISE_KEY_SPAN * strand_random(params, root_uv, 7);
+        }
+        let wave = &params.wave;
+        if wave.amplitude_m != 0.0 {
+            strand.wave_phase_rad = wave.phase_spread * TAU * strand_random(params, root_uv, 8);
+        }
+        strand
+    }
+}
+
 /// The sum of the offsets of curl, noise, clump, frizz and wave at one vertex (object space).
 /// Twist is applied by the strand generator, which knows the bundle's centre strand.
 pub fn styling_offset(params: &StylingParams, input: &StylingInput) -> DVec3 {
-    let StylingInput {
-        u,
-        v,
-        root_uv,
-        w,
-        along,
-        ..
-    } = *input;
+    styling_offset_of(params, &StrandStyling::new(params, input.root_uv), input)
+}
+
+/// [`styling_offset`] with the strand's constant part computed already (once per strand).
+pub fn styling_offset_of(
+    params: &StylingParams,
+    strand: &StrandStyling,
+    input: &StylingInput,
+) -> DVec3 {
+    let StylingInput { u, v, w, along, .. } = *input;
     if along <= 0.0 || w <= 0.0 {
         return DVec3::ZERO;
     }
     let mut offset = DVec3::ZERO;
     let curl = &params.curl;
     if curl.radius_m != 0.0 {
-        let phase = TAU * curl.turns_per_m * w + TAU * strand_random(params, root_uv, 1);
-        let radius = curl.radius_m
-            * (1.0 + curl.radius_jitter * (2.0 * strand_random(params, root_uv, 2) - 1.0));
-        offset += smoothstep(curl.ramp_in_m, w) * radius * (phase.cos() * u + phase.sin() * v);
+        let phase = TAU * curl.turns_per_m * w + strand.curl_phase_rad;
+        offset += smoothstep(curl.ramp_in_m, w)
+            * strand.curl_radius_m
+            * (phase.cos() * u + phase.sin() * v);
     }
     let noise = &params.noise;
     if noise.amplitude_m != 0.0 {
-        let key_u = NOISE_KEY_SPAN * strand_random(params, root_uv, 3);
-        let key_v = NOISE_KEY_SPAN * strand_random(params, root_uv, 4);
+        let (key_u, key_v) = (strand.noise_key_u, strand.noise_key_v);
         let (mut nu, mut nv, mut gain, mut frequency) = (0.0, 0.0, 1.0, noise.frequency_per_m);
         for octave in 0..noise.octaves.max(1) {
             nu += gain * value_noise_1d(frequency * w + key_u, params.seed, 10 + octave);
@@ -134,21 +188,20 @@ pub fn styling_offset(params: &StylingParams, input: &StylingInput) -> DVec3 {
     }
     let clump = &params.clump;
     if clump.strength != 0.0 && clump.clumps_per_uv > 0.0 {
-        let pull = clump_pull(root_uv * clump.clumps_per_uv, params.seed);
+        let pull = strand.clump_pull;
         let scale = clump.strength * along.powf(clump.tightening.max(0.0)) * clump.radius_m;
         offset += scale * (pull.x * u + pull.y * v);
     }
     let frizz = &params.frizz;
-    if frizz.amplitude_m != 0.0 && strand_random(params, root_uv, 6) < frizz.fraction {
-        let key = NOISE_KEY_SPAN * strand_random(params, root_uv, 7);
+    if frizz.amplitude_m != 0.0 && strand.frizz {
+        let key = strand.frizz_key;
         let a = value_noise_1d(frizz.frequency_per_m * w + key, params.seed, 30);
         let b = value_noise_1d(frizz.frequency_per_m * w + key + 500.0, params.seed, 31);
         offset += frizz.amplitude_m * along * along * (a * u + b * v);
     }
     let wave = &params.wave;
     if wave.amplitude_m != 0.0 {
-        let phase = TAU * wave.frequency_per_m * w
-            + wave.phase_spread * TAU * strand_random(params, root_uv, 8);
+        let phase = TAU * wave.frequency_per_m * w + strand.wave_phase_rad;
         let direction = wave.direction_rad.cos() * u + wave.direction_rad.sin() * v;
         offset += smoothstep(wave.ramp_in_m, w) * wave.amplitude_m * phase.sin() * direction;
     }

@@ -80,15 +80,24 @@ impl Groom {
         let mut guides = GroomCurves::default();
         for (index, &(group, column, layers)) in guide_keys.iter().enumerate() {
             let positions = &mesh.columns[column as usize].positions;
-            let layers = layers.min(positions.len() - 1);
-            let segments = curve_segments(&positions[..=layers]);
-            let count = layers * GUIDE_POINTS_PER_LAYER + 1;
-            for k in 0..count {
-                let t = k as f64 / GUIDE_POINTS_PER_LAYER as f64;
-                let p: DVec3 = curve_point(&segments, t, SegmentForm::ExactCubic);
-                guides.points.push(p.as_vec3().to_array());
+            // A valid mesh has every layer of its bundles. A column too short for its
+            // bundles (an invalid mesh) still gives a two-point guide, so every id a strand
+            // names exists and every curve has the two points readers require.
+            let layers = layers.min(positions.len().saturating_sub(1));
+            if layers == 0 {
+                let root = positions.first().copied().unwrap_or_default();
+                guides.points.extend([root.as_vec3().to_array(); 2]);
+                guides.vertex_counts.push(2);
+            } else {
+                let segments = curve_segments(&positions[..=layers]);
+                let count = layers * GUIDE_POINTS_PER_LAYER + 1;
+                for k in 0..count {
+                    let t = k as f64 / GUIDE_POINTS_PER_LAYER as f64;
+                    let p: DVec3 = curve_point(&segments, t, SegmentForm::ExactCubic);
+                    guides.points.push(p.as_vec3().to_array());
+                }
+                guides.vertex_counts.push(count as i32);
             }
-            guides.vertex_counts.push(count as i32);
             let bundle_uv = first_uv_of_column(document, column);
             guides.root_uv.push(bundle_uv);
             guides.group_id.push(group);
@@ -120,7 +129,9 @@ impl Groom {
             corners.truncate(3);
             let total: f64 = corners.iter().map(|c| c.0).sum();
             let mut ids = [corners.first().map_or(0, |c| c.1); 3];
-            let mut w = [0.0f32; 3];
+            // No guide at all (a bundle whose columns made none): the first weight carries
+            // everything, so the weights still sum to one.
+            let mut w = [1.0f32, 0.0, 0.0];
             for (k, &(weight, id)) in corners.iter().enumerate() {
                 ids[k] = id;
                 w[k] = if total > 0.0 {

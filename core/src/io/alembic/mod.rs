@@ -27,9 +27,45 @@ pub fn to_file_axes([x, y, z]: [f32; 3]) -> [f32; 3] {
     [x, z, y]
 }
 
-/// The `.abc` of one groom (a static file).
-pub fn groom_file(groom: &Groom) -> Vec<u8> {
-    groom_animation(std::slice::from_ref(groom), 1.0).expect("one frame is an animation")
+/// The `.abc` of one groom (a static file). Refused when the groom's arrays disagree (see
+/// [`groom_animation`]).
+pub fn groom_file(groom: &Groom) -> Result<Vec<u8>, String> {
+    groom_animation(std::slice::from_ref(groom), 1.0)
+}
+
+/// Whether a groom's arrays agree: as many points as its curves' vertex counts add up to,
+/// one value per curve of every per-curve attribute, and per strand its guides.
+fn check_groom(groom: &Groom) -> Result<(), String> {
+    for (name, curves) in [("strands", &groom.strands), ("guides", &groom.guides)] {
+        let points: i64 = curves.vertex_counts.iter().map(|&c| i64::from(c)).sum();
+        if curves.vertex_counts.iter().any(|&c| c < 2) || points != curves.points.len() as i64 {
+            return Err(format!(
+                "{name}: {} points for vertex counts adding up to {points} (each at least 2)",
+                curves.points.len()
+            ));
+        }
+        let count = curves.vertex_counts.len();
+        for (attribute, len) in [
+            ("root_uv", curves.root_uv.len()),
+            ("group_id", curves.group_id.len()),
+            ("id", curves.id.len()),
+        ] {
+            if len != count {
+                return Err(format!(
+                    "{name}: {len} {attribute} values for {count} curves"
+                ));
+            }
+        }
+    }
+    let strands = groom.strands.vertex_counts.len();
+    if groom.closest_guides.len() != strands || groom.guide_weights.len() != strands {
+        return Err(format!(
+            "{} closest guides and {} guide weights for {strands} strands",
+            groom.closest_guides.len(),
+            groom.guide_weights.len()
+        ));
+    }
+    Ok(())
 }
 
 /// An animated `.abc`: the points and bounds of every frame's strands and guides as time
@@ -37,6 +73,9 @@ pub fn groom_file(groom: &Groom) -> Vec<u8> {
 /// have the curves of the first (counts); an empty list is refused.
 pub fn groom_animation(frames: &[Groom], frames_per_second: f64) -> Result<Vec<u8>, String> {
     let first = crate::io::strand_files::first_frame(frames, frames_per_second)?;
+    for (i, frame) in frames.iter().enumerate() {
+        check_groom(frame).map_err(|e| format!("frame {i}: {e}"))?;
+    }
     for (i, frame) in frames.iter().enumerate() {
         if frame.strands.vertex_counts != first.strands.vertex_counts
             || frame.guides.vertex_counts != first.guides.vertex_counts
