@@ -10,7 +10,8 @@ use hairloom_core::model::styling::StylingGroup;
 use hairloom_core::strands::reference::{StrandOptions, generate};
 use hairloom_tests::sample_paths;
 use ogawa_rs::{
-    Archive, ArchiveReader, FileReader, ObjectReader, PodArray, PropertyReader, Schema,
+    Archive, Archive as Archive_, ArchiveReader, FileReader, ObjectReader, PodArray,
+    PropertyReader, Schema,
 };
 
 const WIDTH_M: f32 = 8e-5;
@@ -390,4 +391,53 @@ fn animated_groom_reads_back_its_first_frame_and_refuses_mismatched_frames() {
     assert!(groom_animation(&[first.clone(), fewer], 24.0).is_err());
     assert!(groom_animation(&[], 24.0).is_err());
     assert!(groom_animation(&[first], f64::NAN).is_err());
+}
+
+/// Past 253 distinct metadata strings (and for any longer than 255 bytes) the writer puts
+/// metadata inline in the headers instead of the indexed table: readers find both.
+#[test]
+fn metadata_past_the_indexed_table_is_written_inline_and_read_back() {
+    use hairloom_core::io::alembic::archive::{Archive, Metadata, Object};
+    let long = "x".repeat(300);
+    let objects: Vec<Object> = (0..300)
+        .map(|i| Object {
+            name: format!("object_{i}"),
+            metadata: Metadata::new(&[
+                ("index", &i.to_string()),
+                ("note", if i == 5 { &long } else { "short" }),
+            ]),
+            properties: Vec::new(),
+            children: Vec::new(),
+        })
+        .collect();
+    let bytes = Archive {
+        objects,
+        metadata: Metadata::default(),
+        frames_per_second: 24.0,
+    }
+    .write();
+    let mut file = tempfile::tempfile().expect("temp file");
+    std::io::Write::write_all(&mut file, &bytes).expect("write");
+    let mut reader = FileReader::new(file).expect("reader");
+    let archive = Archive_::new(&mut reader).expect("ogawa-rs opens the file");
+    let root = archive.load_root_object(&mut reader).expect("root");
+    assert_eq!(root.child_count(), 300);
+    for i in [0, 5, 252, 253, 299] {
+        let child = root
+            .load_child(
+                i,
+                &mut reader,
+                &archive.indexed_meta_data,
+                &archive.time_samplings,
+            )
+            .expect("child");
+        let tokens = &child.header.meta_data.tokens;
+        assert_eq!(tokens.get("index"), Some(&i.to_string()), "object {i}");
+        let note = if i == 5 { long.as_str() } else { "short" };
+        assert_eq!(
+            tokens.get("note").map(String::as_str),
+            Some(note),
+            "object {i}"
+        );
+    }
 }

@@ -48,8 +48,11 @@ for path in sys.argv[1:]:
             scalp_st = [(0.0, 0.0)]
         lo = [min(uv[k] for uv in scalp_st) - 1e-5 for k in range(2)]
         hi = [max(uv[k] for uv in scalp_st) + 1e-5 for k in range(2)]
+        scalp_extent = scalp.GetExtentAttr().Get(times[0] if times else Usd.TimeCode.Default())
         scalp_ok = (
-            sum(face_counts) == len(face_indices) == len(scalp_st)
+            scalp_extent is not None
+            and all(scalp_extent[0][k] <= p[k] <= scalp_extent[1][k] for p in scalp_points for k in range(3))
+            and sum(face_counts) == len(face_indices) == len(scalp_st)
             and all(0 <= i < len(scalp_points) for i in face_indices)
             and all(lo[k] <= uv[k] <= hi[k] for uv in st for k in range(2))
         )

@@ -106,7 +106,8 @@ pub fn usda_file(strands: &[Strand], scalp: &ScalpMesh, width_m: f32) -> String 
     let extent = format!("    float3[] extent = {}\n", usda_extent(strands, width_m));
     usda_curves(&mut out, strands, &points, &extent, width_m);
     let scalp_points = format!("    point3f[] points = {}\n", usda_vec3s(&scalp.positions));
-    usda_scalp(&mut out, scalp, &scalp_points);
+    let scalp_extent = format!("    float3[] extent = {}\n", usda_scalp_extent(scalp));
+    usda_scalp(&mut out, scalp, &scalp_points, &scalp_extent);
     out
 }
 
@@ -138,16 +139,27 @@ fn usda_extent(strands: &[Strand], width_m: f32) -> String {
 /// The box around every point of `strands`, widened by half of `width_m`; zero when there
 /// are no points.
 pub fn strand_bounds(strands: &[Strand], width_m: f32) -> ([f32; 3], [f32; 3]) {
-    let mut points = strands
+    let points = strands
         .iter()
         .flat_map(|s| s.points.iter())
         .map(|p| p.as_vec3());
+    bounds_of(points, 0.5 * width_m)
+}
+
+/// The box around `points`, widened by `pad` on every side; zero when there are none.
+fn bounds_of(mut points: impl Iterator<Item = glam::Vec3>, pad: f32) -> ([f32; 3], [f32; 3]) {
     let Some(first) = points.next() else {
         return ([0.0; 3], [0.0; 3]);
     };
     let (lo, hi) = points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    let pad = glam::Vec3::splat(0.5 * width_m);
+    let pad = glam::Vec3::splat(pad);
     ((lo - pad).to_array(), (hi + pad).to_array())
+}
+
+/// `[(min), (max)]` of the scalp's points (a mesh is Boundable too).
+fn usda_scalp_extent(scalp: &ScalpMesh) -> String {
+    let (lo, hi) = bounds_of(scalp.positions.iter().map(|&p| glam::Vec3::from(p)), 0.0);
+    usda_vec3s(&[lo, hi])
 }
 
 fn usda_header(metadata: &str, doc: &str) -> String {
@@ -186,8 +198,8 @@ fn usda_curves(out: &mut String, strands: &[Strand], points: &str, extent: &str,
     let _ = writeln!(out, "}}\n");
 }
 
-/// The `/Scalp` prim: `points` is its points attribute (a value or time samples).
-fn usda_scalp(out: &mut String, scalp: &ScalpMesh, points: &str) {
+/// The `/Scalp` prim: `points` and `extent` are its attributes (values or time samples).
+fn usda_scalp(out: &mut String, scalp: &ScalpMesh, points: &str, extent: &str) {
     use std::fmt::Write;
     let join = |values: &[u32]| {
         values
@@ -208,6 +220,7 @@ fn usda_scalp(out: &mut String, scalp: &ScalpMesh, points: &str) {
         join(&scalp.face_vertex_indices)
     );
     out.push_str(points);
+    out.push_str(extent);
     let uvs: Vec<String> = scalp
         .face_uvs
         .iter()
@@ -285,7 +298,8 @@ pub fn usda_animation(
     let extent = sampled("float3[] extent", &|f| usda_extent(&f.strands, width_m));
     usda_curves(&mut out, &first.strands, &points, &extent, width_m);
     let scalp_points = sampled("point3f[] points", &|f| usda_vec3s(&f.scalp.positions));
-    usda_scalp(&mut out, &first.scalp, &scalp_points);
+    let scalp_extent = sampled("float3[] extent", &|f| usda_scalp_extent(&f.scalp));
+    usda_scalp(&mut out, &first.scalp, &scalp_points, &scalp_extent);
     Ok(out)
 }
 
