@@ -61,7 +61,7 @@ use crate::renderer::body_shadow::BodyShadowRenderer;
 use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::preview_body::{BodyRenderer, GpuBody, PreparedBody};
 use crate::renderer::preview_hair::{HairRenderer, HairUniforms, PreparedHair};
-use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, effect_entries};
+use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, effects_layout};
 use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer};
 use crate::resources::Tracked;
 
@@ -205,15 +205,7 @@ impl GameHair {
             .map_err(GameHairError::EffectLimit)?;
         let context = &self.context;
         self.lighting.sync(context, &active, &scene.material);
-        let entries = effect_entries(&active);
-        let effects_layout = (!entries.is_empty()).then(|| {
-            context
-                .device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("game_effects"),
-                    entries: &entries,
-                })
-        });
+        let effects_layout = effects_layout(context, &active);
         // Pipelines are made against the layouts, so new layouts mean new renderers.
         let targets = self.hair.targets();
         self.hair = HairRenderer::with_targets(context, targets);

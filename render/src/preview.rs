@@ -29,7 +29,7 @@ use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody};
 use crate::renderer::preview_hair::{HairRenderer, HairUniforms};
-use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effect_entries};
+use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
 use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
 use crate::view::View;
 
@@ -137,16 +137,7 @@ impl FrameState {
             .as_ref()
             .is_none_or(|(key, _)| *key != layout_key)
         {
-            let entries = effect_entries(active);
-            let layout = (!entries.is_empty()).then(|| {
-                context
-                    .device
-                    .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                        label: Some("effects"),
-                        entries: &entries,
-                    })
-            });
-            self.effects_layout = Some((layout_key, layout));
+            self.effects_layout = Some((layout_key, effects_layout(context, active)));
             // Pipelines made with the old layout go with it.
             self.hair = HairRenderer::new(context, self.hair_sample_count());
             self.body = BodyRenderer::new(context, self.hair_sample_count());

@@ -10,8 +10,7 @@ use hairloom_core::model::styling::StylingGroup;
 use hairloom_core::strands::reference::{StrandOptions, generate};
 use hairloom_tests::sample_paths;
 use ogawa_rs::{
-    Archive, Archive as Archive_, ArchiveReader, FileReader, ObjectReader, PodArray,
-    PropertyReader, Schema,
+    Archive, ArchiveReader, FileReader, ObjectReader, PodArray, PropertyReader, Schema,
 };
 
 const WIDTH_M: f32 = 8e-5;
@@ -35,6 +34,29 @@ fn grouped_sample() -> Document {
         params,
     });
     document
+}
+
+/// The sub-property `name` of compound `$compound`, which must be a `$kind` (the crate's
+/// reader types cannot be named outside it, so this is a macro, not a function).
+macro_rules! sub_property {
+    ($compound:expr, $name:expr, $kind:ident, $r:expr, $archive:expr) => {
+        match $compound
+            .load_sub_property_by_name($name, $r, $archive)
+            .expect($name)
+        {
+            Some(PropertyReader::$kind(property)) => property,
+            _ => panic!("{} is not a {}", $name, stringify!($kind)),
+        }
+    };
+}
+
+/// `bytes` as ogawa-rs opens a file: the reader and the archive.
+fn open_archive(bytes: &[u8]) -> (FileReader, Archive) {
+    let mut file = tempfile::tempfile().expect("temp file");
+    std::io::Write::write_all(&mut file, bytes).expect("write");
+    let mut reader = FileReader::new(file).expect("reader");
+    let archive = Archive::new(&mut reader).expect("ogawa-rs opens the file");
+    (reader, archive)
 }
 
 struct Read {
@@ -62,28 +84,13 @@ fn read_curves(obj: &ObjectReader, r: &mut dyn ArchiveReader, archive: &Archive)
         .expect("width")
         .expect("width present");
     let props = obj.properties().expect("properties");
-    let Some(PropertyReader::Compound(geom)) = props
-        .load_sub_property_by_name(".geom", r, archive)
-        .expect(".geom")
-    else {
-        panic!(".geom")
-    };
-    let Some(PropertyReader::Scalar(bounds)) = geom
-        .load_sub_property_by_name(".selfBnds", r, archive)
-        .expect(".selfBnds")
-    else {
-        panic!(".selfBnds")
-    };
+    let geom = sub_property!(props, ".geom", Compound, r, archive);
+    let bounds = sub_property!(geom, ".selfBnds", Scalar, r, archive);
     let PodArray::F64(b) = bounds.load_sample(0, r).expect("bounds") else {
         panic!("bounds are f64")
     };
     let mut arb = std::collections::BTreeMap::new();
-    let Some(PropertyReader::Compound(params)) = geom
-        .load_sub_property_by_name(".arbGeomParams", r, archive)
-        .expect(".arbGeomParams")
-    else {
-        panic!(".arbGeomParams")
-    };
+    let params = sub_property!(geom, ".arbGeomParams", Compound, r, archive);
     for i in 0..params.sub_property_count() {
         if let PropertyReader::Array(a) = params.load_sub_property(i, r, archive).expect("param") {
             let scope = a.header.meta_data.tokens.get("geoScope").cloned();
@@ -94,12 +101,7 @@ fn read_curves(obj: &ObjectReader, r: &mut dyn ArchiveReader, archive: &Archive)
         }
     }
     let mut user = std::collections::BTreeMap::new();
-    let Some(PropertyReader::Compound(props)) = geom
-        .load_sub_property_by_name(".userProperties", r, archive)
-        .expect(".userProperties")
-    else {
-        panic!(".userProperties")
-    };
+    let props = sub_property!(geom, ".userProperties", Compound, r, archive);
     for i in 0..props.sub_property_count() {
         if let PropertyReader::Scalar(s) = props.load_sub_property(i, r, archive).expect("user") {
             user.insert(
@@ -119,10 +121,7 @@ fn read_curves(obj: &ObjectReader, r: &mut dyn ArchiveReader, archive: &Archive)
 }
 
 fn read_file(bytes: Vec<u8>) -> (Read, Read, String) {
-    let mut file = tempfile::tempfile().expect("temp file");
-    std::io::Write::write_all(&mut file, &bytes).expect("write");
-    let mut reader = FileReader::new(file).expect("reader");
-    let archive = Archive::new(&mut reader).expect("ogawa-rs opens the file");
+    let (mut reader, archive) = open_archive(&bytes);
     let root = archive.load_root_object(&mut reader).expect("root");
     assert_eq!(root.child_count(), 2);
     let mut objects = Vec::new();
@@ -416,10 +415,7 @@ fn metadata_past_the_indexed_table_is_written_inline_and_read_back() {
         frames_per_second: 24.0,
     }
     .write();
-    let mut file = tempfile::tempfile().expect("temp file");
-    std::io::Write::write_all(&mut file, &bytes).expect("write");
-    let mut reader = FileReader::new(file).expect("reader");
-    let archive = Archive_::new(&mut reader).expect("ogawa-rs opens the file");
+    let (mut reader, archive) = open_archive(&bytes);
     let root = archive.load_root_object(&mut reader).expect("root");
     assert_eq!(root.child_count(), 300);
     for i in [0, 5, 252, 253, 299] {

@@ -250,6 +250,22 @@ fn texture_entry(
     }
 }
 
+/// The group-2 layout of the lit shaders for `effects`; `None` when they take no group 2.
+pub fn effects_layout(
+    context: &GpuContext,
+    effects: &ActiveEffects,
+) -> Option<wgpu::BindGroupLayout> {
+    let entries = effect_entries(effects);
+    (!entries.is_empty()).then(|| {
+        context
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("effects"),
+                entries: &entries,
+            })
+    })
+}
+
 /// The group-2 layout entries of `effects` (empty: the shaders take no group 2).
 pub fn effect_entries(effects: &ActiveEffects) -> Vec<wgpu::BindGroupLayoutEntry> {
     let mut entries = Vec::new();
