@@ -77,7 +77,10 @@ run: toolchain gpu-deps
 	  echo "Rendered $(SAMPLE) to $(RENDER_OUT)"; \
 	fi
 
+# `cargo test --all-targets` builds examples as test harnesses, so the game example that
+# render/tests/game_window.rs opens in a window is built as a program first.
 test: toolchain deps
+	$(CARGO) build -p hairloom-render --example game
 	$(CARGO) test --workspace --all-targets
 	$(CARGO) test --workspace --doc
 

@@ -2,9 +2,10 @@
 //! using only `hairloom_render::game`) opens on Xvfb, draws a few frames of the bundled
 //! sample and exits cleanly, saying what it drew. (`tests/game.rs` checks the picture.)
 //!
-//! Needs Xvfb (Debian: xvfb), which `make test` installs, and the example built, which
-//! `cargo test --all-targets` (what `make test` runs) does first; without either the test is
-//! skipped unless HAIRLOOM_REQUIRE_DISPLAY=1 (set by `make test`).
+//! Needs Xvfb (Debian: xvfb), which `make test` installs, and the example built as a program
+//! (`cargo build -p hairloom-render --example game`, which `make test` runs first: `cargo test
+//! --all-targets` builds examples only as test harnesses); without either the test is skipped
+//! unless HAIRLOOM_REQUIRE_DISPLAY=1 (set by `make test`).
 
 use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
@@ -48,7 +49,7 @@ fn the_game_example_draws_in_a_window() {
     if !have_xvfb || !binary.exists() {
         assert!(
             !required,
-            "needs Xvfb (apt-get install xvfb) and the example built at {} (cargo test --all-targets)",
+            "needs Xvfb (apt-get install xvfb) and the example built at {} (cargo build -p hairloom-render --example game)",
             binary.display()
         );
         eprintln!("skipped: Xvfb or {} missing", binary.display());
