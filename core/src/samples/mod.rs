@@ -236,6 +236,9 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
     mesh
 }
 
+/// The first layer step as a fraction of the others (see [`comb_column`]).
+const FIRST_LAYER_STEP: f64 = 0.3;
+
 /// One column combed from its root (normal `n`): out along the normal, then bending toward
 /// −y by `growth.gravity`, front hair swept back, each vertex kept outside the inflated
 /// cranium ellipsoid.
@@ -267,6 +270,14 @@ fn comb_column(
         let sweep = DVec3::new(0.0, 0.0, -(0.6 + 3.0 * front) * (1.0 - hang));
         let down = (-DVec3::Y + outward * (1.0 - hang) + sweep).normalize();
         let direction = n.lerp(down, bend).normalize_or(n);
+        // Hair leaves the scalp and lies down on it within a centimetre: a full first step
+        // would lift the first layer off the scalp, and the strand's curve from the root to
+        // it would cut through the curved scalp (a bald patch behind the hairline).
+        let step_m = if k == 1 {
+            FIRST_LAYER_STEP * step_m
+        } else {
+            step_m
+        };
         let mut p = previous + direction * step_m;
         // Keep clear of the head: push out of the inflated cranium ellipsoid.
         let clearance = 1.0 + growth.volume * fraction.sqrt();
@@ -294,9 +305,10 @@ pub fn keep_out_of_body(mesh: &HairMesh, body: &BodyMesh) -> HairMesh {
             retention_root: 1.0,
             retention_tip: 0.6,
             volume_m_per_layer: 0.0,
-            // Strands run between the hair-mesh vertices, curving as they go: keep the
-            // vertices far enough out that no strand dips into the scalp.
-            collision_margin_m: 0.006,
+            // Strands run between the hair-mesh vertices, curving as they go; the curves
+            // are lifted clear afterwards (`lift_curves_out_of_body`), so the vertices may
+            // rest close to the scalp.
+            collision_margin_m: CURVE_CLEARANCE_M,
             ..HairPhysics::default()
         },
         ..Motion::default()
@@ -306,8 +318,124 @@ pub fn keep_out_of_body(mesh: &HairMesh, body: &BodyMesh) -> HairMesh {
         sim.step();
     }
     let mut settled = sim.posed_mesh();
+    let sdf = crate::simulate::body_sdf::BodySdf::for_hair(body, &settled);
+    lift_curves_out_of_body(&mut settled, &sdf, CURVE_CLEARANCE_M);
     settled.update_w();
     settled
+}
+
+/// How far the column curves are kept from the body between their vertices (see
+/// [`lift_curves_out_of_body`]).
+const CURVE_CLEARANCE_M: f64 = 0.003;
+
+/// Lifts the strand curves clear of the body by `clearance_m`: the collision keeps hair-mesh
+/// *vertices* out, but hair lying on a curved scalp sags under it between them — a long layer
+/// step's curve is a chord under the curvature, and so is a strand between the corners of a
+/// bundle that fans out over the crown. Each bundle is sampled where strands grow (its
+/// corners, edge midpoints and centre, as the runtime blends the corner columns' cubics);
+/// where a layer segment dips below the clearance, the corner vertices at both ends of that
+/// segment move out along the field's gradient by the shortfall, weighted by how near each
+/// end is to the dip. A few rounds settle it (a move changes neighbouring tangents). Roots
+/// stay on the scalp.
+fn lift_curves_out_of_body(
+    mesh: &mut HairMesh,
+    sdf: &crate::simulate::body_sdf::BodySdf,
+    clearance_m: f64,
+) {
+    use crate::geometry::curve::{CurveDefinition, ReferenceStrand, SegmentForm};
+    const ROUNDS: usize = 12;
+    const SAMPLES_PER_SEGMENT: usize = 8;
+    for _ in 0..ROUNDS {
+        // The largest push each (column, layer) vertex is asked for this round.
+        let mut pushes: Vec<Vec<DVec3>> = mesh
+            .columns
+            .iter()
+            .map(|c| vec![DVec3::ZERO; c.positions.len()])
+            .collect();
+        for (b, bundle) in mesh.bundles.iter().enumerate() {
+            let corners = bundle.vertices.len().min(4);
+            let mut samples: Vec<[f64; 4]> = Vec::with_capacity(2 * corners + 1);
+            for i in 0..corners {
+                let mut corner = [0.0; 4];
+                corner[i] = 1.0;
+                samples.push(corner);
+                let mut edge = [0.0; 4];
+                edge[i] = 0.5;
+                edge[(i + 1) % corners] = 0.5;
+                samples.push(edge);
+            }
+            samples.push(std::array::from_fn(|i| {
+                if i < corners {
+                    1.0 / corners as f64
+                } else {
+                    0.0
+                }
+            }));
+            for weights in samples {
+                let Some(strand) = ReferenceStrand::with_weights(mesh, b, weights) else {
+                    continue;
+                };
+                for k in 0..strand.layers {
+                    // The strand grows out of the scalp: the clearance it needs ramps up over
+                    // the first half of the first layer.
+                    let needed_m = |t: f64| clearance_m * (2.0 * (k as f64 + t)).min(1.0);
+                    let worst = (1..SAMPLES_PER_SEGMENT)
+                        .map(|i| {
+                            let t = i as f64 / SAMPLES_PER_SEGMENT as f64;
+                            let p = strand.point(
+                                k as f64 + t,
+                                CurveDefinition::ColumnBlend,
+                                SegmentForm::ExactCubic,
+                            );
+                            (t, p, needed_m(t) - sdf.distance_m(p))
+                        })
+                        .max_by(|a, b| a.2.total_cmp(&b.2));
+                    let Some((t, p, shortfall_m)) = worst else {
+                        continue;
+                    };
+                    if !(shortfall_m > 0.0) {
+                        continue;
+                    }
+                    let out = sdf.gradient(p) * shortfall_m;
+                    // Ends moved by a₀ and a₁ move the dip by about a₀(1−t) + a₁t: weights
+                    // (1−t, t) over the sum of squares of the movable ones (not the root)
+                    // make that the whole shortfall.
+                    let ends = [(k, 1.0 - t), (k + 1, t)];
+                    let norm: f64 = ends
+                        .iter()
+                        .filter(|(layer, _)| *layer > 0)
+                        .map(|(_, along)| along * along)
+                        .sum();
+                    for (layer, along) in ends {
+                        if layer == 0 {
+                            continue;
+                        }
+                        for (i, &column) in bundle.vertices.iter().enumerate().take(corners) {
+                            if weights[i] > 0.0 {
+                                let slot = &mut pushes[column as usize][layer];
+                                let push = out * (along / norm);
+                                if push.length() > slot.length() {
+                                    *slot = push;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut moved = false;
+        for (column, column_pushes) in mesh.columns.iter_mut().zip(pushes) {
+            for (position, push) in column.positions.iter_mut().zip(column_pushes) {
+                if push != DVec3::ZERO {
+                    *position += push;
+                    moved = true;
+                }
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
 }
 
 /// Area-weighted root-layer vertex normals.
