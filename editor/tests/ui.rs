@@ -1349,3 +1349,37 @@ fn lock_and_unlock_the_selected_bundles_vertices_as_undo_steps() {
         "two undo steps"
     );
 }
+
+/// Set density thins the selected bundles' strands (a hairline) as one undo step, and the
+/// geometry stays where it was.
+#[test]
+fn set_density_thins_the_selected_bundles_as_an_undo_step() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    harness.state_mut().state.selection = [0u32, 3].into_iter().collect();
+    harness.get_by_label("Set density").click();
+    harness.run();
+    let state = &harness.state().state;
+    let mesh = &state.document().hair_mesh;
+    let density = harness.state().tools.density;
+    assert!(density > 0.0 && density < 1.0, "{density}");
+    for (b, bundle) in mesh.bundles.iter().enumerate() {
+        let expected = if b == 0 || b == 3 {
+            density
+        } else {
+            original.hair_mesh.bundles[b].density
+        };
+        assert_eq!(bundle.density, expected, "bundle {b}");
+    }
+    assert_eq!(
+        mesh.columns, original.hair_mesh.columns,
+        "geometry untouched"
+    );
+    assert_eq!(
+        state.project.history.undo.last().map(|c| c.label()),
+        Some("Set density")
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original, "one undo step");
+}

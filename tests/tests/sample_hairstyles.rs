@@ -107,3 +107,61 @@ fn hair_rests_on_the_crown() {
         }
     }
 }
+
+/// Hair thins out over the hairline instead of ending in a hard edge: the bundles on the
+/// scalp's rim grow about a third of their strands, the next ring about two thirds, and the
+/// rest all of them; the generated strands follow.
+#[test]
+fn strand_density_falls_off_over_the_hairline() {
+    for (name, document) in head_samples() {
+        let mesh = &document.hair_mesh;
+        let mut edge_uses = std::collections::HashMap::<(u32, u32), u32>::new();
+        for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
+            let n = bundle.vertices.len();
+            for i in 0..n {
+                let (a, b) = (bundle.vertices[i], bundle.vertices[(i + 1) % n]);
+                *edge_uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let on_rim = |b: usize| {
+            let vertices = &mesh.bundles[b].vertices;
+            (0..vertices.len()).any(|i| {
+                let (a, c) = (vertices[i], vertices[(i + 1) % vertices.len()]);
+                edge_uses[&(a.min(c), a.max(c))] == 1
+            })
+        };
+        let rim: Vec<usize> = (0..mesh.bundles.len()).filter(|&b| on_rim(b)).collect();
+        assert!(rim.len() > 20, "{name}: {} rim bundles", rim.len());
+        for &b in &rim {
+            assert!(
+                mesh.bundles[b].density < 0.5,
+                "{name}: rim bundle {b} has density {}",
+                mesh.bundles[b].density
+            );
+        }
+        let full = mesh.bundles.iter().filter(|b| b.density == 1.0).count();
+        assert!(
+            full * 2 > mesh.bundles.len(),
+            "{name}: only {full} bundles at full density"
+        );
+        let options = StrandOptions {
+            strands_per_bundle: 32,
+            vertices_log2: 2,
+            ..StrandOptions::default()
+        };
+        let strands = generate(&document, &options);
+        let mut per_bundle = vec![0usize; mesh.bundles.len()];
+        for strand in &strands {
+            per_bundle[strand.bundle as usize] += 1;
+        }
+        for &b in &rim {
+            assert!(
+                per_bundle[b] < 16,
+                "{name}: rim bundle {b}: {}",
+                per_bundle[b]
+            );
+        }
+        let densest = per_bundle.iter().max().copied().unwrap_or(0);
+        assert_eq!(densest, 32, "{name}: full bundles grow every strand");
+    }
+}

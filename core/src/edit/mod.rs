@@ -27,7 +27,8 @@ use crate::model::mesh::{HairMesh, VertexRef};
 // The edit API in one place: callers write `edit::extrude`, whichever file it lives in.
 pub use coordinates::{set_corner_uvs, set_w, set_w_mode};
 pub use topology::{
-    ExtrudeDirection, delete_layer, extrude, insert_layer, layer_closure, set_removed, subdivide,
+    ExtrudeDirection, delete_layer, extrude, insert_layer, layer_closure, set_density, set_removed,
+    subdivide,
 };
 pub use transform::{VertexTransform, falloff_weight, transform_vertices};
 pub use wisps::{bundle_layer_centre, growth_direction, mirror_shape, paste_shape};
@@ -147,6 +148,31 @@ mod tests {
 
     fn at(column: u32, layer: u32) -> VertexRef {
         VertexRef { column, layer }
+    }
+
+    #[test]
+    fn set_density_changes_only_the_selected_bundles_and_refuses_out_of_range() {
+        let mesh = grid(3, 2, 2, 0.5);
+        let outcome = set_density(&mesh, &[0, 4], 0.3).expect("set");
+        for (b, bundle) in outcome.mesh.bundles.iter().enumerate() {
+            let expected = if b == 0 || b == 4 { 0.3 } else { 1.0 };
+            assert_eq!(bundle.density, expected, "bundle {b}");
+        }
+        assert_eq!(outcome.mesh.columns, mesh.columns, "geometry untouched");
+        for bad in [1.5, -0.2, f64::NAN] {
+            match set_density(&mesh, &[1], bad) {
+                Err(EditError::Invalid(e)) => assert_eq!(e.path, "bundles[1].density"),
+                other => panic!("density {bad}: {other:?}"),
+            }
+        }
+        assert!(matches!(
+            set_density(&mesh, &[], 0.5),
+            Err(EditError::EmptySelection)
+        ));
+        assert!(matches!(
+            set_density(&mesh, &[99], 0.5),
+            Err(EditError::BundleOutOfRange { .. })
+        ));
     }
 
     #[test]

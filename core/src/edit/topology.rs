@@ -243,6 +243,21 @@ pub fn set_removed(
     finish(out, bundles.iter().copied().collect(), None)
 }
 
+/// Sets the fraction of strands the selected bundles grow (`Bundle::density`, `[0, 1]`;
+/// anything else is refused with the bundle's field named). Geometry is untouched.
+pub fn set_density(
+    mesh: &HairMesh,
+    bundles: &[u32],
+    density: f64,
+) -> Result<EditOutcome, EditError> {
+    check_bundles(mesh, bundles)?;
+    let mut out = mesh.clone();
+    for &b in bundles {
+        out.bundles[b as usize].density = density;
+    }
+    finish(out, bundles.iter().copied().collect(), Some(&[]))
+}
+
 /// Splits each selected root face 1 → 4 (quads into four quads through edge midpoints and
 /// the centre, triangles into four triangles through edge midpoints), through all layers.
 /// Edge-midpoint columns are shared by two subdivided neighbours; next to a face that is
@@ -315,6 +330,7 @@ pub fn subdivide(mesh: &HairMesh, bundles: &[u32]) -> Result<EditOutcome, EditEr
             uvs,
             layers: bundle.layers,
             removed: bundle.removed,
+            density: bundle.density,
         };
         let v = &bundle.vertices;
         let uv = &bundle.uvs;

@@ -54,6 +54,18 @@ pub struct BundleEntry {
     pub triangle: bool,
     /// Index into `styling.groups`, or −1 for the global parameters.
     pub styling_group: i32,
+    /// The fraction of the bundle's strands that grow (`⌈density · N⌉` of them); absent
+    /// means 1.
+    #[serde(default = "full_density", skip_serializing_if = "is_full_density")]
+    pub density: f32,
+}
+
+fn full_density() -> f32 {
+    1.0
+}
+
+fn is_full_density(density: &f32) -> bool {
+    *density == 1.0
 }
 
 /// `manifest.json` of a runtime bundle.
@@ -273,6 +285,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
                 layers: b.layers,
                 triangle: Atlas::is_triangle(b),
                 styling_group: hair.block_styling[i] as i32 - 1,
+                density: hair.block_density[i],
             })
             .collect(),
         strands_per_bundle: hair.strands_per_bundle,
@@ -464,6 +477,15 @@ pub fn load_runtime_bundle_from(
                 format!("bundles[{i}].corner_of_block has a corner above 3"),
             ));
         }
+        if !(0.0..=1.0).contains(&entry.density) {
+            return Err(error(
+                MANIFEST_FILE,
+                format!(
+                    "bundles[{i}].density {} is outside [0, 1] (the fraction of strands that grow)",
+                    entry.density
+                ),
+            ));
+        }
         let groups = manifest.styling.groups.len() as i32;
         if !(-1..groups).contains(&entry.styling_group) {
             return Err(error(
@@ -567,6 +589,7 @@ pub fn load_runtime_bundle_from(
             .iter()
             .map(|b| (b.styling_group + 1) as u32)
             .collect(),
+        block_density: manifest.bundles.iter().map(|b| b.density).collect(),
         styling: manifest.styling,
         scene: manifest.scene,
         lod: manifest.lod,
@@ -771,6 +794,58 @@ mod tests {
         assert!(error.to_string().contains(&manifest.w.file), "{error}");
     }
 
+    /// A thinned bundle's density travels through the manifest (absent when 1) and back, and
+    /// the runtime strands grow only its share.
+    #[test]
+    fn bundle_density_round_trips_and_thins_the_runtime_strands() {
+        let mut mesh = grid(2, 2, 1, 0.5);
+        crate::geometry::interior::place_interior(&mut mesh, None);
+        mesh.bundles[2].density = 0.25;
+        let document = Document::new("grid", mesh);
+        let options = RuntimeOptions {
+            strands_per_bundle: 16,
+            ..RuntimeOptions::default()
+        };
+        let files = runtime_bundle(&document, &options).expect("export");
+        let text = String::from_utf8(files[files.len() - 1].1.clone()).expect("utf-8");
+        assert_eq!(
+            text.matches("\"density\"").count(),
+            1,
+            "only the thinned one"
+        );
+        let loaded =
+            load_runtime_bundle_from(&files.into_iter().collect::<HashMap<_, _>>(), "memory")
+                .expect("loads");
+        let built = RuntimeHair::from_document(&document, &options);
+        assert_eq!(loaded.block_density, built.block_density);
+        let block = built
+            .textures
+            .atlas
+            .blocks
+            .iter()
+            .position(|b| b.bundle == 2)
+            .expect("block of bundle 2");
+        assert_eq!(built.block_density[block], 0.25);
+        assert_eq!(built.block_strand_count(block), 4);
+        let strands = crate::runtime::strand_gen::runtime_strands(
+            &built,
+            5,
+            crate::runtime::strand_gen::Filtering::Exact,
+        );
+        assert_eq!(strands.len(), 3 * 16 + 4);
+        assert_eq!(strands.iter().filter(|s| s.bundle == 2).count(), 4);
+        // The CPU reference grows the same share.
+        let reference = crate::strands::reference::generate(
+            &document,
+            &crate::strands::reference::StrandOptions {
+                strands_per_bundle: 16,
+                ..Default::default()
+            },
+        );
+        assert_eq!(reference.iter().filter(|s| s.bundle == 2).count(), 4);
+        assert_eq!(reference.len(), 3 * 16 + 4);
+    }
+
     /// A bundle in memory, with its manifest as JSON to edit.
     fn bundle_in_memory() -> (HashMap<String, Vec<u8>>, serde_json::Value) {
         let mut mesh = grid(2, 2, 1, 0.5);
@@ -827,6 +902,10 @@ mod tests {
             (
                 Box::new(|m| m["body"] = "missing.glb".into()),
                 "no such file",
+            ),
+            (
+                Box::new(|m| m["bundles"][0]["density"] = 1.5.into()),
+                "bundles[0].density 1.5 is outside [0, 1]",
             ),
         ];
         for (edit, expected) in cases {

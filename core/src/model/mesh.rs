@@ -31,10 +31,23 @@ pub struct Bundle {
     /// and does not count as part of the hair volume.
     #[serde(default, skip_serializing_if = "is_false")]
     pub removed: bool,
+    /// The fraction of the bundle's strands that grow, in `[0, 1]`: below 1 at a hairline,
+    /// so hair thins out over it instead of ending at a hard edge. The runtime draws the
+    /// first `⌈density · N⌉` of its `N` progressive root samples (an even, sparser cover).
+    #[serde(default = "full_density", skip_serializing_if = "is_full_density")]
+    pub density: f64,
 }
 
 fn is_false(value: &bool) -> bool {
     !*value
+}
+
+fn full_density() -> f64 {
+    1.0
+}
+
+fn is_full_density(density: &f64) -> bool {
+    *density == 1.0
 }
 
 impl Bundle {
@@ -203,6 +216,7 @@ impl HairMesh {
                 uvs: uv.clone(),
                 layers: 0,
                 removed: false,
+                density: 1.0,
             })
             .collect();
         Self {
@@ -302,6 +316,15 @@ impl HairMesh {
                     format!(
                         "{} layers is above the cap of {cap} layers per bundle",
                         bundle.layers
+                    ),
+                ));
+            }
+            if !(0.0..=1.0).contains(&bundle.density) {
+                return Err(invalid(
+                    format!("bundles[{bi}].density"),
+                    format!(
+                        "density {} is outside [0, 1] (the fraction of strands that grow)",
+                        bundle.density
                     ),
                 ));
             }
@@ -579,6 +602,14 @@ mod tests {
             mesh.validate().expect_err("nan").path,
             "columns[4].positions[1]"
         );
+
+        for density in [1.5, -0.1, f64::NAN] {
+            let mut mesh = grid(2, 2, 1, 1.0);
+            mesh.bundles[3].density = density;
+            let error = mesh.validate().expect_err("density out of range");
+            assert_eq!(error.path, "bundles[3].density");
+            assert!(error.message.contains("[0, 1]"), "{error}");
+        }
 
         let mut mesh = grid(2, 2, 1, 1.0);
         mesh.columns[0].positions.push(DVec3::ZERO);

@@ -5,7 +5,9 @@
 //! in [`crate::strands::lod`].
 
 use crate::runtime::gpu_types::StrandRun;
-use crate::strands::lod::{detail_level, strand_count, thickness_factor, vertex_lod};
+use crate::strands::lod::{
+    density_count, detail_level, strand_count, thickness_factor, vertex_lod,
+};
 
 /// Where one bundle's hair is, from the runtime textures (`RuntimeTextures::bundle_bounds`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,6 +20,8 @@ pub struct BundleBounds {
     pub root_size_m: f32,
     /// Length of the bundle's first column curve (control polygon), the `h` of vertex LOD.
     pub strand_length_m: f32,
+    /// The fraction of its strands the bundle grows (`Bundle::density`; 1 for a full bundle).
+    pub density: f32,
 }
 
 /// Level-of-detail switches of a frame.
@@ -137,7 +141,11 @@ pub fn plan_frame(
             let delta = crate::strands::random::hash_to_unit(crate::strands::random::pcg_hash(
                 index as u32,
             ));
-            let count = strand_count(strand_level, per_bundle, delta);
+            // A thinned bundle (density < 1) drops strands at the same rate from its own
+            // count, never drawing more than it grows at full detail.
+            let density = bounds.density as f64;
+            let count = strand_count(strand_level * density, per_bundle, delta)
+                .min(density_count(density, per_bundle));
             let vertex_level = detail_level(
                 bounds.strand_length_m as f64,
                 resolution,
@@ -153,7 +161,12 @@ pub fn plan_frame(
                 thickness_factor(strand_level, per_bundle) as f32,
             )
         } else {
-            (per_bundle, full_vertices, 0.0, 1.0)
+            (
+                density_count(bounds.density as f64, per_bundle),
+                full_vertices,
+                0.0,
+                1.0,
+            )
         };
         let mut first_root = index as u32 * per_bundle;
         let mut remaining = strands;
@@ -201,6 +214,7 @@ mod tests {
         (0..40)
             .map(|i| BundleBounds {
                 centre: glam::Vec3::new((i % 8) as f32 * 0.02, (i / 8) as f32 * 0.02, 0.0),
+                density: 1.0,
                 radius_m: 0.1,
                 root_size_m: 0.03,
                 strand_length_m: 0.2,
@@ -260,6 +274,46 @@ mod tests {
             (0..40 * 64).collect::<Vec<u32>>(),
             "each root once, in order"
         );
+    }
+
+    /// A thinned bundle grows ⌈density · N⌉ strands with LOD off, never more with LOD on
+    /// close up, and still drops strands with distance; density 0 grows none.
+    #[test]
+    fn thinned_bundles_draw_their_share_of_strands() {
+        let mut thinned = bundles();
+        thinned[0].density = 0.35;
+        thinned[1].density = 0.0;
+        let off = LodSettings {
+            enabled: false,
+            ..LodSettings::default()
+        };
+        let plan = plan_frame(&thinned, 64, 5, &camera(0.3, false), &off, 1 << 20);
+        // ⌈0.35 · 64⌉ = 23 (0.35 in f32 is a hair above 0.35).
+        assert_eq!(plan.strands, 38 * 64 + 23);
+        let roots = check_runs(&plan, 1 << 20);
+        assert_eq!(
+            &roots[..23],
+            &(0..23).collect::<Vec<u32>>()[..],
+            "first samples"
+        );
+        assert_eq!(
+            roots[23], 128,
+            "bundle 1 grows nothing, bundle 2 starts at 2 · 64"
+        );
+        let on = LodSettings::default();
+        let near = plan_frame(&thinned, 64, 5, &camera(0.3, false), &on, 1 << 20);
+        assert_eq!(near.strands, plan.strands, "close up, LOD keeps the share");
+        let far = plan_frame(&thinned, 64, 5, &camera(20.0, false), &on, 1 << 20);
+        let full_far = plan_frame(&bundles(), 64, 5, &camera(20.0, false), &on, 1 << 20);
+        let first = |p: &FramePlan| {
+            p.batches
+                .iter()
+                .flatten()
+                .filter(|r| r.first_root < 64)
+                .map(|r| r.strand_count)
+                .sum::<u32>()
+        };
+        assert!(first(&far) < first(&full_far) && first(&far) >= 1);
     }
 
     #[test]

@@ -73,6 +73,8 @@ pub struct RuntimeHair {
     pub strands_per_bundle: u32,
     /// Per atlas block: 0 = global styling, `g + 1` = group `g` of [`Self::styling`].
     pub block_styling: Vec<u32>,
+    /// Per atlas block: the fraction of its strands that grow (`Bundle::density`).
+    pub block_density: Vec<f32>,
     pub styling: StylingSet,
     /// Lights, material and effects: how the hair is meant to be seen.
     pub scene: Scene,
@@ -99,6 +101,15 @@ impl RuntimeHair {
         let textures = RuntimeTextures::build(&document.hair_mesh, options.precision);
         let mut hair = Self {
             block_styling: block_styling(&textures, &document.styling),
+            block_density: textures
+                .atlas
+                .blocks
+                .iter()
+                .map(|block| {
+                    let bundle = document.hair_mesh.bundles.get(block.bundle as usize);
+                    bundle.map_or(1.0, |b| b.density as f32)
+                })
+                .collect(),
             textures,
             samples: RootSamples::default(),
             strands_per_bundle: 0,
@@ -146,6 +157,23 @@ impl RuntimeHair {
     pub fn set_styling(&mut self, styling: &StylingSet) {
         self.block_styling = block_styling(&self.textures, styling);
         self.styling = styling.clone();
+    }
+
+    /// Where each block's hair is (culling and LOD inputs) and how densely it grows: what a
+    /// frame plan ([`crate::runtime::frame_plan::plan_frame`]) takes.
+    pub fn bundle_bounds(&self) -> Vec<crate::runtime::frame_plan::BundleBounds> {
+        let mut bounds = self.textures.bundle_bounds();
+        for (bundle, density) in bounds.iter_mut().zip(&self.block_density) {
+            bundle.density = *density;
+        }
+        bounds
+    }
+
+    /// Strands block `block` grows at full detail: `⌈density · N⌉` of the
+    /// `strands_per_bundle` roots laid out for it.
+    pub fn block_strand_count(&self, block: usize) -> u32 {
+        let density = self.block_density.get(block).copied().unwrap_or(1.0);
+        crate::strands::lod::density_count(density as f64, self.strands_per_bundle)
     }
 
     /// Every strand root at full detail, bundle-major (root `i` is sample

@@ -257,6 +257,8 @@ pub fn runtime_strands(
     hair.strand_roots()
         .iter()
         .enumerate()
+        // A thinned bundle grows only its first ⌈density · N⌉ roots.
+        .filter(|(i, _)| i % per_bundle < hair.block_strand_count(i / per_bundle) as usize)
         .map(|(i, root)| {
             let block = &hair.textures.atlas.blocks[i / per_bundle];
             let params = styling

@@ -307,6 +307,7 @@ impl RuntimeTextures {
                     radius_m,
                     root_size_m,
                     strand_length_m,
+                    density: 1.0,
                 }
             })
             .collect()

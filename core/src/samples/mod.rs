@@ -393,7 +393,8 @@ fn lift_curves_out_of_body(
                     let Some((t, p, shortfall_m)) = worst else {
                         continue;
                     };
-                    if !(shortfall_m > 0.0) {
+                    // (NaN, a point off the field, is no shortfall either.)
+                    if shortfall_m.is_nan() || shortfall_m <= 0.0 {
                         continue;
                     }
                     let out = sdf.gradient(p) * shortfall_m;
@@ -435,6 +436,45 @@ fn lift_curves_out_of_body(
         if !moved {
             break;
         }
+    }
+}
+
+/// Strand density of the bundles along the hairline, from the edge in: hair thins out over a
+/// couple of centimetres instead of ending in a hard line.
+pub const HAIRLINE_DENSITY: [f64; 2] = [0.35, 0.7];
+
+/// Sets the density of the bundles on the scalp's rim to `densities[0]`, of those touching
+/// them to `densities[1]`, and so on inward (rings of bundles sharing a corner).
+pub fn thin_hairline(mesh: &mut HairMesh, densities: &[f64]) {
+    let mut edge_uses: std::collections::HashMap<(u32, u32), u32> =
+        std::collections::HashMap::new();
+    for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
+        let n = bundle.vertices.len();
+        for i in 0..n {
+            let (a, b) = (bundle.vertices[i], bundle.vertices[(i + 1) % n]);
+            *edge_uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    // Columns of the current ring's outer side: the rim first.
+    let mut front: std::collections::HashSet<u32> = edge_uses
+        .iter()
+        .filter(|(_, uses)| **uses == 1)
+        .flat_map(|(&(a, b), _)| [a, b])
+        .collect();
+    let mut ring = vec![usize::MAX; mesh.bundles.len()];
+    for (r, &density) in densities.iter().enumerate() {
+        let mut next = std::collections::HashSet::new();
+        for (b, bundle) in mesh.bundles.iter_mut().enumerate() {
+            if bundle.removed || ring[b] != usize::MAX {
+                continue;
+            }
+            if bundle.vertices.iter().any(|v| front.contains(v)) {
+                ring[b] = r;
+                bundle.density = density.clamp(0.0, 1.0);
+                next.extend(bundle.vertices.iter().copied());
+            }
+        }
+        front = next;
     }
 }
 
@@ -578,7 +618,8 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
         .iter()
         .map(|(name, growth)| {
             let shaped = grow(&scalp, *growth, radii_m);
-            let mesh = keep_out_of_body(&shaped, &body);
+            let mut mesh = keep_out_of_body(&shaped, &body);
+            thin_hairline(&mut mesh, &HAIRLINE_DENSITY);
             let mut document = Document::new(*name, mesh);
             document.styling.global = head_style(name);
             document.scene.material = head_material(name);

@@ -59,6 +59,38 @@ pub fn strand_count(level: f64, strands: u32, delta: f64) -> u32 {
     (count as u32).min(strands)
 }
 
+/// Strands a bundle of `strands` grows at `density` (the fraction that grow, see
+/// `Bundle::density`): `⌈density · N⌉`, none for 0 (or NaN), all for 1.
+pub fn density_count(density: f64, strands: u32) -> u32 {
+    let density = if density.is_nan() {
+        0.0
+    } else {
+        density.clamp(0.0, 1.0)
+    };
+    ((density * strands as f64).ceil() as u32).min(strands)
+}
+
+#[cfg(test)]
+mod density_tests {
+    use super::density_count;
+
+    #[test]
+    fn density_count_rounds_up_and_stays_in_range() {
+        assert_eq!(density_count(1.0, 64), 64);
+        assert_eq!(density_count(0.5, 64), 32);
+        assert_eq!(density_count(0.34, 64), 22, "21.76 rounds up");
+        assert_eq!(
+            density_count(0.001, 64),
+            1,
+            "a thinned bundle keeps a strand"
+        );
+        assert_eq!(density_count(0.0, 64), 0);
+        assert_eq!(density_count(f64::NAN, 64), 0);
+        assert_eq!(density_count(7.0, 64), 64);
+        assert_eq!(density_count(-1.0, 64), 0);
+    }
+}
+
 /// Thickness factor that compensates for dropped strands: `min(1/L, N)` (eq. 8 text).
 /// Equals `N` as `L → 0` and 1 for `L = 1`.
 pub fn thickness_factor(level: f64, strands: u32) -> f64 {

@@ -206,7 +206,9 @@ impl StrandPlan {
         } else {
             &self.quad_samples
         };
-        samples[..self.count]
+        // A thinned bundle (hairline) grows the first ⌈density · N⌉ of its samples.
+        let count = crate::strands::lod::density_count(bundle.density, self.count as u32);
+        samples[..count as usize]
             .iter()
             .filter_map(|sample| {
                 let coord = FaceCoord {

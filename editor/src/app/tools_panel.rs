@@ -13,6 +13,8 @@ pub struct ToolsPanel {
     pub layer: u32,
     /// The bundle whose shape Copy shape took (wisp copy / paste).
     pub copied_shape: Option<u32>,
+    /// The strand density Set density gives the selected bundles.
+    pub density: f64,
 }
 
 impl Default for ToolsPanel {
@@ -21,6 +23,7 @@ impl Default for ToolsPanel {
             extrude_distance_m: 0.02,
             layer: 1,
             copied_shape: None,
+            density: 0.5,
         }
     }
 }
@@ -89,13 +92,16 @@ impl ToolsPanel {
             .labelled_by(label.id)
             .on_hover_text("Unselected vertices this close follow with a smooth falloff (wheel while transforming)");
         });
-        ui.checkbox(&mut state.tool.xray, "X-ray")
-            .on_hover_text("Select through the head: clicks and regions also take bundles and vertices the body hides");
-        ui.checkbox(&mut state.tool.z_up, "Z up (Blender axes)")
-            .on_hover_text(
-                "Axis keys and typed values in G / R / S: on, Z is up and Y points away from \
-                 the front view (Blender); off, the scene's own axes (Y up, Z toward the front)",
-            );
+        // One row for both switches: the panel has no height to spare.
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut state.tool.xray, "X-ray")
+                .on_hover_text("Select through the head: clicks and regions also take bundles and vertices the body hides");
+            ui.checkbox(&mut state.tool.z_up, "Z up (Blender axes)")
+                .on_hover_text(
+                    "Axis keys and typed values in G / R / S: on, Z is up and Y points away from \
+                     the front view (Blender); off, the scene's own axes (Y up, Z toward the front)",
+                );
+        });
         ui.label(
             egui::RichText::new(
                 "G move · R rotate · S scale in the viewport; X / Y / Z lock an axis; \
@@ -148,6 +154,27 @@ impl ToolsPanel {
             }
             if ui.button("Subdivide").clicked() {
                 state.edit_mesh("Subdivide", edit::subdivide);
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::DragValue::new(&mut self.density)
+                    .range(0.0..=1.0)
+                    .speed(0.01)
+                    .max_decimals(2),
+            )
+            .on_hover_text("The fraction of their strands the bundles grow");
+            if ui
+                .button("Set density")
+                .on_hover_text(
+                    "Thin the selected bundles' strands (a hairline thins out instead of ending in a hard edge)",
+                )
+                .clicked()
+            {
+                let density = self.density;
+                state.edit_mesh("Set density", |mesh, bundles| {
+                    edit::set_density(mesh, bundles, density)
+                });
             }
         });
         ui.horizontal(|ui| {

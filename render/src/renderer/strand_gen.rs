@@ -465,7 +465,7 @@ impl StrandGenRenderer {
             sample_set: sample_set as u32,
             root_count: block_count * per_bundle,
             styling: buffer("strand_gen_styling", styling_bytes),
-            bundles: textures.bundle_bounds(),
+            bundles: hair.bundle_bounds(),
             per_bundle: per_bundle as u32,
             bytes: a
                 + b
