@@ -59,6 +59,23 @@ fn open_archive(bytes: &[u8]) -> (FileReader, Archive) {
     (reader, archive)
 }
 
+/// Child `i` of `parent`, read with the archive's metadata table and time samplings.
+fn load_child(
+    parent: &ObjectReader,
+    i: usize,
+    reader: &mut FileReader,
+    archive: &Archive,
+) -> ObjectReader {
+    parent
+        .load_child(
+            i,
+            reader,
+            &archive.indexed_meta_data,
+            &archive.time_samplings,
+        )
+        .expect("child")
+}
+
 struct Read {
     counts: Vec<i32>,
     points: Vec<[f32; 3]>,
@@ -126,14 +143,7 @@ fn read_file(bytes: Vec<u8>) -> (Read, Read, String) {
     assert_eq!(root.child_count(), 2);
     let mut objects = Vec::new();
     for i in 0..root.child_count() {
-        let child = root
-            .load_child(
-                i,
-                &mut reader,
-                &archive.indexed_meta_data,
-                &archive.time_samplings,
-            )
-            .expect("child");
+        let child = load_child(&root, i, &mut reader, &archive);
         assert_eq!(
             child
                 .header
@@ -419,14 +429,7 @@ fn metadata_past_the_indexed_table_is_written_inline_and_read_back() {
     let root = archive.load_root_object(&mut reader).expect("root");
     assert_eq!(root.child_count(), 300);
     for i in [0, 5, 252, 253, 299] {
-        let child = root
-            .load_child(
-                i,
-                &mut reader,
-                &archive.indexed_meta_data,
-                &archive.time_samplings,
-            )
-            .expect("child");
+        let child = load_child(&root, i, &mut reader, &archive);
         let tokens = &child.header.meta_data.tokens;
         assert_eq!(tokens.get("index"), Some(&i.to_string()), "object {i}");
         let note = if i == 5 { long.as_str() } else { "short" };

@@ -352,7 +352,8 @@ fn lift_curves_out_of_body(
             .iter()
             .map(|c| vec![DVec3::ZERO; c.positions.len()])
             .collect();
-        for (b, bundle) in mesh.bundles.iter().enumerate() {
+        // A removed bundle grows no strands to lift.
+        for (b, bundle) in mesh.bundles.iter().enumerate().filter(|(_, b)| !b.removed) {
             let corners = bundle.vertices.len().min(4);
             let mut samples: Vec<[f64; 4]> = Vec::with_capacity(2 * corners + 1);
             for i in 0..corners {
@@ -446,20 +447,10 @@ pub const HAIRLINE_DENSITY: [f64; 2] = [0.35, 0.7];
 /// Sets the density of the bundles on the scalp's rim to `densities[0]`, of those touching
 /// them to `densities[1]`, and so on inward (rings of bundles sharing a corner).
 pub fn thin_hairline(mesh: &mut HairMesh, densities: &[f64]) {
-    let mut edge_uses: std::collections::HashMap<(u32, u32), u32> =
-        std::collections::HashMap::new();
-    for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
-        let n = bundle.vertices.len();
-        for i in 0..n {
-            let (a, b) = (bundle.vertices[i], bundle.vertices[(i + 1) % n]);
-            *edge_uses.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    // Columns of the current ring's outer side: the rim first.
-    let mut front: std::collections::HashSet<u32> = edge_uses
-        .iter()
-        .filter(|(_, uses)| **uses == 1)
-        .flat_map(|(&(a, b), _)| [a, b])
+    // Columns of the current ring's outer side: the rim (root boundary) first.
+    let topology = crate::model::mesh::Topology::build(mesh);
+    let mut front: std::collections::HashSet<u32> = (0..mesh.columns.len() as u32)
+        .filter(|&c| topology.root_boundary[c as usize])
         .collect();
     let mut ring = vec![usize::MAX; mesh.bundles.len()];
     for (r, &density) in densities.iter().enumerate() {
