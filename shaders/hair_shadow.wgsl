@@ -11,8 +11,11 @@ struct ShadowVertex {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vertex_index: u32) -> ShadowVertex {
-    let ribbon = ribbon_vertex(vertex_index);
+fn vs_main(
+    @builtin(vertex_index) vertex_index: u32,
+    @builtin(instance_index) instance_index: u32,
+) -> ShadowVertex {
+    let ribbon = ribbon_vertex(vertex_index, instance_index);
     var out: ShadowVertex;
     out.clip = ribbon.clip;
     out.coverage = ribbon.coverage;

@@ -22,8 +22,11 @@ struct VertexOutput {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vertex_index: u32) -> VertexOutput {
-    let ribbon = ribbon_vertex(vertex_index);
+fn vs_main(
+    @builtin(vertex_index) vertex_index: u32,
+    @builtin(instance_index) instance_index: u32,
+) -> VertexOutput {
+    let ribbon = ribbon_vertex(vertex_index, instance_index);
     var out: VertexOutput;
     out.clip = ribbon.clip;
     out.world = ribbon.world;

@@ -1,5 +1,10 @@
 // strand_gen: every vertex of every styled strand, from the five runtime textures alone
-// (seed 000 §3.1-3.4). One invocation per strand vertex:
+// (seed 000 §3.1-3.4). `main`: one invocation per strand, which computes what the strand's
+// vertices share once (root, root uv, length, the styling ops' random phases, keys and clump
+// pull: `strand_input`) and then walks its vertices, morphing each odd one from the
+// neighbours it has just computed. `main_per_vertex`: one invocation per vertex, redoing the
+// per-strand set-up at every vertex (and three vertices for a morphed one) — the earlier
+// split, kept as a switch because a GPU may prefer its coalesced writes. Per vertex:
 // - position: two filtered fetches of the hair-mesh texture and one lerp (one quadratic
 //   Bézier of the column curves);
 // - the styling frame û, v̂ and the styling coordinate w: one filtered fetch each between
@@ -15,70 +20,8 @@
 // `positions[run.vertex_offset + strand * run.vertex_count + k]` = (position, along), one
 // bounded scratch buffer per batch of runs; odd vertices morph toward their neighbours'
 // midpoint by the run's γ (eq. 11).
-// Structs: keep in sync with core/src/runtime/gpu_types.rs.
-
-struct StrandGenParams {
-    position_offset: vec4<f32>,
-    vertex_total: u32,
-    run_count: u32,
-    filtering: u32,
-    first_run: u32,
-    per_bundle: u32,
-    sample_set: u32,
-    _padding: vec2<u32>,
-}
-
-struct BundleGpu {
-    origin_texel: vec2<f32>,
-    layers: u32,
-    styling: u32,
-    rotation: u32,
-    triangle: u32,
-    _padding: vec2<u32>,
-}
-
-// struct StrandRun: shaders/shared/strand_run.wgsl, prepended by render/src/.
-
-struct StrandRoot {
-    texel: vec2<f32>,
-    centre_texel: vec2<f32>,
-    layers: u32,
-    styling: u32,
-    _padding: vec2<u32>,
-}
-
-struct Styling {
-    curl_radius_m: f32,
-    curl_turns_per_m: f32,
-    curl_ramp_in_m: f32,
-    curl_radius_jitter: f32,
-    twist_turns_per_m: f32,
-    noise_amplitude_m: f32,
-    noise_frequency_per_m: f32,
-    noise_octaves: u32,
-    clump_strength: f32,
-    clump_clumps_per_uv: f32,
-    clump_radius_m: f32,
-    clump_tightening: f32,
-    frizz_amplitude_m: f32,
-    frizz_frequency_per_m: f32,
-    frizz_fraction: f32,
-    length_fraction: f32,
-    wave_amplitude_m: f32,
-    wave_frequency_per_m: f32,
-    wave_direction_rad: f32,
-    wave_phase_spread: f32,
-    wave_ramp_in_m: f32,
-    variation_per_uv: f32,
-    seed: u32,
-    _padding: u32,
-}
-
-const SLICES_PER_SEGMENT: u32 = 4u;
-const FILTERING_EXACT: u32 = 0u;
-const TAU: f32 = 6.283185307179586;
-// Mirror: NOISE_KEY_SPAN in core/src/strands/styling.rs.
-const NOISE_KEY_SPAN: f32 = 16.0;
+// The vertex itself (structs, fetches, styling ops): shared/strand_vertex.wgsl, prepended by
+// render/src/ with shared/strand_run.wgsl.
 
 @group(0) @binding(0) var<uniform> params: StrandGenParams;
 @group(0) @binding(1) var<storage, read> bundles: array<BundleGpu>;
@@ -95,335 +38,56 @@ const NOISE_KEY_SPAN: f32 = 16.0;
 // `sample_set` for triangles (barycentric).
 @group(0) @binding(11) var<storage, read> samples: array<vec2<f32>>;
 
-// Trilinear filtering in f32 with textureLoad: the "exact" switch (mirror: sample_trilinear
-// with Filtering::Exact). Texel centres sit at i + 0.5; clamp to the edge.
-fn fetch_exact(texture: texture_3d<f32>, coord: vec3<f32>) -> vec4<f32> {
-    let size = vec3<i32>(textureDimensions(texture));
-    let x = clamp(coord - vec3<f32>(0.5), vec3<f32>(0.0), vec3<f32>(size - vec3<i32>(1)));
-    let i0 = min(vec3<i32>(floor(x)), max(size - vec3<i32>(2), vec3<i32>(0)));
-    let f = x - vec3<f32>(i0);
-    let i1 = min(i0 + vec3<i32>(1), size - vec3<i32>(1));
-    let c000 = textureLoad(texture, vec3<i32>(i0.x, i0.y, i0.z), 0);
-    let c100 = textureLoad(texture, vec3<i32>(i1.x, i0.y, i0.z), 0);
-    let c010 = textureLoad(texture, vec3<i32>(i0.x, i1.y, i0.z), 0);
-    let c110 = textureLoad(texture, vec3<i32>(i1.x, i1.y, i0.z), 0);
-    let c001 = textureLoad(texture, vec3<i32>(i0.x, i0.y, i1.z), 0);
-    let c101 = textureLoad(texture, vec3<i32>(i1.x, i0.y, i1.z), 0);
-    let c011 = textureLoad(texture, vec3<i32>(i0.x, i1.y, i1.z), 0);
-    let c111 = textureLoad(texture, vec3<i32>(i1.x, i1.y, i1.z), 0);
-    let bottom0 = c000 + (c100 - c000) * f.x;
-    let top0 = c010 + (c110 - c010) * f.x;
-    let plane0 = bottom0 + (top0 - bottom0) * f.y;
-    let bottom1 = c001 + (c101 - c001) * f.x;
-    let top1 = c011 + (c111 - c011) * f.x;
-    let plane1 = bottom1 + (top1 - bottom1) * f.y;
-    return plane0 + (plane1 - plane0) * f.z;
-}
-
-// The filtering switch: exact (manual, f32 weights) or the texture unit's (8-bit weights).
-fn fetch(texture: texture_3d<f32>, coord: vec3<f32>) -> vec4<f32> {
-    if params.filtering == FILTERING_EXACT {
-        return fetch_exact(texture, coord);
-    }
-    let size = vec3<f32>(textureDimensions(texture));
-    return textureSampleLevel(texture, linear_clamp, coord / size, 0.0);
-}
-
-// Mirror: StrandGen::strand_position.
-fn strand_position(texel: vec2<f32>, layers: u32, tau_in: f32) -> vec3<f32> {
-    let layer_count = max(layers, 1u);
-    let tau = clamp(tau_in, 0.0, f32(layer_count));
-    let segment = min(u32(floor(tau)), layer_count - 1u);
-    let local = tau - f32(segment);
-    var first_slice = SLICES_PER_SEGMENT * segment;
-    var q = local * 2.0;
-    if local >= 0.5 {
-        first_slice = first_slice + 2u;
-        q = local * 2.0 - 1.0;
-    }
-    let a = fetch(hair_mesh, vec3<f32>(texel, f32(first_slice) + q + 0.5)).xyz;
-    let b = fetch(hair_mesh, vec3<f32>(texel, f32(first_slice) + 1.0 + q + 0.5)).xyz;
-    return a + (b - a) * q + params.position_offset.xyz;
-}
-
-// --- Deterministic randomness (mirror: core/src/strands/random.rs, core/src/strands/styling.rs) ---
-
-fn pcg_hash(value: u32) -> u32 {
-    let state = value * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
-fn hash3(a: u32, b: u32, c: u32) -> u32 {
-    return pcg_hash(pcg_hash(pcg_hash(0x6A09E667u ^ a) ^ b) ^ c);
-}
-
-fn hash4(a: u32, b: u32, c: u32, d: u32) -> u32 {
-    return pcg_hash(hash3(a, b, c) ^ d);
-}
-
-fn hash_to_unit(hash: u32) -> f32 {
-    return f32(hash >> 8u) * (1.0 / 16777216.0);
-}
-
-fn fade(t: f32) -> f32 {
-    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
-}
-
-// Float cell index to the u32 the CPU gets from `as i64 as u32`.
-fn cell_index(cell: f32) -> u32 {
-    return bitcast<u32>(i32(cell));
-}
-
-fn value_noise_2d(p: vec2<f32>, seed: u32, channel: u32) -> f32 {
-    let cell = floor(p);
-    let f = p - cell;
-    let ix = cell_index(cell.x);
-    let iy = cell_index(cell.y);
-    let l00 = hash_to_unit(hash4(seed, channel, ix, iy));
-    let l10 = hash_to_unit(hash4(seed, channel, ix + 1u, iy));
-    let l01 = hash_to_unit(hash4(seed, channel, ix, iy + 1u));
-    let l11 = hash_to_unit(hash4(seed, channel, ix + 1u, iy + 1u));
-    let fx = fade(f.x);
-    let fy = fade(f.y);
-    let bottom = l00 + (l10 - l00) * fx;
-    let top = l01 + (l11 - l01) * fx;
-    return bottom + (top - bottom) * fy;
-}
-
-fn value_noise_1d(x: f32, seed: u32, channel: u32) -> f32 {
-    let cell = floor(x);
-    let f = fade(x - cell);
-    let i = cell_index(cell);
-    let l0 = hash_to_unit(hash3(seed, channel, i)) * 2.0 - 1.0;
-    let l1 = hash_to_unit(hash3(seed, channel, i + 1u)) * 2.0 - 1.0;
-    return l0 + (l1 - l0) * f;
-}
-
-fn strand_random(s: Styling, root_uv: vec2<f32>, channel: u32) -> f32 {
-    return value_noise_2d(root_uv * s.variation_per_uv, s.seed, channel);
-}
-
-fn ramp(edge: f32, x: f32) -> f32 {
-    if edge <= 0.0 {
-        return select(0.0, 1.0, x > 0.0);
-    }
-    let t = clamp(x / edge, 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
-}
-
-fn clump_pull(x: vec2<f32>, seed: u32) -> vec2<f32> {
-    let cell = floor(x);
-    var weighted = vec2<f32>(0.0);
-    var total = 0.0;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let c = cell + vec2<f32>(f32(dx), f32(dy));
-            let ix = cell_index(c.x);
-            let iy = cell_index(c.y);
-            let jitter = vec2<f32>(
-                hash_to_unit(hash4(seed, 40u, ix, iy)),
-                hash_to_unit(hash4(seed, 41u, ix, iy)),
-            );
-            let centre = c + jitter;
-            let d = centre - x;
-            let k = max(1.0 - dot(d, d), 0.0);
-            weighted += k * k * d;
-            total += k * k;
-        }
-    }
-    return weighted / (total + 0.25);
-}
-
-// Mirror: styling::styling_offset (without twist).
-fn styling_offset(
-    s: Styling,
-    u: vec3<f32>,
-    v: vec3<f32>,
-    root_uv: vec2<f32>,
-    w: f32,
-    along: f32,
-) -> vec3<f32> {
-    if along <= 0.0 || w <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    var offset = vec3<f32>(0.0);
-    if s.curl_radius_m != 0.0 {
-        let phase = TAU * s.curl_turns_per_m * w + TAU * strand_random(s, root_uv, 1u);
-        let radius = s.curl_radius_m
-            * (1.0 + s.curl_radius_jitter * (2.0 * strand_random(s, root_uv, 2u) - 1.0));
-        offset += ramp(s.curl_ramp_in_m, w) * radius * (cos(phase) * u + sin(phase) * v);
-    }
-    if s.noise_amplitude_m != 0.0 {
-        let key_u = NOISE_KEY_SPAN * strand_random(s, root_uv, 3u);
-        let key_v = NOISE_KEY_SPAN * strand_random(s, root_uv, 4u);
-        var nu = 0.0;
-        var nv = 0.0;
-        var gain = 1.0;
-        var frequency = s.noise_frequency_per_m;
-        for (var octave = 0u; octave < max(s.noise_octaves, 1u); octave++) {
-            nu += gain * value_noise_1d(frequency * w + key_u, s.seed, 10u + octave);
-            nv += gain * value_noise_1d(frequency * w + key_v, s.seed, 20u + octave);
-            gain *= 0.5;
-            frequency *= 2.0;
-        }
-        offset += s.noise_amplitude_m * along * (nu * u + nv * v);
-    }
-    if s.clump_strength != 0.0 && s.clump_clumps_per_uv > 0.0 {
-        let pull = clump_pull(root_uv * s.clump_clumps_per_uv, s.seed);
-        let scale = s.clump_strength * pow(along, s.clump_tightening) * s.clump_radius_m;
-        offset += scale * (pull.x * u + pull.y * v);
-    }
-    if s.frizz_amplitude_m != 0.0 && strand_random(s, root_uv, 6u) < s.frizz_fraction {
-        let key = NOISE_KEY_SPAN * strand_random(s, root_uv, 7u);
-        let a = value_noise_1d(s.frizz_frequency_per_m * w + key, s.seed, 30u);
-        let b = value_noise_1d(s.frizz_frequency_per_m * w + key + 500.0, s.seed, 31u);
-        offset += s.frizz_amplitude_m * along * along * (a * u + b * v);
-    }
-    if s.wave_amplitude_m != 0.0 {
-        let phase = TAU * s.wave_frequency_per_m * w
-            + s.wave_phase_spread * TAU * strand_random(s, root_uv, 8u);
-        let direction = cos(s.wave_direction_rad) * u + sin(s.wave_direction_rad) * v;
-        offset += ramp(s.wave_ramp_in_m, w) * s.wave_amplitude_m * sin(phase) * direction;
-    }
-    return offset;
-}
-
-// Mirror: frames::fallback_frame(n).v (a unit vector perpendicular to n).
-fn perpendicular(n: vec3<f32>) -> vec3<f32> {
-    let sign = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    return vec3<f32>(b, sign + n.y * n.y * a, -n.y);
-}
-
-fn normalize_or(x: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
-    let length_squared = dot(x, x);
-    if !(length_squared > 1e-30) {
-        return fallback;
-    }
-    return x * inverseSqrt(length_squared);
-}
-
-// Mirror: styling::apply_twist (Rodrigues about the bundle's centre strand).
-fn twist(s: Styling, p: vec3<f32>, centre: vec3<f32>, axis: vec3<f32>, w: f32) -> vec3<f32> {
-    if s.twist_turns_per_m == 0.0 || w <= 0.0 {
-        return p;
-    }
-    let angle = TAU * s.twist_turns_per_m * w;
-    let o = p - centre;
-    let c = cos(angle);
-    let sn = sin(angle);
-    return centre + o * c + cross(axis, o) * sn + axis * dot(axis, o) * (1.0 - c);
-}
-
-// Mirror: runtime::strand_root (Atlas::sample_block_coords).
-fn strand_root(root_index: u32) -> StrandRoot {
-    let bundle = bundles[root_index / params.per_bundle];
-    let sample_index = root_index % params.per_bundle;
-    var coords: vec2<f32>;
-    var centre: vec2<f32>;
-    if bundle.triangle != 0u {
-        // Barycentric (s, t) to block coordinates (s / (1 − t), t).
-        let sample = samples[params.sample_set + sample_index];
-        let denominator = 1.0 - sample.y;
-        var s = 0.0;
-        if denominator > 0.0 {
-            s = clamp(sample.x / denominator, 0.0, 1.0);
-        }
-        coords = vec2<f32>(s, sample.y);
-        centre = vec2<f32>(0.5, 1.0 / 3.0);
-    } else {
-        // `rotation` quarter turns (s, t) ↦ (t, 1 − s).
-        coords = samples[sample_index];
-        for (var turn = 0u; turn < bundle.rotation; turn++) {
-            coords = vec2<f32>(coords.y, 1.0 - coords.x);
-        }
-        centre = vec2<f32>(0.5, 0.5);
-    }
-    var root: StrandRoot;
-    root.texel = bundle.origin_texel + coords;
-    root.centre_texel = bundle.origin_texel + centre;
-    root.layers = bundle.layers;
-    root.styling = bundle.styling;
-    return root;
-}
-
-// The run holding scratch vertex `vertex` (binary search over the batch's runs).
-fn find_run(vertex: u32) -> u32 {
-    var low = params.first_run;
-    var high = params.first_run + params.run_count - 1u;
-    while low < high {
-        let middle = (low + high + 1u) / 2u;
-        if runs[middle].vertex_offset <= vertex {
-            low = middle;
-        } else {
-            high = middle - 1u;
-        }
-    }
-    return low;
-}
-
-struct StrandInput {
-    root: StrandRoot,
-    style: Styling,
-    root_uv: vec2<f32>,
-    length_fraction: f32,
-}
-
-// Vertex k of n of a styled strand (mirror: StrandGen::styled_vertex).
-fn styled_vertex(input: StrandInput, k: u32, n: u32) -> vec3<f32> {
-    let root = input.root;
-    let s = input.style;
-    let along = f32(k) / f32(n - 1u);
-    let tau = f32(root.layers) * input.length_fraction * along;
-    var p = strand_position(root.texel, root.layers, tau);
-    if k == 0u {
-        return p;
-    }
-    let layer_coord = vec3<f32>(root.texel, tau + 0.5);
-    let u = normalize_or(fetch(u_texture, layer_coord).xyz, vec3<f32>(1.0, 0.0, 0.0));
-    let v = normalize_or(fetch(v_texture, layer_coord).xyz, vec3<f32>(0.0, 1.0, 0.0));
-    let w_axis = normalize_or(cross(u, v), perpendicular(u));
-    let w = fetch(w_texture, layer_coord).x;
-    if s.twist_turns_per_m != 0.0 {
-        let centre = strand_position(root.centre_texel, root.layers, tau);
-        p = twist(s, p, centre, w_axis, w);
-    }
-    return p + styling_offset(s, u, v, input.root_uv, w, along);
-}
-
+// One invocation per strand: the set-up once, then every vertex in order; an odd vertex is
+// written once its right neighbour exists (eq. 11 morph by the run's γ).
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let strand = id.x;
+    if params.run_count == 0u || strand >= params.strand_total {
+        return;
+    }
+    let run = runs[find_run(params.first_run, params.run_count, strand, RUN_BY_STRAND)];
+    let n = max(run.vertex_count, 2u);
+    let local = strand - run_start(run, RUN_BY_STRAND);
+    let base = run.vertex_offset + local * n;
+    let input = strand_input(run.first_root + local);
+    var previous = styled_vertex(input, 0u, n);
+    positions[base] = vec4<f32>(previous, 0.0);
+    for (var k = 1u; k < n; k += 2u) {
+        let current = styled_vertex(input, k, n);
+        if k + 1u < n {
+            let next = styled_vertex(input, k + 1u, n);
+            var p = current;
+            if run.gamma > 0.0 {
+                p = mix(current, 0.5 * (previous + next), run.gamma);
+            }
+            positions[base + k] = vec4<f32>(p, along_of(k, n));
+            positions[base + k + 1u] = vec4<f32>(next, along_of(k + 1u, n));
+            previous = next;
+        } else {
+            positions[base + k] = vec4<f32>(current, along_of(k, n));
+        }
+    }
+}
+
+// One invocation per vertex: the strand's set-up again at every vertex.
+@compute @workgroup_size(64)
+fn main_per_vertex(@builtin(global_invocation_id) id: vec3<u32>) {
     let vertex = id.x;
     if params.run_count == 0u || vertex >= params.vertex_total {
         return;
     }
-    let run = runs[find_run(vertex)];
+    let run = runs[find_run(params.first_run, params.run_count, vertex, RUN_BY_VERTEX)];
     let n = max(run.vertex_count, 2u);
     let local = vertex - run.vertex_offset;
     let strand = local / n;
     let k = local % n;
-    let root = strand_root(run.first_root + strand);
-    var style_index = root.styling;
-    if style_index >= arrayLength(&styling) {
-        style_index = 0u;
-    }
-    var input: StrandInput;
-    input.root = root;
-    input.style = styling[style_index];
-    // Root uv: always exact (it seeds every per-strand random value).
-    input.root_uv = fetch_exact(uv_texture, vec3<f32>(root.texel, 0.5)).xy;
-    input.length_fraction = 1.0;
-    if input.style.length_fraction > 0.0 {
-        input.length_fraction = 1.0
-            - input.style.length_fraction * strand_random(input.style, input.root_uv, 5u);
-    }
+    let input = strand_input(run.first_root + strand);
     var p = styled_vertex(input, k, n);
     if run.gamma > 0.0 && k % 2u == 1u && k + 1u < n {
         // Eq. 11: odd vertices slide toward their neighbours' midpoint.
         let middle = 0.5 * (styled_vertex(input, k - 1u, n) + styled_vertex(input, k + 1u, n));
         p = mix(p, middle, run.gamma);
     }
-    positions[vertex] = vec4<f32>(p, f32(k) / f32(n - 1u));
+    positions[vertex] = vec4<f32>(p, along_of(k, n));
 }

@@ -51,6 +51,7 @@ use glam::{Mat4, Vec3};
 use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere, shadow_views};
 use hairloom_core::model::scene::{Coverage, Scene, SelfShadowing};
 use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
+use hairloom_core::runtime::gpu_types::StrandRun;
 use hairloom_core::runtime::hair::RuntimeHair;
 use hairloom_core::runtime::strand_gen::Filtering;
 
@@ -60,7 +61,7 @@ use crate::renderer::Targets;
 use crate::renderer::body_shadow::BodyShadowRenderer;
 use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::preview_body::{BodyRenderer, GpuBody, PreparedBody};
-use crate::renderer::preview_hair::{HairRenderer, HairUniforms, PreparedHair};
+use crate::renderer::preview_hair::{HairRenderer, HairUniforms, PreparedHair, RibbonInput};
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, effects_layout};
 use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer};
 use crate::resources::Tracked;
@@ -132,7 +133,8 @@ pub struct GameHair {
 struct PreparedFrame {
     hair: PreparedHair,
     body: PreparedBody,
-    segments: u32,
+    /// The frame's one batch.
+    runs: Vec<StrandRun>,
     _runs: wgpu::Buffer,
     _scratch: Tracked<wgpu::Buffer>,
 }
@@ -211,8 +213,13 @@ impl GameHair {
         self.hair = HairRenderer::with_targets(context, targets);
         self.body_renderer = BodyRenderer::with_targets(context, targets);
         let scene_layout = &self.lighting.scene_layout;
-        self.hair
-            .ensure(context, &active, scene_layout, effects_layout.as_ref());
+        self.hair.ensure(
+            context,
+            &active,
+            scene_layout,
+            effects_layout.as_ref(),
+            RibbonInput::Buffer,
+        );
         self.body_renderer.ensure(
             context,
             active.shader_key(),
@@ -229,6 +236,7 @@ impl GameHair {
                 active.opacity_layers,
                 active.shadow_resolution,
                 slots,
+                RibbonInput::Buffer,
             )
         });
         self.body_shadow = (active.body_shadows && slots > 0).then(|| {
@@ -340,10 +348,7 @@ impl GameHair {
         }
         let runs = self.generator.upload_runs(context, &plan);
         let scratch = self.generator.scratch(context, &plan);
-        let segments = plan
-            .batches
-            .first()
-            .map_or(0, |b| FramePlan::batch_segments(b) as u32);
+        let batch_runs = plan.batches.first().cloned().unwrap_or_default();
         if let Some(batch) = plan.batches.first() {
             self.generator.encode(
                 context,
@@ -399,7 +404,7 @@ impl GameHair {
             }
             if let Some(hair_shadow) = &self.hair_shadow {
                 if hair_shadow.kind == SelfShadowing::DeepOpacityMaps {
-                    hair_shadow.encode_depth(encoder, &hair, slot, 0, segments, true);
+                    hair_shadow.encode_depth(encoder, &hair, slot, 0, &batch_runs, true);
                 }
                 hair_shadow.encode_opacity(
                     encoder,
@@ -407,7 +412,7 @@ impl GameHair {
                     &self.lighting.scene_group,
                     slot,
                     0,
-                    segments,
+                    &batch_runs,
                     true,
                 );
             }
@@ -415,7 +420,7 @@ impl GameHair {
         self.frame = Some(PreparedFrame {
             hair,
             body,
-            segments,
+            runs: batch_runs,
             _runs: runs,
             _scratch: scratch,
         });
@@ -441,7 +446,7 @@ impl GameHair {
             .into_iter()
             .flatten()
         {
-            HairRenderer::draw_with(pass, pipeline, &frame.hair, 0, 0, frame.segments);
+            HairRenderer::draw_with(pass, pipeline, &frame.hair, 0, 0, &frame.runs);
         }
     }
 }

@@ -28,9 +28,11 @@ use crate::renderer::body_shadow::BodyShadowRenderer;
 use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody};
-use crate::renderer::preview_hair::{HairRenderer, HairUniforms};
+use crate::renderer::preview_hair::{HairRenderer, HairUniforms, RibbonInput};
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
-use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
+use crate::renderer::strand_gen::{
+    GenerationPath, GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit,
+};
 use crate::view::View;
 
 /// A perspective camera looking at `target`.
@@ -125,7 +127,13 @@ struct FrameState {
 impl FrameState {
     /// Makes what `active` needs and frees what it does not; returns the material's mean
     /// forward transmittance per fibre.
-    fn sync(&mut self, context: &GpuContext, active: &ActiveEffects, scene: &Scene) -> [f32; 3] {
+    fn sync(
+        &mut self,
+        context: &GpuContext,
+        active: &ActiveEffects,
+        scene: &Scene,
+        input: RibbonInput,
+    ) -> [f32; 3] {
         let mean_forward = self.lighting.sync(context, active, &scene.material);
         let layout_key = (
             active.opacity_maps,
@@ -143,8 +151,13 @@ impl FrameState {
             self.body = BodyRenderer::new(context, self.hair_sample_count());
         }
         let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
-        self.hair
-            .ensure(context, active, &self.lighting.scene_layout, effects_layout);
+        self.hair.ensure(
+            context,
+            active,
+            &self.lighting.scene_layout,
+            effects_layout,
+            input,
+        );
         self.body.ensure(
             context,
             active.shader_key(),
@@ -159,6 +172,7 @@ impl FrameState {
                     active.opacity_layers,
                     active.shadow_resolution,
                     slots,
+                    input,
                 )
             });
             if !fits {
@@ -171,6 +185,7 @@ impl FrameState {
                     active.opacity_layers,
                     active.shadow_resolution,
                     slots,
+                    input,
                 ));
             }
         } else {
@@ -352,7 +367,17 @@ impl PreviewRenderer {
         let active = self.active_effects(context, scene)?;
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         let state = &mut *state;
-        let mean_forward = state.sync(context, &active, scene.lighting);
+        // Ribbons read their vertices from a buffer unless the generator makes them in the
+        // vertex shader.
+        let input = match &scene.hair {
+            HairSource::Generated { generator, .. }
+                if generator.path() == GenerationPath::VertexShader =>
+            {
+                RibbonInput::Generated
+            }
+            _ => RibbonInput::Buffer,
+        };
+        let mean_forward = state.sync(context, &active, scene.lighting, input);
         View::ensure(&mut state.view, context, width, height, self.sample_count);
         let view = state.view.as_ref().expect("made above");
         if let Some(oit) = &mut state.oit {
@@ -441,6 +466,11 @@ impl PreviewRenderer {
                 (&owned, 0)
             }
             HairSource::Stored { buffer, .. } => (buffer, 0),
+            // No scratch: the ribbons bind the textures instead.
+            HairSource::Generated { .. } if input == RibbonInput::Generated => {
+                owned = storage("preview_no_strands", &[0; 16]);
+                (&owned, 0)
+            }
             HairSource::Generated { generator, .. } => {
                 scratch = generator.scratch(context, plan);
                 (&scratch, scratch.size())
@@ -473,9 +503,22 @@ impl PreviewRenderer {
             },
             &shadow_views,
         );
-        let prepared_hair = state
-            .hair
-            .prepare(context, &hair_views, &ranges, strands, &runs);
+        let prepared_hair = match generator {
+            Some((generator, gpu_hair, filtering)) if input == RibbonInput::Generated => {
+                state.hair.prepare_generated(
+                    context,
+                    &hair_views,
+                    &ranges,
+                    generator,
+                    gpu_hair,
+                    filtering,
+                    &runs,
+                )
+            }
+            _ => state
+                .hair
+                .prepare(context, &hair_views, &ranges, strands, &runs),
+        };
         let prepared_body = state.body.prepare(context, &body_views);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("preview"),
@@ -488,7 +531,7 @@ impl PreviewRenderer {
             let Some((generator, gpu_hair, filtering)) = generator else {
                 return;
             };
-            if single_batch && generated {
+            if (single_batch && generated) || input == RibbonInput::Generated {
                 return;
             }
             generated = true;
@@ -504,7 +547,8 @@ impl PreviewRenderer {
                 timer.and_then(|t| t.compute_pass()),
             );
         };
-        let segments = |index: usize| FramePlan::batch_segments(&plan.batches[index]) as u32;
+        let no_runs = Vec::new();
+        let batch_runs = |index: usize| plan.batches.get(index).unwrap_or(&no_runs);
         let batch_count = plan.batches.len();
         // 1. Shadow passes, per shadow-casting light.
         for slot in 0..active.shadow_slots as usize {
@@ -517,17 +561,12 @@ impl PreviewRenderer {
                         if index < batch_count {
                             generate(&mut encoder, index);
                         }
-                        let count = if index < batch_count {
-                            segments(index)
-                        } else {
-                            0
-                        };
                         hair_shadow.encode_depth(
                             &mut encoder,
                             &prepared_hair,
                             slot,
                             index,
-                            count,
+                            batch_runs(index),
                             index == 0,
                         );
                     }
@@ -536,18 +575,13 @@ impl PreviewRenderer {
                     if index < batch_count {
                         generate(&mut encoder, index);
                     }
-                    let count = if index < batch_count {
-                        segments(index)
-                    } else {
-                        0
-                    };
                     hair_shadow.encode_opacity(
                         &mut encoder,
                         &prepared_hair,
                         &state.lighting.scene_group,
                         slot,
                         index,
-                        count,
+                        batch_runs(index),
                         index == 0,
                     );
                 }
@@ -633,7 +667,7 @@ impl PreviewRenderer {
                         &prepared_hair,
                         0,
                         index,
-                        segments(index),
+                        batch_runs(index),
                     );
                 }
             }
@@ -675,7 +709,7 @@ impl PreviewRenderer {
                         &prepared_hair,
                         0,
                         index,
-                        segments(index),
+                        batch_runs(index),
                     );
                 }
             }

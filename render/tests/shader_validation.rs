@@ -25,21 +25,32 @@ fn embedded() -> Vec<(String, String)> {
     use hairloom_core::model::scene::SelfShadowing;
     use hairloom_render::renderer::oit_composite::oit_composite_shader;
     use hairloom_render::renderer::scene_lighting::{
-        ShaderKey, body_shader, hair_shader, hair_shadow_shader,
+        RibbonInput, ShaderKey, body_shader, hair_shader, hair_shadow_shader,
     };
+    let inputs = [RibbonInput::Buffer, RibbonInput::Generated];
     let mut sources = vec![(
         "strand_gen".to_string(),
         hairloom_render::renderer::strand_gen::SHADER_SOURCE.to_string(),
     )];
     for key in ShaderKey::all() {
-        sources.push((format!("preview_hair {key:?}"), hair_shader(&key)));
+        for input in inputs {
+            sources.push((
+                format!("preview_hair {key:?} {input:?}"),
+                hair_shader(&key, input),
+            ));
+        }
         sources.push((format!("preview_body {key:?}"), body_shader(&key)));
     }
     for kind in [
         SelfShadowing::OpacityShadowMaps,
         SelfShadowing::DeepOpacityMaps,
     ] {
-        sources.push((format!("hair_shadow {kind:?}"), hair_shadow_shader(kind)));
+        for input in inputs {
+            sources.push((
+                format!("hair_shadow {kind:?} {input:?}"),
+                hair_shadow_shader(kind, input),
+            ));
+        }
     }
     for samples in [1, 4] {
         sources.push((

@@ -8,7 +8,17 @@ use hairloom_core::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
 use hairloom_core::runtime::textures::Precision;
 use hairloom_render::device::headless_for_test;
-use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
+use hairloom_render::renderer::strand_gen::{GenerationPath, StrandGenRenderer, full_detail_plan};
+
+/// Both compute distributions of the work (per strand, per vertex): each must match the
+/// mirror.
+fn compute_renderers(context: &hairloom_render::device::GpuContext) -> [StrandGenRenderer; 2] {
+    [
+        GenerationPath::ComputePerStrand,
+        GenerationPath::ComputePerVertex,
+    ]
+    .map(|path| StrandGenRenderer::with_path(context, path))
+}
 
 fn sample(name: &str) -> hairloom_core::model::document::Document {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -23,7 +33,8 @@ fn gpu_strands_match_the_cpu_mirror() {
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };
-    let renderer = StrandGenRenderer::new(&context);
+    let renderers = compute_renderers(&context);
+    let renderer = &renderers[0];
     for name in ["head_curly", "head_long_wavy", "teapot_fur"] {
         let mut document = sample(name);
         // The sample's own ops plus twist (the one that reads the centre strand), and a group
@@ -66,11 +77,15 @@ fn gpu_strands_match_the_cpu_mirror() {
             assert_eq!(hair.root_count, roots.len());
             let vertex_count = 17u32;
             let plan = full_detail_plan(roots.len(), vertex_count);
-            for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
+            for (filtering, renderer) in [Filtering::Exact, Filtering::Hardware8Bit]
+                .into_iter()
+                .flat_map(|f| renderers.iter().map(move |r| (f, r)))
+            {
+                let path = renderer.path();
                 let positions = match renderer.generate_positions(&context, &hair, &plan, filtering)
                 {
                     Ok(positions) => positions,
-                    Err(error) => panic!("{name} {precision:?} {filtering:?}: {error}"),
+                    Err(error) => panic!("{name} {precision:?} {filtering:?} {path:?}: {error}"),
                 };
                 assert_eq!(positions.len(), roots.len() * vertex_count as usize);
                 let mirror = StrandGen {
@@ -94,11 +109,11 @@ fn gpu_strands_match_the_cpu_mirror() {
                     Filtering::Hardware8Bit => 4e-3 * size,
                 };
                 eprintln!(
-                    "{name} {precision:?} {filtering:?}: max |GPU − CPU mirror| = {worst:.3e} (bound {bound:.3e}, size {size:.3})"
+                    "{name} {precision:?} {filtering:?} {path:?}: max |GPU − CPU mirror| = {worst:.3e} (bound {bound:.3e}, size {size:.3})"
                 );
                 assert!(
                     worst <= bound,
-                    "{name} {precision:?} {filtering:?}: {worst} > {bound}"
+                    "{name} {precision:?} {filtering:?} {path:?}: {worst} > {bound}"
                 );
             }
         }
@@ -195,7 +210,8 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };
-    let renderer = StrandGenRenderer::new(&context);
+    let renderers = compute_renderers(&context);
+    let renderer = &renderers[0];
     let document = sample("head_long_wavy");
     let runtime = RuntimeHair::from_document(
         &document,
@@ -237,10 +253,6 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
     assert!(runs.iter().any(|r| r.gamma > 0.0), "no run morphs");
     assert!(runs.iter().any(|r| r.vertex_count < 33), "no vertex LOD");
     assert!(plan.batches.len() > 1);
-    let positions = renderer
-        .generate_positions(&context, &hair, &plan, Filtering::Exact)
-        .expect("positions");
-    assert_eq!(positions.len(), plan.vertices);
     let mirror = StrandGen {
         textures,
         filtering: Filtering::Exact,
@@ -251,14 +263,23 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
         .iter()
         .flat_map(|batch| mirror.main(&roots, batch, &params))
         .collect();
-    let size = document.hair_mesh.size() as f32;
-    let worst = positions
-        .iter()
-        .zip(&expected)
-        .map(|(g, e)| glam::Vec3::new(g[0], g[1], g[2]).distance(*e))
-        .fold(0.0f32, f32::max);
-    eprintln!("LOD runs: max |GPU − CPU mirror| = {worst:.3e} (size {size:.3})");
-    assert!(worst <= 1e-5 * size, "{worst}");
+    for renderer in &renderers {
+        let positions = renderer
+            .generate_positions(&context, &hair, &plan, Filtering::Exact)
+            .expect("positions");
+        assert_eq!(positions.len(), plan.vertices);
+        let size = document.hair_mesh.size() as f32;
+        let worst = positions
+            .iter()
+            .zip(&expected)
+            .map(|(g, e)| glam::Vec3::new(g[0], g[1], g[2]).distance(*e))
+            .fold(0.0f32, f32::max);
+        eprintln!(
+            "LOD runs, {:?}: max |GPU − CPU mirror| = {worst:.3e} (size {size:.3})",
+            renderer.path()
+        );
+        assert!(worst <= 1e-5 * size, "{worst}");
+    }
 }
 
 #[test]

@@ -22,7 +22,9 @@ pub struct StrandGenParams {
     pub per_bundle: u32,
     /// Samples per domain in the samples buffer (quads first, then triangles).
     pub sample_set: u32,
-    pub _padding: [u32; 2],
+    /// Strands this dispatch writes (the batch's runs together).
+    pub strand_total: u32,
+    pub _padding: u32,
 }
 
 /// One bundle's placement on the root slice: what the shader needs to turn a root sample into

@@ -120,13 +120,11 @@ impl StrandGen<'_> {
         self.styled_strand(&root, vertex_count, params)
     }
 
-    /// What a strand's vertices share, computed once: the root uv, the length fraction and
-    /// the styling ops' random values and clump pull (`strand_gen.wgsl` recomputes them per
-    /// vertex: splitting them into a per-strand pass measured no faster on lavapipe, where
-    /// the textures' fetches dominate). The root uv seeds every
-    /// per-strand random value, so it is always filtered exactly (manual bilinear in the
-    /// shader), even in hardware mode: 8-bit weights must not shift a strand's curl phase or
-    /// clump.
+    /// What a strand's vertices share, computed once (mirror: `strand_input`, which the
+    /// shader's `main` runs once per strand): the root uv, the length fraction and the
+    /// styling ops' random values and clump pull. The root uv seeds every per-strand random
+    /// value, so it is always filtered exactly (manual bilinear in the shader), even in
+    /// hardware mode: 8-bit weights must not shift a strand's curl phase or clump.
     pub fn strand_input<'p>(
         &self,
         root: &StrandRoot,

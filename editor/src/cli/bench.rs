@@ -51,6 +51,13 @@ pub enum Which {
         /// Measured runs per row after one warm-up (the median is reported).
         #[arg(long, default_value_t = 3)]
         runs: usize,
+        /// Generation paths to measure, comma-separated: strand (compute, one invocation per
+        /// strand), vertex (compute, one per vertex), vs (in the ribbon vertex shader).
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("strand"), String::from("vertex"), String::from("vs")])]
+        paths: Vec<String>,
+        /// Filtering to measure, comma-separated (exact, hardware).
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("exact"), String::from("hardware")])]
+        filtering: Vec<String>,
     },
     /// Edit-to-frame latency in the editor's viewport setting: a styling slider tick through
     /// a full rebuild and re-upload (the old path) and through the in-place styling update
@@ -191,7 +198,32 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             size,
             textures,
             runs,
+            paths,
+            filtering,
         } => {
+            use hairloom_core::runtime::strand_gen::Filtering;
+            use hairloom_render::renderer::strand_gen::GenerationPath;
+            let paths = paths
+                .iter()
+                .map(|p| match p.as_str() {
+                    "strand" => Ok(GenerationPath::ComputePerStrand),
+                    "vertex" => Ok(GenerationPath::ComputePerVertex),
+                    "vs" => Ok(GenerationPath::VertexShader),
+                    other => Err(anyhow::anyhow!(
+                        "unknown generation path {other:?} (strand, vertex, vs)"
+                    )),
+                })
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            let filterings = filtering
+                .iter()
+                .map(|f| match f.as_str() {
+                    "exact" => Ok(Filtering::Exact),
+                    "hardware" => Ok(Filtering::Hardware8Bit),
+                    other => Err(anyhow::anyhow!(
+                        "unknown filtering {other:?} (exact, hardware)"
+                    )),
+                })
+                .collect::<anyhow::Result<Vec<_>>>()?;
             let precisions = textures
                 .iter()
                 .map(|t| match t.as_str() {
@@ -209,6 +241,8 @@ pub fn run(which: Which) -> anyhow::Result<()> {
                 &size,
                 &precisions,
                 runs,
+                &paths,
+                &filterings,
             )
         }
     }
@@ -316,6 +350,10 @@ fn gpu_or_wall(trust_timestamps: bool, gpu_ms: Option<f64>, wall_ms: f64) -> (f6
     }
 }
 
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the command's options, passed through"
+)]
 fn gpu(
     project: Option<std::path::PathBuf>,
     vertices_log2: u32,
@@ -323,17 +361,25 @@ fn gpu(
     size: &str,
     precisions: &[hairloom_core::runtime::textures::Precision],
     runs: usize,
+    paths: &[hairloom_render::renderer::strand_gen::GenerationPath],
+    filterings: &[hairloom_core::runtime::strand_gen::Filtering],
 ) -> anyhow::Result<()> {
     use hairloom_core::runtime::frame_plan::LodSettings;
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-    use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
+    use hairloom_render::renderer::strand_gen::{
+        GenerationPath, StrandGenRenderer, full_detail_plan,
+    };
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = super::render::parse_size(size)?;
     let document = hairloom_core::io::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
     let generator = StrandGenRenderer::new(&context);
+    let generators: Vec<StrandGenRenderer> = paths
+        .iter()
+        .map(|&path| StrandGenRenderer::with_path(&context, path))
+        .collect();
     let preview = PreviewRenderer::new(&context);
     let body = hairloom_render::renderer::preview_body::GpuBody::upload(&context, &document.body);
     // The method's own cost (generation against stored vertices): no optional effect, so the
@@ -356,10 +402,11 @@ fn gpu(
         preview.sample_count
     );
     println!(
-        "{:>8} {:>4} {:>8} {:<22} {:>9} {:>9} {:>11} {:>10} {:>10} {:>9}",
+        "{:>8} {:>4} {:>8} {:<18} {:<22} {:>9} {:>9} {:>11} {:>10} {:>10} {:>9}",
         "strands",
         "tex",
         "filter",
+        "path",
         "mode",
         "vertices",
         "ms",
@@ -396,13 +443,14 @@ fn gpu(
             let full = full_detail_plan(hair.root_count, vertex_count);
             let stored_bytes = full.vertices as u64 * 16;
             let hair_mb = hair.bytes as f64 / 1e6;
-            for filtering in [Filtering::Exact, Filtering::Hardware8Bit] {
+            for &filtering in filterings {
                 let filter_name = if filtering == Filtering::Exact {
                     "exact"
                 } else {
                     "hardware"
                 };
-                let row = |mode: &str,
+                let row = |path: &str,
+                           mode: &str,
                            drawn: usize,
                            ms: (f64, &str),
                            versus: Option<f64>,
@@ -410,10 +458,11 @@ fn gpu(
                            memory: f64,
                            ratio: Option<f64>| {
                     println!(
-                        "{:>8} {:>4} {:>8} {:<22} {:>9} {:>8.2}{:1} {:>11} {:>10.1} {:>10.2} {:>9}",
+                        "{:>8} {:>4} {:>8} {:<18} {:<22} {:>9} {:>8.2}{:1} {:>11} {:>10.1} {:>10.2} {:>9}",
                         hair.root_count,
                         format!("{precision:?}"),
                         filter_name,
+                        path,
                         mode,
                         drawn,
                         ms.0,
@@ -424,20 +473,30 @@ fn gpu(
                         ratio.map_or("".into(), |r| format!("{r:.0}×")),
                     );
                 };
-                let generation = match median_timing(
-                    || generator.time_generation(&context, &hair, &full, filtering),
-                    runs,
-                    |t| t.wall_ms,
-                ) {
-                    Ok(timing) => timing,
-                    Err(error) => {
-                        println!(
-                            "{:>8} {:>4?} {:>8}   skipped: {error}",
-                            hair.root_count, precision, filter_name
-                        );
-                        continue;
+                // Generation alone, per compute path (the vertex-shader path generates
+                // only while drawing).
+                let mut generation = Vec::new();
+                let mut refused = None;
+                for generator in generators
+                    .iter()
+                    .filter(|g| g.path() != GenerationPath::VertexShader)
+                {
+                    match median_timing(
+                        || generator.time_generation(&context, &hair, &full, filtering),
+                        runs,
+                        |t| t.wall_ms,
+                    ) {
+                        Ok(timing) => generation.push((generator.path(), timing)),
+                        Err(error) => refused = Some(error),
                     }
-                };
+                }
+                if let Some(error) = refused {
+                    println!(
+                        "{:>8} {:>4?} {:>8}   skipped: {error}",
+                        hair.root_count, precision, filter_name
+                    );
+                    continue;
+                }
                 // The explicit-storage baseline: the same strands generated once into a
                 // persistent vertex buffer, then only drawn.
                 let stored = if stored_bytes <= max_binding {
@@ -474,47 +533,54 @@ fn gpu(
                 };
                 let stored_ms = stored_frame.map(|t| gpu_or_wall(trust, t.gpu_ms, t.wall_ms).0);
                 let explicit_mb = stored_bytes as f64 / 1e6;
-                row(
-                    "generate only",
-                    full.vertices,
-                    gpu_or_wall(trust, generation.gpu_ms, generation.wall_ms),
-                    None,
-                    generation.scratch_bytes,
-                    hair_mb,
-                    Some(explicit_mb / hair_mb),
-                );
-                for (mode, camera, enabled) in [
-                    ("frame, LOD off", near, false),
-                    ("frame, LOD on", near, true),
-                    ("frame ×4 far, LOD off", far, false),
-                    ("frame ×4 far, LOD on", far, true),
-                ] {
-                    let lod = LodSettings {
-                        enabled,
-                        ..LodSettings::default()
-                    };
-                    let timing = frame(
-                        HairSource::Generated {
-                            generator: &generator,
-                            hair: &hair,
-                            filtering,
-                            lod,
-                        },
-                        camera,
-                    )?;
-                    let ms = gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms);
+                for (path, timing) in &generation {
                     row(
-                        mode,
-                        timing.vertices,
-                        ms,
-                        stored_ms.map(|s| s / ms.0),
+                        path.name(),
+                        "generate only",
+                        full.vertices,
+                        gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms),
+                        None,
                         timing.scratch_bytes,
                         hair_mb,
                         Some(explicit_mb / hair_mb),
                     );
                 }
+                for generator in &generators {
+                    for (mode, camera, enabled) in [
+                        ("frame, LOD off", near, false),
+                        ("frame, LOD on", near, true),
+                        ("frame ×4 far, LOD off", far, false),
+                        ("frame ×4 far, LOD on", far, true),
+                    ] {
+                        let lod = LodSettings {
+                            enabled,
+                            ..LodSettings::default()
+                        };
+                        let timing = frame(
+                            HairSource::Generated {
+                                generator,
+                                hair: &hair,
+                                filtering,
+                                lod,
+                            },
+                            camera,
+                        )?;
+                        let ms = gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms);
+                        row(
+                            generator.path().name(),
+                            mode,
+                            timing.vertices,
+                            ms,
+                            stored_ms.map(|s| s / ms.0),
+                            timing.scratch_bytes,
+                            hair_mb,
+                            Some(explicit_mb / hair_mb),
+                        );
+                    }
+                }
                 match stored_frame {
                     Some(timing) => row(
+                        "stored",
                         "frame, stored vertices",
                         full.vertices,
                         gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms),
@@ -524,8 +590,8 @@ fn gpu(
                         Some(1.0),
                     ),
                     None => println!(
-                        "{:>8} {:>4?} {:>8} {:<22} skipped: {explicit_mb:.0} MB exceeds the adapter's storage binding limit",
-                        hair.root_count, precision, filter_name, "frame, stored vertices"
+                        "{:>8} {:>4?} {:>8} {:<18} {:<22} skipped: {explicit_mb:.0} MB exceeds the adapter's storage binding limit",
+                        hair.root_count, precision, filter_name, "stored", "frame, stored vertices"
                     ),
                 }
             }

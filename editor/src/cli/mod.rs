@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use hairloom_core::io::project;
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::runtime::textures::Precision;
+use hairloom_render::renderer::strand_gen::GenerationPath;
 
 mod accuracy;
 mod bench;
@@ -129,6 +130,10 @@ enum Command {
         /// Texture filtering in the generation shader.
         #[arg(long, value_enum, default_value_t = FilteringArg::Exact)]
         filtering: FilteringArg,
+        /// Where strands are generated: compute (one invocation per strand, into a scratch
+        /// buffer), compute-per-vertex, or vertex-shader (in the ribbons, no scratch).
+        #[arg(long, value_enum, default_value_t = GenerationArg::Compute)]
+        generation: GenerationArg,
         /// Draw every strand at full detail (no strand or vertex LOD).
         #[arg(long)]
         no_lod: bool,
@@ -179,6 +184,24 @@ impl From<PrecisionArg> for Precision {
 enum FilteringArg {
     Exact,
     Hardware,
+}
+
+/// Where strands are generated, on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum GenerationArg {
+    Compute,
+    ComputePerVertex,
+    VertexShader,
+}
+
+impl From<GenerationArg> for GenerationPath {
+    fn from(value: GenerationArg) -> Self {
+        match value {
+            GenerationArg::Compute => GenerationPath::ComputePerStrand,
+            GenerationArg::ComputePerVertex => GenerationPath::ComputePerVertex,
+            GenerationArg::VertexShader => GenerationPath::VertexShader,
+        }
+    }
 }
 
 impl From<FilteringArg> for Filtering {
@@ -244,6 +267,7 @@ pub fn main() -> ExitCode {
             vertices_log2,
             precision,
             filtering,
+            generation,
             no_lod,
             alpha_strands,
             alpha_vertices,
@@ -269,6 +293,7 @@ pub fn main() -> ExitCode {
                 vertices_log2,
                 precision: precision.into(),
                 filtering: filtering.into(),
+                generation: generation.into(),
                 lod: hairloom_core::runtime::frame_plan::LodSettings {
                     enabled: !no_lod,
                     cull: true,

@@ -17,7 +17,7 @@ use hairloom_core::runtime::textures::Precision;
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::preview_body::GpuBody;
-use hairloom_render::renderer::strand_gen::StrandGenRenderer;
+use hairloom_render::renderer::strand_gen::{GenerationPath, StrandGenRenderer};
 
 /// The longest simulated time a command accepts (`--time`, `--seconds`): bounded work.
 pub const MAX_SIMULATED_S: f64 = 600.0;
@@ -39,6 +39,8 @@ pub struct RenderSettings {
     /// Texture precision of a project render (a runtime bundle has its own).
     pub precision: Precision,
     pub filtering: Filtering,
+    /// Where strands are generated (compute per strand by default).
+    pub generation: GenerationPath,
     pub lod: LodSettings,
     /// `--time`: simulate the scene's motion to this time first (projects only).
     pub time_s: f64,
@@ -54,6 +56,7 @@ impl Default for RenderSettings {
             vertices_log2: PREVIEW_VERTICES_LOG2,
             precision: Precision::F32,
             filtering: Filtering::Exact,
+            generation: GenerationPath::default(),
             lod: LodSettings::default(),
             time_s: 0.0,
         }
@@ -145,9 +148,9 @@ pub struct HeadlessRenderer {
 }
 
 impl HeadlessRenderer {
-    pub fn new(context: &GpuContext) -> Self {
+    pub fn new(context: &GpuContext, generation: GenerationPath) -> Self {
         Self {
-            generator: StrandGenRenderer::new(context),
+            generator: StrandGenRenderer::with_path(context, generation),
             preview: PreviewRenderer::new(context),
         }
     }
@@ -230,7 +233,7 @@ pub fn render_pixels(
     direction: Vec3,
     settings: &RenderSettings,
 ) -> anyhow::Result<(Vec<u8>, String)> {
-    HeadlessRenderer::new(context).draw(
+    HeadlessRenderer::new(context, settings.generation).draw(
         context,
         hair,
         (width, height),

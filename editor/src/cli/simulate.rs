@@ -167,7 +167,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
 
     let gpu = if !settings.no_render {
         let context = GpuContext::new_headless()?;
-        let renderer = HeadlessRenderer::new(&context);
+        let renderer = HeadlessRenderer::new(&context, render_settings.generation);
         println!("adapter: {}", describe(&context.adapter_info));
         Some((context, renderer))
     } else {

@@ -102,6 +102,7 @@ impl BodyShadowRenderer {
                 groups: &[body.layout()],
                 buffers: &BODY_VERTEX_LAYOUT,
                 vertex_entry: "vs_shadow",
+                topology: wgpu::PrimitiveTopology::TriangleList,
                 fragment_entry: None,
                 targets: &[],
                 depth: Some(shadow_depth_state(2.0)),

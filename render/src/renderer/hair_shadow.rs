@@ -9,10 +9,11 @@
 //! the layers at and behind its distance.
 
 use hairloom_core::model::scene::SelfShadowing;
+use hairloom_core::runtime::gpu_types::StrandRun;
 
 use crate::device::GpuContext;
 use crate::renderer::body_shadow::{depth_array, shadow_depth_state};
-use crate::renderer::preview_hair::{HairRenderer, PreparedHair};
+use crate::renderer::preview_hair::{HairRenderer, PreparedHair, RibbonInput};
 use crate::renderer::scene_lighting::{first_hair_depth_entry, hair_shadow_shader};
 use crate::renderer::{PipelineSpec, pipeline};
 use crate::resources::Tracked;
@@ -21,6 +22,8 @@ pub const OPACITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float
 
 pub struct HairShadowRenderer {
     pub kind: SelfShadowing,
+    /// Where the ribbons' vertices come from.
+    pub input: RibbonInput,
     pub layers: u32,
     pub resolution: u32,
     pub slots: u32,
@@ -41,6 +44,10 @@ pub struct HairShadowRenderer {
 }
 
 impl HairShadowRenderer {
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the effect's settings, each a field of the renderer"
+    )]
     pub fn new(
         context: &GpuContext,
         hair: &HairRenderer,
@@ -49,9 +56,11 @@ impl HairShadowRenderer {
         layers: u32,
         resolution: u32,
         slots: u32,
+        input: RibbonInput,
     ) -> Self {
         let device = &context.device;
-        let source = hair_shadow_shader(kind);
+        let source = hair_shadow_shader(kind, input);
+        let topology = HairRenderer::topology(input);
         let deep = kind == SelfShadowing::DeepOpacityMaps;
         let depth_pipeline = deep.then(|| {
             pipeline(
@@ -59,9 +68,10 @@ impl HairShadowRenderer {
                 &PipelineSpec {
                     label: "hair_shadow_depth",
                     source: &source,
-                    groups: &[hair.draw_layout()],
+                    groups: &[hair.draw_layout(input)],
                     buffers: &[],
                     vertex_entry: "vs_main",
+                    topology,
                     fragment_entry: None,
                     targets: &[],
                     depth: Some(shadow_depth_state(0.0)),
@@ -93,7 +103,7 @@ impl HairShadowRenderer {
                 })
             })
             .collect();
-        let mut pipeline_groups = vec![hair.draw_layout(), scene_layout];
+        let mut pipeline_groups = vec![hair.draw_layout(input), scene_layout];
         pipeline_groups.extend(first_hair_layout.as_ref());
         let opacity_pipeline = pipeline(
             context,
@@ -103,6 +113,7 @@ impl HairShadowRenderer {
                 groups: &pipeline_groups,
                 buffers: &[],
                 vertex_entry: "vs_main",
+                topology,
                 fragment_entry: Some("fs_opacity"),
                 targets: &targets,
                 depth: None,
@@ -164,6 +175,7 @@ impl HairShadowRenderer {
                 });
         Self {
             kind,
+            input,
             layers,
             resolution,
             slots,
@@ -178,7 +190,17 @@ impl HairShadowRenderer {
     }
 
     /// Whether these maps serve a scene with these settings.
-    pub fn fits(&self, kind: SelfShadowing, layers: u32, resolution: u32, slots: u32) -> bool {
+    pub fn fits(
+        &self,
+        kind: SelfShadowing,
+        layers: u32,
+        resolution: u32,
+        slots: u32,
+        input: RibbonInput,
+    ) -> bool {
+        if self.input != input {
+            return false;
+        }
         (self.kind, self.layers, self.resolution, self.slots) == (kind, layers, resolution, slots)
     }
 
@@ -195,7 +217,7 @@ impl HairShadowRenderer {
         prepared: &PreparedHair,
         slot: usize,
         batch: usize,
-        segments: u32,
+        runs: &[StrandRun],
         clear: bool,
     ) {
         let (Some(pipeline), Some((_, layers, _))) = (&self.depth_pipeline, &self.first_hair)
@@ -221,7 +243,7 @@ impl HairShadowRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        HairRenderer::draw_with(&mut pass, pipeline, prepared, slot + 1, batch, segments);
+        HairRenderer::draw_with(&mut pass, pipeline, prepared, slot + 1, batch, runs);
     }
 
     /// The opacity pass of light `slot` for one batch; `clear` on the first batch.
@@ -236,7 +258,7 @@ impl HairShadowRenderer {
         scene_group: &wgpu::BindGroup,
         slot: usize,
         batch: usize,
-        segments: u32,
+        runs: &[StrandRun],
         clear: bool,
     ) {
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = (0..4)
@@ -276,7 +298,7 @@ impl HairShadowRenderer {
             prepared,
             slot + 1,
             batch,
-            segments,
+            runs,
         );
     }
 }

@@ -26,14 +26,15 @@ use crate::device::GpuContext;
 use crate::resources::Tracked;
 use crate::view::{COLOR_FORMAT, DEPTH_FORMAT};
 
-/// What differs between the renderers' pipelines; the rest (triangle lists, no culling) is
-/// shared.
+/// What differs between the renderers' pipelines; the rest (no culling) is shared.
 pub(crate) struct PipelineSpec<'a> {
     pub label: &'a str,
     pub source: &'a str,
     pub groups: &'a [&'a wgpu::BindGroupLayout],
     pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
     pub vertex_entry: &'a str,
+    /// Triangle lists, or a strip per instance (ribbons generated in the vertex shader).
+    pub topology: wgpu::PrimitiveTopology,
     /// `None`: a depth-only pipeline.
     pub fragment_entry: Option<&'a str>,
     pub targets: &'a [Option<wgpu::ColorTargetState>],
@@ -66,7 +67,7 @@ pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgp
                 buffers: spec.buffers,
             },
             primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
+                topology: spec.topology,
                 cull_mode: None,
                 ..Default::default()
             },

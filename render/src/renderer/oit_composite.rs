@@ -66,6 +66,7 @@ impl OitRenderer {
                 groups: &[&layout],
                 buffers: &[],
                 vertex_entry: "vs_main",
+                topology: wgpu::PrimitiveTopology::TriangleList,
                 fragment_entry: Some("fs_main"),
                 targets: &[Some(wgpu::ColorTargetState {
                     format: COLOR_FORMAT,

@@ -158,6 +158,7 @@ impl BodyRenderer {
                 groups: &groups,
                 buffers: &BODY_VERTEX_LAYOUT,
                 vertex_entry: "vs_main",
+                topology: wgpu::PrimitiveTopology::TriangleList,
                 fragment_entry: Some("fs_main"),
                 targets: &view_color_target(&self.targets),
                 depth: Some(view_depth(&self.targets, true)),

@@ -7,8 +7,16 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use hairloom_core::runtime::frame_plan::FramePlan;
+use hairloom_core::runtime::gpu_types::StrandRun;
+use hairloom_core::runtime::strand_gen::Filtering;
+
 use crate::device::GpuContext;
+pub use crate::renderer::scene_lighting::RibbonInput;
 use crate::renderer::scene_lighting::{ActiveEffects, ShaderKey, hair_shader};
+use crate::renderer::strand_gen::{
+    GENERATED_BINDING_OFFSET, GpuHair, StrandGenRenderer, source_layout_entries,
+};
 use crate::renderer::{
     PipelineSpec, Targets, pipeline, uniform_entry, view_color_target, view_depth,
 };
@@ -17,12 +25,15 @@ use crate::resources::Tracked;
 /// The default variant's source (Marschner, deep opacity maps, body shadows, dual
 /// scattering): what tests that append an entry point to the hair shader compile.
 pub fn default_hair_shader() -> String {
-    hair_shader(&ShaderKey {
-        shading: hairloom_core::model::scene::Shading::Marschner,
-        opacity_maps: hairloom_core::model::scene::SelfShadowing::DeepOpacityMaps,
-        body_shadows: true,
-        dual_scattering: true,
-    })
+    hair_shader(
+        &ShaderKey {
+            shading: hairloom_core::model::scene::Shading::Marschner,
+            opacity_maps: hairloom_core::model::scene::SelfShadowing::DeepOpacityMaps,
+            body_shadows: true,
+            dual_scattering: true,
+        },
+        RibbonInput::Buffer,
+    )
 }
 
 /// Keep in sync with `shaders/shared/ribbon.wgsl` (`HairUniforms`).
@@ -45,7 +56,7 @@ pub const OIT_ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg
 pub const OIT_REVEALAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
 
 struct HairPipelines {
-    key: (ShaderKey, bool),
+    key: (ShaderKey, bool, RibbonInput),
     /// Depth only: the nearest ribbon per sample, so the lit pass shades each once.
     depth: Tracked<wgpu::RenderPipeline>,
     /// Lit, where the depth pre-pass left this ribbon nearest.
@@ -56,7 +67,10 @@ struct HairPipelines {
 
 /// The ribbons' bindings and the lit pipelines of the current effects.
 pub struct HairRenderer {
+    /// Group 0 with the vertices in a buffer.
     draw_layout: wgpu::BindGroupLayout,
+    /// Group 0 with strand_gen's resources, for ribbons that generate their vertices.
+    generated_layout: wgpu::BindGroupLayout,
     /// Bytes between two uniform entries (the adapter's dynamic-offset alignment).
     uniform_stride: u64,
     targets: Targets,
@@ -66,6 +80,7 @@ pub struct HairRenderer {
 /// One frame's ribbon bindings: every view's uniforms for every batch, one bind group.
 pub struct PreparedHair {
     group: wgpu::BindGroup,
+    input: RibbonInput,
     stride: u64,
     batch_count: usize,
 }
@@ -101,9 +116,26 @@ impl HairRenderer {
                 ),
             ],
         });
+        let mut generated_entries = vec![
+            uniform_entry(0, size_of::<HairUniforms>(), true),
+            storage(
+                2,
+                size_of::<hairloom_core::runtime::gpu_types::StrandRun>() as u64,
+            ),
+        ];
+        generated_entries.extend(source_layout_entries(
+            device,
+            GENERATED_BINDING_OFFSET,
+            wgpu::ShaderStages::VERTEX,
+        ));
+        let generated_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("preview_hair_generated"),
+            entries: &generated_entries,
+        });
         let alignment = device.limits().min_uniform_buffer_offset_alignment as u64;
         Self {
             draw_layout,
+            generated_layout,
             uniform_stride: (size_of::<HairUniforms>() as u64).div_ceil(alignment) * alignment,
             targets,
             pipelines: None,
@@ -115,26 +147,40 @@ impl HairRenderer {
         self.targets
     }
 
-    /// Group 0 of every pipeline that draws ribbons.
-    pub fn draw_layout(&self) -> &wgpu::BindGroupLayout {
-        &self.draw_layout
+    /// Group 0 of every pipeline that draws ribbons from `input`.
+    pub fn draw_layout(&self, input: RibbonInput) -> &wgpu::BindGroupLayout {
+        match input {
+            RibbonInput::Buffer => &self.draw_layout,
+            RibbonInput::Generated => &self.generated_layout,
+        }
     }
 
-    /// Makes the lit pipelines for `effects` unless they exist (the previous ones are freed).
+    /// The primitive topology of ribbons from `input`.
+    pub fn topology(input: RibbonInput) -> wgpu::PrimitiveTopology {
+        match input {
+            RibbonInput::Buffer => wgpu::PrimitiveTopology::TriangleList,
+            RibbonInput::Generated => wgpu::PrimitiveTopology::TriangleStrip,
+        }
+    }
+
+    /// Makes the lit pipelines for `effects` and ribbons from `input` unless they exist (the
+    /// previous ones are freed).
     pub fn ensure(
         &mut self,
         context: &GpuContext,
         effects: &ActiveEffects,
         scene_layout: &wgpu::BindGroupLayout,
         effects_layout: Option<&wgpu::BindGroupLayout>,
+        input: RibbonInput,
     ) {
-        let key = (effects.shader_key(), effects.width_oit);
+        let key = (effects.shader_key(), effects.width_oit, input);
         if self.pipelines.as_ref().is_some_and(|p| p.key == key) {
             return;
         }
         self.pipelines = None;
-        let source = hair_shader(&key.0);
-        let mut groups = vec![&self.draw_layout, scene_layout];
+        let source = hair_shader(&key.0, input);
+        let topology = Self::topology(input);
+        let mut groups = vec![self.draw_layout(input), scene_layout];
         groups.extend(effects_layout);
         let depth = pipeline(
             context,
@@ -144,6 +190,7 @@ impl HairRenderer {
                 groups: &groups,
                 buffers: &[],
                 vertex_entry: "vs_main",
+                topology,
                 fragment_entry: Some("fs_depth"),
                 // The view's colour target, untouched (the pass has it attached).
                 targets: &[Some(wgpu::ColorTargetState {
@@ -163,6 +210,7 @@ impl HairRenderer {
                 groups: &groups,
                 buffers: &[],
                 vertex_entry: "vs_main",
+                topology,
                 fragment_entry: Some("fs_main"),
                 targets: &view_color_target(&self.targets),
                 depth: Some(wgpu::DepthStencilState {
@@ -191,6 +239,7 @@ impl HairRenderer {
                     groups: &groups,
                     buffers: &[],
                     vertex_entry: "vs_main",
+                    topology,
                     fragment_entry: Some("fs_oit"),
                     targets: &[
                         Some(wgpu::ColorTargetState {
@@ -225,17 +274,14 @@ impl HairRenderer {
         });
     }
 
-    /// The uniforms of every view in `views` (each with its own view, eye and width) for
-    /// every batch of `batches` (their run ranges), and one bind group over them, the strand
-    /// vertices and the runs.
-    pub fn prepare(
+    /// One uniform buffer with every view of `views` (each with its own view, eye and width)
+    /// for every batch of `batches` (their run ranges), at the dynamic-offset stride.
+    fn uniforms(
         &self,
         context: &GpuContext,
         views: &[HairUniforms],
         batches: &[[u32; 2]],
-        strands: &wgpu::Buffer,
-        runs: &wgpu::Buffer,
-    ) -> PreparedHair {
+    ) -> (Tracked<wgpu::Buffer>, usize) {
         let stride = self.uniform_stride as usize;
         let batch_count = batches.len().max(1);
         let mut bytes = vec![0u8; stride * batch_count * views.len().max(1)];
@@ -249,7 +295,7 @@ impl HairRenderer {
                     .copy_from_slice(bytemuck::bytes_of(&uniforms));
             }
         }
-        let uniforms = context.resources.buffer_init(
+        let buffer = context.resources.buffer_init(
             &context.device,
             &wgpu::util::BufferInitDescriptor {
                 label: Some("preview_hair_uniforms"),
@@ -257,20 +303,38 @@ impl HairRenderer {
                 usage: wgpu::BufferUsages::UNIFORM,
             },
         );
+        (buffer, batch_count)
+    }
+
+    fn uniform_entry<'a>(buffer: &'a wgpu::Buffer) -> wgpu::BindGroupEntry<'a> {
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer,
+                offset: 0,
+                size: wgpu::BufferSize::new(size_of::<HairUniforms>() as u64),
+            }),
+        }
+    }
+
+    /// The uniforms of every view in `views` for every batch of `batches`, and one bind
+    /// group over them, the strand vertices and the runs ([`RibbonInput::Buffer`]).
+    pub fn prepare(
+        &self,
+        context: &GpuContext,
+        views: &[HairUniforms],
+        batches: &[[u32; 2]],
+        strands: &wgpu::Buffer,
+        runs: &wgpu::Buffer,
+    ) -> PreparedHair {
+        let (uniforms, batch_count) = self.uniforms(context, views, batches);
         let group = context
             .device
             .create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview_hair"),
                 layout: &self.draw_layout,
                 entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                            buffer: &uniforms,
-                            offset: 0,
-                            size: wgpu::BufferSize::new(size_of::<HairUniforms>() as u64),
-                        }),
-                    },
+                    Self::uniform_entry(&uniforms),
                     wgpu::BindGroupEntry {
                         binding: 1,
                         resource: strands.as_entire_binding(),
@@ -283,26 +347,86 @@ impl HairRenderer {
             });
         PreparedHair {
             group,
+            input: RibbonInput::Buffer,
             stride: self.uniform_stride,
             batch_count,
         }
     }
 
-    /// Draws batch `batch` (its `segments` segments) of view `view` with `pipeline`; groups
-    /// 1 and 2, when the pipeline has them, are set by the caller.
+    /// As [`Self::prepare`], for ribbons that generate their own vertices from `hair`
+    /// ([`RibbonInput::Generated`]): the bind group holds strand_gen's resources instead of
+    /// vertices.
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "one frame's generation inputs, passed through"
+    )]
+    pub fn prepare_generated(
+        &self,
+        context: &GpuContext,
+        views: &[HairUniforms],
+        batches: &[[u32; 2]],
+        generator: &StrandGenRenderer,
+        hair: &GpuHair,
+        filtering: Filtering,
+        runs: &wgpu::Buffer,
+    ) -> PreparedHair {
+        let (uniforms, batch_count) = self.uniforms(context, views, batches);
+        // first_run and run_count are per batch in the ribbons' uniforms; these are unused.
+        let params = generator.params_buffer(context, hair, filtering, 0, &[]);
+        let mut entries = vec![
+            Self::uniform_entry(&uniforms),
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: runs.as_entire_binding(),
+            },
+        ];
+        entries.extend(generator.source_entries(GENERATED_BINDING_OFFSET, hair, &params));
+        let group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("preview_hair_generated"),
+                layout: &self.generated_layout,
+                entries: &entries,
+            });
+        PreparedHair {
+            group,
+            input: RibbonInput::Generated,
+            stride: self.uniform_stride,
+            batch_count,
+        }
+    }
+
+    /// Draws batch `batch` (whose runs are `runs`) of view `view` with `pipeline`; groups 1
+    /// and 2, when the pipeline has them, are set by the caller. Ribbons from a buffer are one
+    /// triangle-list draw (6 vertices per segment); generated ribbons one draw per run, a
+    /// strip of 2 vertices per strand vertex for each of its strands (the instances).
     pub fn draw_with(
         pass: &mut wgpu::RenderPass<'_>,
         pipeline: &wgpu::RenderPipeline,
         prepared: &PreparedHair,
         view: usize,
         batch: usize,
-        segments: u32,
+        runs: &[StrandRun],
     ) {
-        if segments > 0 {
-            pass.set_pipeline(pipeline);
-            let index = (view * prepared.batch_count + batch) as u64;
-            pass.set_bind_group(0, &prepared.group, &[(index * prepared.stride) as u32]);
-            pass.draw(0..segments * 6, 0..1);
+        let segments = FramePlan::batch_segments(runs) as u32;
+        if segments == 0 {
+            return;
+        }
+        pass.set_pipeline(pipeline);
+        let index = (view * prepared.batch_count + batch) as u64;
+        pass.set_bind_group(0, &prepared.group, &[(index * prepared.stride) as u32]);
+        match prepared.input {
+            RibbonInput::Buffer => pass.draw(0..segments * 6, 0..1),
+            RibbonInput::Generated => {
+                for run in runs.iter().filter(|r| r.strand_count > 0) {
+                    // Strands before the run each have one more vertex than segments.
+                    let first = run.vertex_offset - run.segment_offset;
+                    pass.draw(
+                        0..2 * run.vertex_count.max(2),
+                        first..first + run.strand_count,
+                    );
+                }
+            }
         }
     }
 

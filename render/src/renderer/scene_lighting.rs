@@ -133,6 +133,27 @@ macro_rules! shader_file {
 
 pub const STRAND_RUN: &str = shader_file!("shared/strand_run.wgsl");
 pub const RIBBON: &str = shader_file!("shared/ribbon.wgsl");
+pub const RIBBON_STORED: &str = shader_file!("shared/ribbon_stored.wgsl");
+pub const RIBBON_GENERATED: &str = shader_file!("shared/ribbon_generated.wgsl");
+pub const STRAND_VERTEX: &str = shader_file!("shared/strand_vertex.wgsl");
+
+/// Where the ribbons' strand vertices come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RibbonInput {
+    /// A buffer: the batch's scratch (compute generation) or stored vertices.
+    #[default]
+    Buffer,
+    /// Generated in the ribbon vertex shader from the runtime textures.
+    Generated,
+}
+
+/// The ribbon modules for `input`: the runs, where the vertices come from, the ribbons.
+fn ribbon_modules(input: RibbonInput) -> String {
+    match input {
+        RibbonInput::Buffer => [STRAND_RUN, RIBBON_STORED, RIBBON].concat(),
+        RibbonInput::Generated => [STRAND_RUN, STRAND_VERTEX, RIBBON_GENERATED, RIBBON].concat(),
+    }
+}
 pub const SCENE: &str = shader_file!("shared/scene.wgsl");
 pub const HAIR_BSDF: &str = shader_file!("light/hair_bsdf.wgsl");
 pub const KAJIYA_KAY: &str = shader_file!("light/kajiya_kay.wgsl");
@@ -172,10 +193,11 @@ fn shadow_modules(key: &ShaderKey, source: &mut String) {
     });
 }
 
-/// The hair's colour pass for `key`: runs, ribbons, the scene, the shading model's modules,
-/// the shadow modules, then `preview_hair.wgsl`.
-pub fn hair_shader(key: &ShaderKey) -> String {
-    let mut source = [STRAND_RUN, RIBBON, SCENE].concat();
+/// The hair's colour pass for `key`: runs, ribbons from `input`, the scene, the shading
+/// model's modules, the shadow modules, then `preview_hair.wgsl`.
+pub fn hair_shader(key: &ShaderKey, input: RibbonInput) -> String {
+    let mut source = ribbon_modules(input);
+    source.push_str(SCENE);
     match key.shading {
         Shading::KajiyaKay => {
             source.push_str(KAJIYA_KAY);
@@ -206,10 +228,9 @@ pub fn body_shader(key: &ShaderKey) -> String {
 
 /// The hair's shadow passes for opacity maps of `kind` (deep opacity maps read the first-hair
 /// depth; opacity shadow maps start at the near plane).
-pub fn hair_shadow_shader(kind: SelfShadowing) -> String {
+pub fn hair_shadow_shader(kind: SelfShadowing, input: RibbonInput) -> String {
     [
-        STRAND_RUN,
-        RIBBON,
+        ribbon_modules(input).as_str(),
         SCENE,
         OPACITY_LAYERS,
         if kind == SelfShadowing::DeepOpacityMaps {

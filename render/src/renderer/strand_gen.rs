@@ -19,12 +19,72 @@ use wgpu::util::DeviceExt;
 use crate::device::{GpuContext, read_buffer};
 use crate::resources::Tracked;
 
-/// The WGSL source: `shaders/shared/strand_run.wgsl` then `shaders/strand_gen.wgsl`
-/// (validated by naga in `cargo test`).
+/// The WGSL source: `shaders/shared/strand_run.wgsl`, `shaders/shared/strand_vertex.wgsl`,
+/// then `shaders/strand_gen.wgsl` (validated by naga in `cargo test`).
 pub const SHADER_SOURCE: &str = concat!(
     include_str!("../../../shaders/shared/strand_run.wgsl"),
+    include_str!("../../../shaders/shared/strand_vertex.wgsl"),
     include_str!("../../../shaders/strand_gen.wgsl")
 );
+
+/// Where the ribbon vertex shader binds strand_gen's resources: their compute bindings plus
+/// this (`shaders/shared/ribbon_generated.wgsl`).
+pub const GENERATED_BINDING_OFFSET: u32 = 16;
+
+/// strand_gen's bindings other than its output (4) and runs (10).
+const SOURCE_BINDINGS: [u32; 10] = [0, 1, 2, 3, 5, 6, 7, 8, 9, 11];
+
+/// The layout entries of strand_gen's resources other than its output and runs (params,
+/// bundles, the five textures and their sampler, styling, samples) at their compute bindings
+/// plus `offset`: the compute layout's (offset 0) and the generating ribbons'
+/// ([`GENERATED_BINDING_OFFSET`]). 32-bit float textures are only filterable with
+/// `FLOAT32_FILTERABLE`; without it the layout declares them unfilterable and hardware
+/// filtering is refused ([`StrandGenRenderer::check_filtering`]).
+pub fn source_layout_entries(
+    device: &wgpu::Device,
+    offset: u32,
+    visibility: wgpu::ShaderStages,
+) -> Vec<wgpu::BindGroupLayoutEntry> {
+    let float32_filterable = device
+        .features()
+        .contains(wgpu::Features::FLOAT32_FILTERABLE);
+    let storage = |size: u64| wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only: true },
+        has_dynamic_offset: false,
+        min_binding_size: wgpu::BufferSize::new(size),
+    };
+    let texture = wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float {
+            filterable: float32_filterable,
+        },
+        view_dimension: wgpu::TextureViewDimension::D3,
+        multisampled: false,
+    };
+    SOURCE_BINDINGS
+        .iter()
+        .map(|&binding| wgpu::BindGroupLayoutEntry {
+            binding: binding + offset,
+            visibility,
+            ty: match binding {
+                0 => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: wgpu::BufferSize::new(size_of::<StrandGenParams>() as u64),
+                },
+                1 => storage(size_of::<BundleGpu>() as u64),
+                3 => wgpu::BindingType::Sampler(if float32_filterable {
+                    wgpu::SamplerBindingType::Filtering
+                } else {
+                    wgpu::SamplerBindingType::NonFiltering
+                }),
+                9 => storage(size_of::<StylingGpu>() as u64),
+                11 => storage(8),
+                _ => texture,
+            },
+            count: None,
+        })
+        .collect()
+}
 
 /// Why generation failed.
 #[derive(Debug, thiserror::Error)]
@@ -127,8 +187,46 @@ pub fn check_adapter_limits(
     Ok(())
 }
 
+/// Where strands are generated, and how the work is spread (`hairloom bench gpu` measures
+/// each side by side).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GenerationPath {
+    /// `strand_gen.wgsl` `main` into a bounded scratch buffer the ribbons read: one
+    /// invocation per strand computes the strand's set-up (root, root uv, length, the styling
+    /// ops' random values) once and walks its vertices, morphing odd ones from the neighbours
+    /// it has just computed.
+    #[default]
+    ComputePerStrand,
+    /// `main_per_vertex`: one invocation per vertex, redoing the set-up at every vertex (and
+    /// three vertices for a morphed one); adjacent invocations write adjacent vertices, which
+    /// a GPU's memory system may prefer.
+    ComputePerVertex,
+    /// No compute pass and no scratch buffer: the ribbon vertex shader evaluates its own
+    /// strand vertex from the textures (`shared/ribbon_generated.wgsl`), in every pass that
+    /// draws the hair. Readbacks ([`StrandGenRenderer::generate_positions`],
+    /// [`StrandGenRenderer::store`]) still use the per-strand compute entry.
+    VertexShader,
+}
+
+impl GenerationPath {
+    pub const ALL: [GenerationPath; 3] = [
+        GenerationPath::ComputePerStrand,
+        GenerationPath::ComputePerVertex,
+        GenerationPath::VertexShader,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            GenerationPath::ComputePerStrand => "compute per strand",
+            GenerationPath::ComputePerVertex => "compute per vertex",
+            GenerationPath::VertexShader => "vertex shader",
+        }
+    }
+}
+
 /// Pipeline and bind-group layout of `strand_gen` (one per device).
 pub struct StrandGenRenderer {
+    path: GenerationPath,
     pipeline: Tracked<wgpu::ComputePipeline>,
     bind_group_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
@@ -299,7 +397,13 @@ fn styling_or_default(styling: Vec<StylingGpu>) -> Vec<StylingGpu> {
 }
 
 impl StrandGenRenderer {
+    /// Generation by compute, one invocation per strand ([`GenerationPath::ComputePerStrand`]).
     pub fn new(context: &GpuContext) -> Self {
+        Self::with_path(context, GenerationPath::default())
+    }
+
+    /// Generation where and as `path` says.
+    pub fn with_path(context: &GpuContext, path: GenerationPath) -> Self {
         let device = &context.device;
         let float32_filterable = device
             .features()
@@ -308,59 +412,30 @@ impl StrandGenRenderer {
             label: Some("strand_gen"),
             source: wgpu::ShaderSource::Wgsl(SHADER_SOURCE.into()),
         });
-        let entry = |binding: u32, ty: wgpu::BindingType| wgpu::BindGroupLayoutEntry {
+        let storage = |binding: u32, size: u64| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(size),
+            },
             count: None,
         };
-        let storage = |read_only: bool, size: u64| wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: wgpu::BufferSize::new(size),
-        };
-        // 32-bit float textures are only filterable with FLOAT32_FILTERABLE; without it the
-        // layout declares them unfilterable and hardware filtering is refused (check_filtering).
-        let texture = wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float {
-                filterable: float32_filterable,
+        let mut entries = source_layout_entries(device, 0, wgpu::ShaderStages::COMPUTE);
+        entries.push(storage(4, 16));
+        entries.push(wgpu::BindGroupLayoutEntry {
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(size_of::<StrandRun>() as u64),
             },
-            view_dimension: wgpu::TextureViewDimension::D3,
-            multisampled: false,
-        };
-        let sampler_type = if float32_filterable {
-            wgpu::SamplerBindingType::Filtering
-        } else {
-            wgpu::SamplerBindingType::NonFiltering
-        };
-        // In @binding order, as the shader declares them.
-        let bind_group_layout =
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("strand_gen"),
-                entries: &[
-                    entry(
-                        0,
-                        wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Uniform,
-                            has_dynamic_offset: false,
-                            min_binding_size: wgpu::BufferSize::new(
-                                size_of::<StrandGenParams>() as u64
-                            ),
-                        },
-                    ),
-                    entry(1, storage(true, size_of::<BundleGpu>() as u64)),
-                    entry(2, texture),
-                    entry(3, wgpu::BindingType::Sampler(sampler_type)),
-                    entry(4, storage(false, 16)),
-                    entry(5, texture),
-                    entry(6, texture),
-                    entry(7, texture),
-                    entry(8, texture),
-                    entry(9, storage(true, size_of::<StylingGpu>() as u64)),
-                    entry(10, storage(true, size_of::<StrandRun>() as u64)),
-                    entry(11, storage(true, 8)),
-                ],
-            });
+            ..storage(10, 0)
+        });
+        let bind_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("strand_gen"),
+            entries: &entries,
+        });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("strand_gen"),
             bind_group_layouts: &[Some(&bind_group_layout)],
@@ -372,7 +447,10 @@ impl StrandGenRenderer {
                 label: Some("strand_gen"),
                 layout: Some(&layout),
                 module: &module,
-                entry_point: Some("main"),
+                entry_point: Some(match path {
+                    GenerationPath::ComputePerVertex => "main_per_vertex",
+                    _ => "main",
+                }),
                 compilation_options: Default::default(),
                 cache: None,
             },
@@ -392,6 +470,7 @@ impl StrandGenRenderer {
             ..Default::default()
         });
         Self {
+            path,
             pipeline,
             bind_group_layout,
             sampler,
@@ -549,8 +628,52 @@ impl StrandGenRenderer {
         output: &wgpu::Buffer,
         timestamp_writes: Option<wgpu::ComputePassTimestampWrites>,
     ) {
-        let device = &context.device;
         let vertex_total = FramePlan::batch_vertices(batch) as u32;
+        let strand_total: u32 = batch.iter().map(|run| run.strand_count).sum();
+        let params = self.params_buffer(context, hair, filtering, first_run as u32, batch);
+        let mut entries = self.source_entries(0, hair, &params);
+        entries.push(wgpu::BindGroupEntry {
+            binding: 4,
+            resource: output.as_entire_binding(),
+        });
+        entries.push(wgpu::BindGroupEntry {
+            binding: 10,
+            resource: runs.as_entire_binding(),
+        });
+        let bind_group = context
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("strand_gen"),
+                layout: &self.bind_group_layout,
+                entries: &entries,
+            });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("strand_gen"),
+            timestamp_writes,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        let invocations = match self.path {
+            GenerationPath::ComputePerVertex => vertex_total,
+            _ => strand_total,
+        };
+        pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP_SIZE), 1, 1);
+    }
+
+    /// Where strands are generated.
+    pub fn path(&self) -> GenerationPath {
+        self.path
+    }
+
+    /// The uniform parameters of generating `batch` (`runs[first_run..]` of the uploaded runs).
+    pub fn params_buffer(
+        &self,
+        context: &GpuContext,
+        hair: &GpuHair,
+        filtering: Filtering,
+        first_run: u32,
+        batch: &[StrandRun],
+    ) -> wgpu::Buffer {
         let params = StrandGenParams {
             position_offset: [
                 hair.position_offset[0],
@@ -558,74 +681,57 @@ impl StrandGenRenderer {
                 hair.position_offset[2],
                 0.0,
             ],
-            vertex_total,
+            vertex_total: FramePlan::batch_vertices(batch) as u32,
             run_count: batch.len() as u32,
             filtering: match filtering {
                 Filtering::Exact => FILTERING_EXACT,
                 Filtering::Hardware8Bit => FILTERING_HARDWARE,
             },
-            first_run: first_run as u32,
+            first_run,
             per_bundle: hair.per_bundle.max(1),
             sample_set: hair.sample_set,
-            _padding: [0; 2],
+            strand_total: batch.iter().map(|run| run.strand_count).sum(),
+            _padding: 0,
         };
-        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("strand_gen_params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        fn view(binding: u32, view: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+        context
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("strand_gen_params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+    }
+
+    /// The bind-group entries of `hair` for [`source_layout_entries`] at `offset`.
+    pub fn source_entries<'a>(
+        &'a self,
+        offset: u32,
+        hair: &'a GpuHair,
+        params: &'a wgpu::Buffer,
+    ) -> Vec<wgpu::BindGroupEntry<'a>> {
+        let view = |binding: u32, view: &'a wgpu::TextureView| wgpu::BindGroupEntry {
+            binding: binding + offset,
+            resource: wgpu::BindingResource::TextureView(view),
+        };
+        let buffer = |binding: u32, buffer: &'a wgpu::Buffer| wgpu::BindGroupEntry {
+            binding: binding + offset,
+            resource: buffer.as_entire_binding(),
+        };
+        vec![
+            buffer(0, params),
+            buffer(1, &hair.bundle_buffer),
+            view(2, &hair.hair_mesh),
             wgpu::BindGroupEntry {
-                binding,
-                resource: wgpu::BindingResource::TextureView(view),
-            }
-        }
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("strand_gen"),
-            layout: &self.bind_group_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: hair.bundle_buffer.as_entire_binding(),
-                },
-                view(2, &hair.hair_mesh),
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&self.sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: output.as_entire_binding(),
-                },
-                view(5, &hair.uv),
-                view(6, &hair.w),
-                view(7, &hair.u),
-                view(8, &hair.v),
-                wgpu::BindGroupEntry {
-                    binding: 9,
-                    resource: hair.styling.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 10,
-                    resource: runs.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 11,
-                    resource: hair.samples.as_entire_binding(),
-                },
-            ],
-        });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("strand_gen"),
-            timestamp_writes,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(vertex_total.div_ceil(WORKGROUP_SIZE), 1, 1);
+                binding: 3 + offset,
+                resource: wgpu::BindingResource::Sampler(&self.sampler),
+            },
+            view(5, &hair.uv),
+            view(6, &hair.w),
+            view(7, &hair.u),
+            view(8, &hair.v),
+            buffer(9, &hair.styling),
+            buffer(11, &hair.samples),
+        ]
     }
 
     /// A scratch buffer for the largest batch of `plan`.
