@@ -12,7 +12,7 @@ use hairloom_render::game::{GameCamera, GameFrameStats, GameHair, game_scene};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::Targets;
 use hairloom_render::renderer::preview_body::GpuBody;
-use hairloom_render::renderer::strand_gen::StrandGenRenderer;
+use hairloom_render::renderer::strand_gen::{GenerationPath, StrandGenRenderer};
 use hairloom_render::view::View;
 
 const SIZE: u32 = 160;
@@ -174,6 +174,30 @@ fn game_runtime_draws_what_the_preview_draws() {
         expected == drawn,
         "game runtime vs preview: mean difference {difference:.3} per channel"
     );
+
+    // Generated in the ribbons' vertex shader instead: no compute pass, no scratch, the same
+    // picture (and the same plan, since the compute path's one batch held every strand).
+    game.set_generation(GenerationPath::VertexShader)
+        .expect("the vertex-shader path");
+    let (vs_stats, vs_drawn) = draw(&context, &mut game, &view, &game_camera, background);
+    assert_eq!(
+        (vs_stats.strands, vs_stats.vertices),
+        (stats.strands, stats.vertices)
+    );
+    assert!(stats.scratch_bytes >= stats.vertices as u64 * 16);
+    assert_eq!(vs_stats.scratch_bytes, 0, "no scratch buffer");
+    let differing = drawn
+        .chunks_exact(4)
+        .zip(vs_drawn.chunks_exact(4))
+        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2))
+        .count();
+    eprintln!("game runtime, vertex-shader generation: {differing} pixels differ by > 2/255");
+    assert!(
+        differing * 1000 <= (SIZE * SIZE) as usize,
+        "{differing} pixels differ"
+    );
+    game.set_generation(GenerationPath::ComputePerStrand)
+        .expect("back to compute");
 
     // Without the body the picture loses it: the switch is real.
     game.set_draw_body(false);
