@@ -300,6 +300,12 @@ impl GameHair {
         self.draw_body = draw;
     }
 
+    /// Bytes the bundle keeps on the GPU (textures, placements, root samples, styling):
+    /// what every frame and every copy drawn from it share.
+    pub fn resident_bytes(&self) -> u64 {
+        self.gpu.bytes
+    }
+
     /// Level of detail and culling (the bundle's settings by default).
     pub fn set_lod(&mut self, lod: LodSettings) {
         self.lod = lod;

@@ -104,6 +104,28 @@ pub enum Which {
         #[arg(long, default_value = "target/bench")]
         out: std::path::PathBuf,
     },
+    /// Many characters in one frame (the paper's Fig. 1 crowd): one uploaded bundle drawn N
+    /// times with its own transform and LOD through the game runtime; frame time and GPU
+    /// memory against N.
+    Crowd {
+        #[arg(long)]
+        project: Option<std::path::PathBuf>,
+        /// Character counts to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [1usize, 4, 16, 64])]
+        characters: Vec<usize>,
+        /// Strands per character (rounded up to whole bundles).
+        #[arg(long, default_value_t = 10_000)]
+        strands: usize,
+        /// Frame size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x720")]
+        size: String,
+        /// Measured runs per row after one warm-up (the median is reported).
+        #[arg(long, default_value_t = 1)]
+        runs: usize,
+        /// Write each crowd's frame as crowd_N.png into this folder.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
     /// What each lighting effect costs: the frame with none, each alone, the scene's own
     /// combination and everything, at 10K and 100K strands (time and GPU memory).
     Effects {
@@ -186,6 +208,21 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             size,
             runs,
         } => super::bench_effects::run(project, &strands, &size, runs.max(1)),
+        Which::Crowd {
+            project,
+            characters,
+            strands,
+            size,
+            runs,
+            out,
+        } => super::bench_crowd::run(&super::bench_crowd::CrowdSettings {
+            project,
+            characters,
+            strands,
+            size,
+            runs,
+            out,
+        }),
         Which::Edit {
             project,
             size,

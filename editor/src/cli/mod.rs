@@ -14,6 +14,7 @@ use hairloom_render::renderer::strand_gen::GenerationPath;
 
 mod accuracy;
 mod bench;
+mod bench_crowd;
 mod bench_effects;
 mod bench_shading;
 mod bench_sim;
