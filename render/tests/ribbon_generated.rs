@@ -4,8 +4,10 @@
 //! shader's own `ribbon_centre` runs in a compute entry point appended to the preview shader
 //! (the vertex stage cannot write a buffer), with the bindings the vertex stage reads.
 
+mod common;
+
 use glam::Vec3;
-use hairloom_core::runtime::frame_plan::{LodCamera, LodSettings, plan_frame};
+use hairloom_core::runtime::frame_plan::{LodSettings, plan_frame};
 use hairloom_core::runtime::gpu_types::StrandRun;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::preview_hair::batch_tangents;
@@ -44,20 +46,12 @@ fn ribbon_readback(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 "#;
 
-fn sample(name: &str) -> hairloom_core::model::document::Document {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../assets/samples/{name}.hairloom"));
-    hairloom_core::io::project::load(&path)
-        .expect("sample")
-        .document
-}
-
 #[test]
 fn vertex_shader_generation_matches_compute_and_the_cpu_mirror() {
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };
-    let document = sample("head_long_wavy");
+    let document = common::sample("head_long_wavy");
     let runtime = RuntimeHair::from_document(
         &document,
         &RuntimeOptions {
@@ -72,22 +66,7 @@ fn vertex_shader_generation_matches_compute_and_the_cpu_mirror() {
     // A camera far enough for partial strand counts, several vertex levels and morphing;
     // one batch.
     let (lo, hi) = runtime.textures.hair_bounds().expect("hair");
-    let centre = (lo + hi) * 0.5;
-    let eye = centre + Vec3::new(0.0, 0.0, 6.0);
-    let fov_y_rad = 30f32.to_radians();
-    let camera = LodCamera {
-        eye,
-        view_projection: glam::Mat4::perspective_rh(fov_y_rad, 1.0, 0.01, 100.0)
-            * glam::Mat4::look_at_rh(eye, centre, Vec3::Y),
-        fov_y_rad,
-        resolution_px: 1080.0,
-    };
-    let lod = LodSettings {
-        alpha_strands: 0.02,
-        alpha_vertices: 0.005,
-        lambda: 1.0,
-        ..LodSettings::default()
-    };
+    let (camera, lod) = common::morphing_lod(lo, hi);
     let mut plan = plan_frame(&hair.bundles, 16, 5, &camera, &lod, usize::MAX / 2);
     assert_eq!(plan.batches.len(), 1);
     // And a run of 2-vertex strands (the tangent's other rule) at the end.
@@ -252,7 +231,7 @@ fn vertex_shader_frames_match_compute_frames() {
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };
-    let document = sample("head_curly");
+    let document = common::sample("head_curly");
     let runtime = RuntimeHair::from_document(
         &document,
         &RuntimeOptions {

@@ -3,6 +3,8 @@
 //! group: exact filtering within 1e-5 × model size; hardware filtering within the bound the
 //! CPU emulation of 8-bit weights documents. Runs on lavapipe in CI.
 
+mod common;
+
 use hairloom_core::model::styling::{StylingGroup, StylingParams, Twist};
 use hairloom_core::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
@@ -20,14 +22,6 @@ fn compute_renderers(context: &hairloom_render::device::GpuContext) -> [StrandGe
     .map(|path| StrandGenRenderer::with_path(context, path))
 }
 
-fn sample(name: &str) -> hairloom_core::model::document::Document {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../assets/samples/{name}.hairloom"));
-    hairloom_core::io::project::load(&path)
-        .expect("sample")
-        .document
-}
-
 #[test]
 fn gpu_strands_match_the_cpu_mirror() {
     let Some(context) = headless_for_test(module_path!()) else {
@@ -36,7 +30,7 @@ fn gpu_strands_match_the_cpu_mirror() {
     let renderers = compute_renderers(&context);
     let renderer = &renderers[0];
     for name in ["head_curly", "head_long_wavy", "teapot_fur"] {
-        let mut document = sample(name);
+        let mut document = common::sample(name);
         // The sample's own ops plus twist (the one that reads the centre strand), and a group
         // with other parameters on a few bundles (the per-root styling index).
         document.styling.global.twist = Twist { turns_per_m: 4.0 };
@@ -127,7 +121,7 @@ fn generation_runs_in_batches_with_bounded_scratch() {
         return;
     };
     let renderer = StrandGenRenderer::new(&context);
-    let document = sample("teapot_fur");
+    let document = common::sample("teapot_fur");
     let mut runtime = RuntimeHair::from_document(
         &document,
         &RuntimeOptions {
@@ -206,13 +200,13 @@ fn generation_runs_in_batches_with_bounded_scratch() {
 
 #[test]
 fn lod_runs_match_the_cpu_mirror_with_morphing() {
-    use hairloom_core::runtime::frame_plan::{LodCamera, LodSettings, plan_frame};
+    use hairloom_core::runtime::frame_plan::plan_frame;
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };
     let renderers = compute_renderers(&context);
     let renderer = &renderers[0];
-    let document = sample("head_long_wavy");
+    let document = common::sample("head_long_wavy");
     let runtime = RuntimeHair::from_document(
         &document,
         &RuntimeOptions {
@@ -225,24 +219,7 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
     let hair = renderer.upload(&context, &runtime).expect("upload");
     // A camera far enough for partial strand counts, several vertex levels and morphing.
     let (lo, hi) = textures.hair_bounds().expect("hair");
-    let centre = (lo + hi) * 0.5;
-    let eye = centre + glam::Vec3::new(0.0, 0.0, 6.0);
-    let fov_y_rad = 30f32.to_radians();
-    let camera = LodCamera {
-        eye,
-        view_projection: glam::Mat4::perspective_rh(fov_y_rad, 1.0, 0.01, 100.0)
-            * glam::Mat4::look_at_rh(eye, centre, glam::Vec3::Y),
-        fov_y_rad,
-        resolution_px: 1080.0,
-    };
-    // A small batch limit, so runs split across batches too.
-    // A wide morph window (λ = 1) so that many bundles sit between two vertex levels.
-    let lod = LodSettings {
-        alpha_strands: 0.02,
-        alpha_vertices: 0.005,
-        lambda: 1.0,
-        ..LodSettings::default()
-    };
+    let (camera, lod) = common::morphing_lod(lo, hi);
     let plan = plan_frame(&hair.bundles, 32, 5, &camera, &lod, 4000);
     let runs: Vec<_> = plan.batches.iter().flatten().collect();
     assert!(
@@ -288,7 +265,7 @@ fn restyling_in_place_generates_what_a_fresh_upload_does() {
         return;
     };
     let renderer = StrandGenRenderer::new(&context);
-    let mut document = sample("head_curly");
+    let mut document = common::sample("head_curly");
     let options = RuntimeOptions {
         strands_per_bundle: 8,
         ..RuntimeOptions::default()
@@ -321,7 +298,7 @@ fn restyling_in_place_generates_what_a_fresh_upload_does() {
             &renderer
                 .upload(
                     &context,
-                    &RuntimeHair::from_document(&sample("head_curly"), &options),
+                    &RuntimeHair::from_document(&common::sample("head_curly"), &options),
                 )
                 .expect("upload"),
             &plan,
@@ -336,7 +313,8 @@ fn restyling_in_place_generates_what_a_fresh_upload_does() {
 #[test]
 fn hair_above_the_adapter_limits_is_refused_by_name() {
     use hairloom_render::renderer::strand_gen::{StrandGenError, check_adapter_limits};
-    let hair = RuntimeHair::from_document(&sample("head_curly"), &RuntimeOptions::default());
+    let hair =
+        RuntimeHair::from_document(&common::sample("head_curly"), &RuntimeOptions::default());
     let depth = hair.textures.hair_mesh.depth;
     let layers = hair
         .textures
