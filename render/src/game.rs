@@ -95,10 +95,11 @@ pub struct GameFrameStats {
     pub vertices: usize,
     /// Bundles outside the view, skipped.
     pub culled_bundles: usize,
-    /// Strands planned but not drawn: more vertices than one generation dispatch of the
-    /// game's device holds (its `max_storage_buffer_binding_size` / 16 B and
-    /// `max_compute_workgroups_per_dimension` × 64; let LOD drop strands, or raise the
-    /// binding limit when the device was created).
+    /// Strands planned but not drawn: more vertices than one compute generation dispatch of
+    /// the game's device holds (its `max_storage_buffer_binding_size` / 16 B, and
+    /// `max_compute_workgroups_per_dimension` × 64 invocations; let LOD drop strands, raise
+    /// the binding limit when the device was created, or generate in the vertex shader,
+    /// which has no such limit).
     pub strands_over_limit: usize,
     /// Bytes of this frame's generation scratch buffer (0 when the ribbons generate their
     /// own vertices).
@@ -353,15 +354,17 @@ impl GameHair {
             resolution_px: height_px as f32,
         };
         // One batch, so generation runs once before the pass: as many vertices as one
-        // storage binding holds (16 B each) and one row of 64-wide workgroups reaches.
-        // Ribbons that generate their own vertices have no scratch to fill, so no limit.
+        // storage binding holds (16 B each) and one row of 64-wide workgroups reaches (one
+        // invocation per vertex, or per strand of at least 2 vertices). Ribbons that generate
+        // their own vertices have no scratch to fill, so no limit.
         let input = self.ribbon_input();
         let limits = context.device.limits();
-        let binding_vertices = match input {
-            RibbonInput::Buffer => (limits.max_storage_buffer_binding_size / 16)
-                .min(limits.max_compute_workgroups_per_dimension as u64 * 64)
-                .max(2) as usize,
-            RibbonInput::Generated => usize::MAX / 2,
+        let binding = limits.max_storage_buffer_binding_size / 16;
+        let row = limits.max_compute_workgroups_per_dimension as u64 * 64;
+        let binding_vertices = match self.generator.path() {
+            GenerationPath::ComputePerVertex => binding.min(row).max(2) as usize,
+            GenerationPath::ComputePerStrand => binding.min(2 * row).max(2) as usize,
+            GenerationPath::VertexShader => usize::MAX / 2,
         };
         let mut plan = plan_frame(
             &self.gpu.bundles,

@@ -5,7 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 
 /// Uniform parameters of strand generation.
-/// Keep in sync with `shaders/strand_gen.wgsl` (`StrandGenParams`).
+/// Keep in sync with `shaders/shared/strand_vertex.wgsl` (`StrandGenParams`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct StrandGenParams {
@@ -29,7 +29,7 @@ pub struct StrandGenParams {
 
 /// One bundle's placement on the root slice: what the shader needs to turn a root sample into
 /// texel coordinates (mirror: `runtime::strand_root`).
-/// Keep in sync with `shaders/strand_gen.wgsl` (`BundleGpu`).
+/// Keep in sync with `shaders/shared/strand_vertex.wgsl` (`BundleGpu`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BundleGpu {
@@ -65,7 +65,7 @@ impl BundleGpu {
 
 /// Consecutive strands of one bundle drawn at one vertex level of detail: the unit the
 /// bundle-level work (culling, strand and vertex LOD) hands to the strand-level work.
-/// Keep in sync with `shaders/strand_gen.wgsl` and `shaders/preview_hair.wgsl` (`StrandRun`).
+/// Keep in sync with `shaders/shared/strand_run.wgsl` (`StrandRun`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct StrandRun {
@@ -86,7 +86,7 @@ pub struct StrandRun {
 }
 
 /// One strand's root on the root slice.
-/// Keep in sync with `shaders/strand_gen.wgsl` (`StrandRoot`).
+/// Keep in sync with `shaders/shared/strand_vertex.wgsl` (`StrandRoot`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct StrandRoot {
@@ -102,7 +102,7 @@ pub struct StrandRoot {
 }
 
 /// One set of styling parameters in f32 (`crate::model::styling::StylingParams`), flattened.
-/// Keep in sync with `shaders/strand_gen.wgsl` (`Styling`).
+/// Keep in sync with `shaders/shared/strand_vertex.wgsl` (`Styling`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct StylingGpu {

@@ -1,4 +1,5 @@
-//! CPU mirror of `shaders/strand_gen.wgsl`: every strand vertex computed from the five
+//! CPU mirror of `shaders/strand_gen.wgsl` and the vertex it evaluates,
+//! `shaders/shared/strand_vertex.wgsl`: every strand vertex computed from the five
 //! runtime textures exactly as the shader computes it, in f32 (the styling ops in f64, within
 //! the parity bound of `render/tests/strand_gen.rs`). Functions carry the names of the WGSL
 //! functions they mirror: [`fetch`], [`StrandGen::strand_position`], [`strand_root`],
@@ -82,7 +83,7 @@ impl StrandGen<'_> {
     }
 
     /// Position at root texel coordinates `texel` of a bundle with `layers` layers and curve
-    /// parameter `tau` (mirror: `strand_position` in `strand_gen.wgsl`).
+    /// parameter `tau` (mirror: `strand_position` in `shared/strand_vertex.wgsl`).
     pub fn strand_position(&self, texel: Vec2, layers: u32, tau: f32) -> Vec3 {
         let tau = tau.clamp(0.0, layers.max(1) as f32);
         let segment = (tau.floor() as u32).min(layers.max(1) - 1);

@@ -125,6 +125,10 @@ pub enum Which {
         /// Write each crowd's frame as crowd_N.png into this folder.
         #[arg(long)]
         out: Option<std::path::PathBuf>,
+        /// Generate in the ribbons' vertex shader (no compute pass, no scratch) instead of
+        /// by compute.
+        #[arg(long)]
+        vertex_shader: bool,
     },
     /// What each lighting effect costs: the frame with none, each alone, the scene's own
     /// combination and everything, at 10K and 100K strands (time and GPU memory).
@@ -215,6 +219,7 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             size,
             runs,
             out,
+            vertex_shader,
         } => super::bench_crowd::run(&super::bench_crowd::CrowdSettings {
             project,
             characters,
@@ -222,6 +227,7 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             size,
             runs,
             out,
+            vertex_shader,
         }),
         Which::Edit {
             project,
