@@ -83,11 +83,6 @@ fn main_per_vertex(@builtin(global_invocation_id) id: vec3<u32>) {
     let strand = local / n;
     let k = local % n;
     let input = strand_input(run.first_root + strand);
-    var p = styled_vertex(input, k, n);
-    if run.gamma > 0.0 && k % 2u == 1u && k + 1u < n {
-        // Eq. 11: odd vertices slide toward their neighbours' midpoint.
-        let middle = 0.5 * (styled_vertex(input, k - 1u, n) + styled_vertex(input, k + 1u, n));
-        p = mix(p, middle, run.gamma);
-    }
+    let p = morphed_vertex(input, k, n, run.gamma);
     positions[vertex] = vec4<f32>(p, along_of(k, n));
 }

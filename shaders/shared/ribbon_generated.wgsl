@@ -21,16 +21,6 @@
 @group(0) @binding(25) var<storage, read> styling: array<Styling>;
 @group(0) @binding(27) var<storage, read> samples: array<vec2<f32>>;
 
-// Vertex k as the compute path leaves it: odd vertices morphed by γ (eq. 11).
-fn morphed_vertex(input: StrandInput, k: u32, n: u32, gamma: f32) -> vec3<f32> {
-    let p = styled_vertex(input, k, n);
-    if gamma > 0.0 && k % 2u == 1u && k + 1u < n {
-        let middle = 0.5 * (styled_vertex(input, k - 1u, n) + styled_vertex(input, k + 1u, n));
-        return mix(p, middle, gamma);
-    }
-    return p;
-}
-
 fn ribbon_centre(vertex_index: u32, instance_index: u32) -> RibbonCentre {
     let run = runs[find_run(hair.batch.x, hair.batch.y, instance_index, RUN_BY_STRAND)];
     let n = max(run.vertex_count, 2u);

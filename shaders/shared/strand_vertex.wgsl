@@ -412,3 +412,14 @@ fn styled_vertex(input: StrandInput, k: u32, n: u32) -> vec3<f32> {
 fn along_of(k: u32, n: u32) -> f32 {
     return f32(k) / f32(n - 1u);
 }
+
+// Vertex k with the run's vertex LOD: an odd vertex slides toward its (unmorphed)
+// neighbours' midpoint by γ (eq. 11; mirror: strands::lod::morph_odd_vertices).
+fn morphed_vertex(input: StrandInput, k: u32, n: u32, gamma: f32) -> vec3<f32> {
+    let p = styled_vertex(input, k, n);
+    if gamma > 0.0 && k % 2u == 1u && k + 1u < n {
+        let middle = 0.5 * (styled_vertex(input, k - 1u, n) + styled_vertex(input, k + 1u, n));
+        return mix(p, middle, gamma);
+    }
+    return p;
+}

@@ -51,13 +51,13 @@ pub enum Which {
         /// Measured runs per row after one warm-up (the median is reported).
         #[arg(long, default_value_t = 3)]
         runs: usize,
-        /// Generation paths to measure, comma-separated: strand (compute, one invocation per
-        /// strand), vertex (compute, one per vertex), vs (in the ribbon vertex shader).
-        #[arg(long, value_delimiter = ',', default_values_t = [String::from("strand"), String::from("vertex"), String::from("vs")])]
-        paths: Vec<String>,
+        /// Generation paths to measure, comma-separated: compute (one invocation per strand),
+        /// compute-per-vertex, vertex-shader (in the ribbons, no scratch).
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["compute", "compute-per-vertex", "vertex-shader"])]
+        paths: Vec<super::GenerationArg>,
         /// Filtering to measure, comma-separated (exact, hardware).
-        #[arg(long, value_delimiter = ',', default_values_t = [String::from("exact"), String::from("hardware")])]
-        filtering: Vec<String>,
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["exact", "hardware"])]
+        filtering: Vec<super::FilteringArg>,
     },
     /// Edit-to-frame latency in the editor's viewport setting: a styling slider tick through
     /// a full rebuild and re-upload (the old path) and through the in-place styling update
@@ -244,29 +244,8 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             paths,
             filtering,
         } => {
-            use hairloom_core::runtime::strand_gen::Filtering;
-            use hairloom_render::renderer::strand_gen::GenerationPath;
-            let paths = paths
-                .iter()
-                .map(|p| match p.as_str() {
-                    "strand" => Ok(GenerationPath::ComputePerStrand),
-                    "vertex" => Ok(GenerationPath::ComputePerVertex),
-                    "vs" => Ok(GenerationPath::VertexShader),
-                    other => Err(anyhow::anyhow!(
-                        "unknown generation path {other:?} (strand, vertex, vs)"
-                    )),
-                })
-                .collect::<anyhow::Result<Vec<_>>>()?;
-            let filterings = filtering
-                .iter()
-                .map(|f| match f.as_str() {
-                    "exact" => Ok(Filtering::Exact),
-                    "hardware" => Ok(Filtering::Hardware8Bit),
-                    other => Err(anyhow::anyhow!(
-                        "unknown filtering {other:?} (exact, hardware)"
-                    )),
-                })
-                .collect::<anyhow::Result<Vec<_>>>()?;
+            let paths: Vec<_> = paths.into_iter().map(Into::into).collect();
+            let filterings: Vec<_> = filtering.into_iter().map(Into::into).collect();
             let precisions = textures
                 .iter()
                 .map(|t| match t.as_str() {
