@@ -393,20 +393,26 @@ fn example_tables() -> Vec<Table> {
         let tau = (root.layers as f64 * input.length_fraction * along) as f32;
         let segment = (tau.floor() as u32).min(root.layers - 1);
         let local = tau - segment as f32;
-        let (a, q) = if local < 0.5 {
-            (4 * segment, local * 2.0)
+        let a = 3 * segment;
+        let (half, q) = if local < 0.5 {
+            (0, local * 2.0)
         } else {
-            (4 * segment + 2, local * 2.0 - 1.0)
+            (1, local * 2.0 - 1.0)
+        };
+        let (z_a, z_b) = if half == 0 {
+            (a as f32 + q, a as f32 + 1.0 + q / 2.0)
+        } else {
+            (a as f32 + 1.5 + q / 2.0, a as f32 + 2.0 + q)
         };
         let fa = fetch(
             &textures.hair_mesh,
-            texel.extend(a as f32 + q + 0.5),
+            texel.extend(z_a + 0.5),
             Filtering::Exact,
         )
         .truncate();
         let fb = fetch(
             &textures.hair_mesh,
-            texel.extend(a as f32 + 1.0 + q + 0.5),
+            texel.extend(z_b + 0.5),
             Filtering::Exact,
         )
         .truncate();
@@ -437,21 +443,22 @@ fn example_tables() -> Vec<Table> {
             sum.as_vec3().distance(styled) < 1e-7,
             "k {k}: the ops add up to the mirror's vertex"
         );
-        first_slices.push(a);
+        first_slices.push((segment, half));
         push("along = k / (n − 1)", index, fixed(&[along], 7));
         push("τ = n · λ_len · along", index, fixed(&[tau as f64], 7));
         push(
             "segment, half",
             index,
-            fixed(&[segment as f64, (a % 4 / 2) as f64], 0),
+            fixed(&[segment as f64, half as f64], 0),
         );
         push(
-            "first slice a, q",
+            "a = 3 · segment, q",
             index,
             format!("{a}, {}", fixed(&[q as f64], 7)),
         );
-        push("A = fetch(a + q + ½)", index, m3f(fa));
-        push("B = fetch(a + 1 + q + ½)", index, m3f(fb));
+        push("z_A, z_B", index, fixed(&[z_a as f64, z_b as f64], 7));
+        push("A = fetch(z_A + ½)", index, m3f(fa));
+        push("B = fetch(z_B + ½)", index, m3f(fb));
         push("position = A + (B − A) q", index, m3f(position));
         push("w", index, fixed(&[w], 7));
         push("û", index, fixed(&u.to_array(), 7));
@@ -507,7 +514,7 @@ fn example_tables() -> Vec<Table> {
     // The prose under the region walks through these four cases.
     assert_eq!(
         first_slices,
-        [0, 2, 4, 6],
+        [(0, 0), (0, 1), (1, 0), (1, 1)],
         "the shown vertices cover every quadratic"
     );
     for (key, cells) in rows {
@@ -890,13 +897,16 @@ mod from_the_document {
         let tau = tau.clamp(0.0, layers as f32);
         let segment = (tau.floor() as u32).min(layers - 1);
         let f = tau - segment as f32;
-        let (a, q) = if f < 0.5 {
-            (4 * segment, 2.0 * f)
+        let a = (3 * segment) as f32;
+        let (z_a, z_b, q) = if f < 0.5 {
+            let q = 2.0 * f;
+            (a + q, a + 1.0 + q / 2.0, q)
         } else {
-            (4 * segment + 2, 2.0 * f - 1.0)
+            let q = 2.0 * f - 1.0;
+            (a + 1.5 + q / 2.0, a + 2.0 + q, q)
         };
-        let first = fetch(t.hair_mesh, p.extend(a as f32 + q + 0.5)).truncate();
-        let second = fetch(t.hair_mesh, p.extend(a as f32 + 1.0 + q + 0.5)).truncate();
+        let first = fetch(t.hair_mesh, p.extend(z_a + 0.5)).truncate();
+        let second = fetch(t.hair_mesh, p.extend(z_b + 0.5)).truncate();
         first + (second - first) * q + t.position_offset
     }
 

@@ -66,7 +66,8 @@ struct Styling {
     _padding: u32,
 }
 
-const SLICES_PER_SEGMENT: u32 = 4u;
+// Mirror: SLICES_PER_SEGMENT in core/src/runtime/textures.rs (p_k, q0, q1 per segment).
+const SLICES_PER_SEGMENT: u32 = 3u;
 const FILTERING_EXACT: u32 = 0u;
 // One turn in radians (2π; light/hair_bsdf.wgsl has its own TAU).
 const TURN_RAD: f32 = 6.283185307179586;
@@ -107,21 +108,30 @@ fn fetch(texture: texture_3d<f32>, coord: vec3<f32>) -> vec4<f32> {
     return textureSampleLevel(texture, linear_clamp, coord / size, 0.0);
 }
 
-// Mirror: StrandGen::strand_position.
-fn strand_position(texel: vec2<f32>, layers: u32, tau_in: f32) -> vec3<f32> {
+// Where the two hair-mesh fetches of curve parameter tau sit: (z_a, z_b, q), the point being
+// mix(fetch(z_a), fetch(z_b), q). The quadratics' joint m = (q0 + q1) / 2 is not stored: it is
+// the fetch half-way between slices 3k+1 (q0) and 3k+2 (q1). Mirror: curve_fetch_slices in
+// core/src/runtime/textures.rs.
+fn curve_fetch_slices(layers: u32, tau_in: f32) -> vec3<f32> {
     let layer_count = max(layers, 1u);
     let tau = clamp(tau_in, 0.0, f32(layer_count));
     let segment = min(u32(floor(tau)), layer_count - 1u);
     let local = tau - f32(segment);
-    var first_slice = SLICES_PER_SEGMENT * segment;
-    var q = local * 2.0;
-    if local >= 0.5 {
-        first_slice = first_slice + 2u;
-        q = local * 2.0 - 1.0;
+    let base = f32(SLICES_PER_SEGMENT * segment);
+    if local < 0.5 {
+        let q = local * 2.0;
+        return vec3<f32>(base + q, base + 1.0 + 0.5 * q, q);
     }
-    let a = fetch(hair_mesh, vec3<f32>(texel, f32(first_slice) + q + 0.5)).xyz;
-    let b = fetch(hair_mesh, vec3<f32>(texel, f32(first_slice) + 1.0 + q + 0.5)).xyz;
-    return a + (b - a) * q + params.position_offset.xyz;
+    let q = local * 2.0 - 1.0;
+    return vec3<f32>(base + 1.5 + 0.5 * q, base + 2.0 + q, q);
+}
+
+// Mirror: StrandGen::strand_position.
+fn strand_position(texel: vec2<f32>, layers: u32, tau: f32) -> vec3<f32> {
+    let slices = curve_fetch_slices(layers, tau);
+    let a = fetch(hair_mesh, vec3<f32>(texel, slices.x + 0.5)).xyz;
+    let b = fetch(hair_mesh, vec3<f32>(texel, slices.y + 0.5)).xyz;
+    return a + (b - a) * slices.z + params.position_offset.xyz;
 }
 
 // --- Deterministic randomness (mirror: core/src/strands/random.rs, core/src/strands/styling.rs) ---

@@ -15,8 +15,13 @@ pub use crate::runtime::hair::LodEntry;
 use crate::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 
-/// Version of the runtime bundle format described in `docs/runtime-format.md`.
-pub const RUNTIME_FORMAT_VERSION: u32 = 1;
+/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 2
+/// stores 3 hair-mesh slices per segment (`p_k, q0, q1`); version 1 stored the quadratics'
+/// joint `m` too (4 slices) and is still read (the `m` slices are dropped on load: `m` is
+/// exactly `(q0 + q1) / 2`).
+pub const RUNTIME_FORMAT_VERSION: u32 = 2;
+/// Hair-mesh slices per segment in format version 1 bundles.
+const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
 /// Why an export failed.
 #[derive(Debug, thiserror::Error)]
@@ -234,7 +239,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         &textures.hair_mesh,
         4,
         false,
-        "object-space positions minus position_offset (xyz); slice 4k is layer k, slices 4k+1..4k+3 are q0, m, q1 of segment k",
+        "object-space positions minus position_offset (xyz); slice 3k is layer k, slices 3k+1 and 3k+2 are q0 and q1 of segment k (its quadratics' joint m is their mean)",
     )?;
     let uv = entry("uv", &textures.uv, 2, true, "root uv (xy)")?;
     let w = entry(
@@ -368,6 +373,28 @@ pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleE
     load_runtime_bundle_from(&BundleFolder(folder), &dir.display().to_string())
 }
 
+/// A format version 1 hair-mesh texture (`p_k, q0, m, q1` per segment) in today's layout
+/// (`p_k, q0, q1`): slices `4k + 2` (the joints `m = (q0 + q1) / 2`) are dropped.
+fn without_joint_slices(four: &Texture3d) -> Texture3d {
+    let slice = (four.width * four.height) as usize;
+    let keep: Vec<u32> = (0..four.depth)
+        .filter(|z| z % VERSION_1_SLICES_PER_SEGMENT != 2)
+        .collect();
+    Texture3d {
+        width: four.width,
+        height: four.height,
+        depth: keep.len() as u32,
+        texels: keep
+            .iter()
+            .flat_map(|&z| {
+                four.texels[z as usize * slice..(z as usize + 1) * slice]
+                    .iter()
+                    .copied()
+            })
+            .collect(),
+    }
+}
+
 /// Loads and checks a runtime bundle: the manifest's version and formats, every KTX2
 /// header against the manifest, sizes, block placements and layer counts, the caps of
 /// [`limits`], and finite texel values. `shown` names the bundle in messages.
@@ -394,17 +421,31 @@ pub fn load_runtime_bundle_from(
             "not a Hairloom runtime manifest (\"format\" is not \"hairloom-runtime\")".into(),
         ));
     }
-    if found != RUNTIME_FORMAT_VERSION as u64 {
+    if found != RUNTIME_FORMAT_VERSION as u64 && found != 1 {
         return Err(error(
             MANIFEST_FILE,
             format!(
-                "format_version {found} is not supported (this build reads {RUNTIME_FORMAT_VERSION})"
+                "format_version {found} is not supported (this build reads 1 to {RUNTIME_FORMAT_VERSION})"
             ),
         ));
     }
     let manifest: Manifest =
         serde_json::from_slice(&manifest_bytes).map_err(|e| error(MANIFEST_FILE, e.to_string()))?;
     check_manifest_caps(&manifest).map_err(|message| error(MANIFEST_FILE, message))?;
+    let slices_per_segment = if found == 1 {
+        VERSION_1_SLICES_PER_SEGMENT
+    } else {
+        SLICES_PER_SEGMENT
+    };
+    if manifest.slices_per_segment != slices_per_segment {
+        return Err(error(
+            MANIFEST_FILE,
+            format!(
+                "slices_per_segment {} does not match format_version {found} (which has {slices_per_segment})",
+                manifest.slices_per_segment
+            ),
+        ));
+    }
     let load = |entry: &TextureEntry, channels: usize| -> Result<Texture3d, BundleError> {
         let format = TexelFormat::for_precision(manifest.precision, channels);
         if entry.vk_format != format.vk_name() {
@@ -438,7 +479,7 @@ pub fn load_runtime_bundle_from(
             ));
         }
     }
-    if hair_mesh.depth != 1 + SLICES_PER_SEGMENT * manifest.max_layers
+    if hair_mesh.depth != 1 + slices_per_segment * manifest.max_layers
         || w.depth != 1 + manifest.max_layers
     {
         return Err(error(
@@ -449,6 +490,11 @@ pub fn load_runtime_bundle_from(
             ),
         ));
     }
+    let hair_mesh = if slices_per_segment == VERSION_1_SLICES_PER_SEGMENT {
+        without_joint_slices(&hair_mesh)
+    } else {
+        hair_mesh
+    };
     let mut blocks = Vec::with_capacity(manifest.bundles.len());
     for (i, entry) in manifest.bundles.iter().enumerate() {
         // Saturating: an origin near u32::MAX must not wrap past the check.
@@ -707,7 +753,8 @@ mod tests {
         assert!(!is_bundle_data_file("notes.ktx2") && !is_bundle_data_file("w.12.ktx2"));
         let manifest: Manifest = serde_json::from_slice(&files[5].1).expect("manifest");
         assert_eq!(manifest.bundles.len(), 6);
-        assert_eq!(manifest.hair_mesh.size[2], 1 + 4 * 2);
+        assert_eq!(manifest.hair_mesh.size[2], 1 + 3 * 2);
+        assert_eq!(manifest.slices_per_segment, 3);
         assert_eq!(manifest.uv.size[2], 0);
         assert_eq!(manifest.quad_samples.len(), 256);
         let empty = Document::new("empty", grid(2, 2, 0, 0.5));
@@ -792,6 +839,84 @@ mod tests {
         std::fs::write(&w_file, &texture[..texture.len() / 2]).expect("truncate");
         let error = load_runtime_bundle(&dir).expect_err("truncated");
         assert!(error.to_string().contains(&manifest.w.file), "{error}");
+    }
+
+    /// A format version 1 bundle (4 hair-mesh slices per segment, the joint `m` stored) still
+    /// loads, into today's 3-slice texture with the same strands; a manifest whose
+    /// slices_per_segment disagrees with its version is refused by name.
+    #[test]
+    fn format_version_1_bundles_load_without_their_joint_slices() {
+        use crate::runtime::strand_gen::{Filtering, StrandGen};
+        let mut mesh = grid(3, 2, 3, 0.5);
+        crate::geometry::interior::place_interior(&mut mesh, None);
+        let document = Document::new("grid", mesh);
+        let options = RuntimeOptions::default();
+        let today = RuntimeHair::from_document(&document, &options);
+        // Version 1's layout: p_k, q0, m, q1 per segment.
+        let three = &today.textures.hair_mesh;
+        let slice = (three.width * three.height) as usize;
+        let layers = (three.depth - 1) / 3;
+        let at = |z: u32| &three.texels[z as usize * slice..(z as usize + 1) * slice];
+        let mut texels = Vec::new();
+        for k in 0..layers {
+            texels.extend_from_slice(at(3 * k));
+            texels.extend_from_slice(at(3 * k + 1));
+            texels.extend(
+                at(3 * k + 1)
+                    .iter()
+                    .zip(at(3 * k + 2))
+                    .map(|(a, b)| (*a + *b) * 0.5),
+            );
+            texels.extend_from_slice(at(3 * k + 2));
+        }
+        texels.extend_from_slice(at(3 * layers));
+        let mut old = today.clone();
+        old.textures.hair_mesh = Texture3d {
+            depth: 1 + 4 * layers,
+            texels,
+            ..three.clone()
+        };
+        let mut files: HashMap<String, Vec<u8>> =
+            bundle_files(&old).expect("export").into_iter().collect();
+        let mut manifest: serde_json::Value =
+            serde_json::from_slice(&files[MANIFEST_FILE]).expect("manifest");
+        manifest["format_version"] = 1.into();
+        manifest["slices_per_segment"] = 4.into();
+        files.insert(
+            MANIFEST_FILE.into(),
+            serde_json::to_vec(&manifest).expect("json"),
+        );
+        let loaded = load_runtime_bundle_from(&files, "memory").expect("version 1 loads");
+        assert_eq!(loaded.textures.hair_mesh, today.textures.hair_mesh);
+        let (a, b) = (
+            StrandGen {
+                textures: &loaded.textures,
+                filtering: Filtering::Exact,
+            },
+            StrandGen {
+                textures: &today.textures,
+                filtering: Filtering::Exact,
+            },
+        );
+        for block in 0..today.textures.atlas.blocks.len() {
+            for tau in [0.2, 0.7, 1.5, 2.9] {
+                assert_eq!(
+                    a.position(block, 0.3, 0.6, tau),
+                    b.position(block, 0.3, 0.6, tau)
+                );
+            }
+        }
+        // Version 2 with 4 slices per segment is a contradiction, named.
+        manifest["format_version"] = RUNTIME_FORMAT_VERSION.into();
+        files.insert(
+            MANIFEST_FILE.into(),
+            serde_json::to_vec(&manifest).expect("json"),
+        );
+        let error = load_runtime_bundle_from(&files, "memory").expect_err("contradiction");
+        assert!(
+            error.to_string().contains("slices_per_segment 4"),
+            "{error}"
+        );
     }
 
     /// A thinned bundle's density travels through the manifest (absent when 1) and back, and

@@ -11,7 +11,7 @@ use glam::{DVec3, Vec2, Vec3, Vec4};
 use crate::model::styling::StylingParams;
 use crate::runtime::gpu_types::{StrandRoot, StrandRun};
 use crate::runtime::hair::strand_root;
-use crate::runtime::textures::{RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
+use crate::runtime::textures::{RuntimeTextures, Texture3d, curve_fetch_slices};
 use crate::strands::styling::{
     StrandStyling, StylingInput, strand_length_fraction, styling_offset_of, twist,
 };
@@ -85,15 +85,7 @@ impl StrandGen<'_> {
     /// Position at root texel coordinates `texel` of a bundle with `layers` layers and curve
     /// parameter `tau` (mirror: `strand_position` in `shared/strand_vertex.wgsl`).
     pub fn strand_position(&self, texel: Vec2, layers: u32, tau: f32) -> Vec3 {
-        let tau = tau.clamp(0.0, layers.max(1) as f32);
-        let segment = (tau.floor() as u32).min(layers.max(1) - 1);
-        let local = tau - segment as f32;
-        // Which quadratic, and its parameter.
-        let (first_slice, q) = if local < 0.5 {
-            (SLICES_PER_SEGMENT * segment, local * 2.0)
-        } else {
-            (SLICES_PER_SEGMENT * segment + 2, local * 2.0 - 1.0)
-        };
+        let (z_a, z_b, q) = curve_fetch_slices(layers, tau);
         let fetch = |slice: f32| {
             fetch(
                 &self.textures.hair_mesh,
@@ -102,8 +94,8 @@ impl StrandGen<'_> {
             )
             .truncate()
         };
-        let a = fetch(first_slice as f32 + q);
-        let b = fetch(first_slice as f32 + 1.0 + q);
+        let a = fetch(z_a);
+        let b = fetch(z_b);
         a + (b - a) * q + self.textures.position_offset
     }
 

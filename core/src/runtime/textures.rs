@@ -2,16 +2,17 @@
 //!
 //! | texture | dim | texel | slices along r |
 //! |---|---|---|---|
-//! | hair mesh | 3D | object-space position | root, then per segment 3 intermediate + 1 layer slice |
+//! | hair mesh | 3D | object-space position | root, then per segment 2 control-point + 1 layer slice |
 //! | uv | 2D | root uv | — |
 //! | w | 3D | w | one per layer |
 //! | u, v | 3D | styling directions û, v̂ | one per layer |
 //!
-//! Hair-mesh slices of segment `k` (layer `k` → `k+1`): `4k` = `p_k`, `4k+1` = `q0`,
-//! `4k+2` = `m`, `4k+3` = `q1`, `4k+4` = `p_{k+1}`, where `(p_k, q0, m)` and `(m, q1, p_{k+1})`
-//! are the two quadratics of the column's cubic segment (`curve::cubic_to_quadratics`).
-//! A quadratic at parameter `q` is `lerp(fetch(a + q), fetch(a + 1 + q), q)` with `a` its first
-//! slice: two filtered fetches and one lerp.
+//! Hair-mesh slices of segment `k` (layer `k` → `k+1`): `3k` = `p_k`, `3k+1` = `q0`,
+//! `3k+2` = `q1`, `3k+3` = `p_{k+1}`, where `(p_k, q0, m)` and `(m, q1, p_{k+1})` are the two
+//! quadratics of the column's cubic segment (`curve::cubic_to_quadratics`). Their joint
+//! `m = (q0 + q1) / 2` is not stored: it is the filtered fetch half-way between slices `3k+1`
+//! and `3k+2`, so a quadratic at parameter `q` is still two filtered fetches and one lerp (de
+//! Casteljau; see [`curve_fetch_slices`]) and the texture takes 3 slices per segment, not 4.
 //!
 //! Texels are stored as RGBA (3D textures have no 3-channel formats). The `f16` variant stores
 //! positions relative to [`RuntimeTextures::position_offset`] (the bounding-box centre) so that
@@ -26,16 +27,39 @@ use crate::runtime::atlas::{Atlas, BundleBlock, build_atlas};
 use crate::runtime::hair::{RootSamples, strand_root};
 use crate::runtime::half::round_to_f16;
 
-/// Slices of the hair-mesh texture per segment (3 intermediate + 1 layer).
-pub const SLICES_PER_SEGMENT: u32 = 4;
+/// Slices of the hair-mesh texture per segment (2 control points + 1 layer).
+pub const SLICES_PER_SEGMENT: u32 = 3;
 /// Most extruded layers one bundle may have. The hair-mesh texture holds
 /// `1 + SLICES_PER_SEGMENT · layers` slices, and 2048 is the 3D-texture depth every wgpu
-/// adapter supports (the default `max_texture_dimension_3d`): 1 + 4 · 511 = 2045. Real hair
-/// meshes use 3-30 layers; a file asking for more is refused by name (a 20,000-layer bundle
-/// used to take 23 s and 2.5 GB to export).
+/// adapter supports (the default `max_texture_dimension_3d`): 1 + 3 · 511 = 1534 (bundles of
+/// format 1, with 4 slices per segment, reach 2045). Real hair meshes use 3-30 layers; a file
+/// asking for more is refused by name (a 20,000-layer bundle used to take 23 s and 2.5 GB to
+/// export).
 pub const MAX_LAYERS_PER_BUNDLE: u32 = 511;
 /// Largest region side in the atlas.
 pub const MAX_REGION_SIDE: usize = 64;
+
+/// Where the two filtered hair-mesh fetches of curve parameter `tau` (in layers, clamped to
+/// `[0, layers]`) sit: `(z_a, z_b, q)` with the point `lerp(fetch(z_a), fetch(z_b), q)`
+/// (slice coordinates, add ½ for texel centres). First half of segment `k` (quadratic
+/// `p_k, q0, m`): `z_a = 3k + q` (p_k → q0), `z_b = 3k + 1 + q/2` (q0 → m, i.e. a quarter of
+/// q0 → q1 per half unit of `q`). Second half (`m, q1, p_{k+1}`): `z_a = 3k + 1.5 + q/2`
+/// (m → q1), `z_b = 3k + 2 + q` (q1 → p_{k+1}). Mirror: `curve_fetch_slices` in
+/// `shaders/shared/strand_vertex.wgsl`.
+pub fn curve_fetch_slices(layers: u32, tau: f32) -> (f32, f32, f32) {
+    let layers = layers.max(1);
+    let tau = tau.clamp(0.0, layers as f32);
+    let segment = (tau.floor() as u32).min(layers - 1);
+    let local = tau - segment as f32;
+    let base = (SLICES_PER_SEGMENT * segment) as f32;
+    if local < 0.5 {
+        let q = local * 2.0;
+        (base + q, base + 1.0 + 0.5 * q, q)
+    } else {
+        let q = local * 2.0 - 1.0;
+        (base + 1.5 + 0.5 * q, base + 2.0 + q, q)
+    }
+}
 
 /// Texel precision of the 3D position and direction textures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -85,7 +109,7 @@ pub struct RuntimeTextures {
     pub precision: Precision,
     /// Added back to sampled hair-mesh positions (zero for f32).
     pub position_offset: Vec3,
-    /// Positions: `1 + 4·max_layers` slices.
+    /// Positions: `1 + 3·max_layers` slices.
     pub hair_mesh: Texture3d,
     /// Root uv (x, y used), one slice.
     pub uv: Texture3d,
@@ -184,9 +208,9 @@ impl RuntimeTextures {
                             Some(segment) => cubic_to_quadratics(segment),
                             None => [[column.positions[last]; 3]; 2],
                         };
+                        // q0 and q1; the joint m = (q0 + q1) / 2 is fetched between them.
                         hair_mesh.set(x, y, base + 1, position(first[1]));
-                        hair_mesh.set(x, y, base + 2, position(first[2]));
-                        hair_mesh.set(x, y, base + 3, position(second[1]));
+                        hair_mesh.set(x, y, base + 2, position(second[1]));
                     }
                 }
             }

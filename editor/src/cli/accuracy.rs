@@ -41,6 +41,9 @@ struct Row {
     /// isolates filtering and storage error from the curve approximation.
     max_vs_quadratics: Option<f64>,
     ms_per_million: f64,
+    /// What the storage costs: the five textures' GPU bytes per hair-mesh vertex (texture
+    /// path rows only).
+    texture_bytes_per_vertex: Option<f64>,
 }
 
 /// Strands to measure: (atlas block index, block coords, bundle-corner weights).
@@ -124,6 +127,7 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
         mean_error: 0.0,
         max_vs_quadratics: None,
         ms_per_million: reference_ms,
+        texture_bytes_per_vertex: None,
     }];
     for (name, definition, form) in [
         (
@@ -145,6 +149,7 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
             mean_error: mean,
             max_vs_quadratics: None,
             ms_per_million: ms,
+            texture_bytes_per_vertex: None,
         });
     }
     for (name, textures, filtering) in [
@@ -194,6 +199,9 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
             mean_error: mean,
             max_vs_quadratics: Some(vs_quadratics),
             ms_per_million: ms,
+            texture_bytes_per_vertex: Some(
+                textures.gpu_bytes() as f64 / mesh.vertex_count().max(1) as f64,
+            ),
         });
     }
     rows.extend(vertex_count_rows(document, per_bundle)?);
@@ -206,11 +214,18 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
     );
     println!("machine: {} (CPU evaluation, one thread)", super::machine());
     println!(
-        "{:<48} {:>11} {:>11} {:>9} {:>12} {:>13} {:>7}",
-        "switch", "max error", "mean error", "max % bw", "max vs quad", "ms / M verts", "× ref"
+        "{:<48} {:>11} {:>11} {:>9} {:>12} {:>13} {:>7} {:>8}",
+        "switch",
+        "max error",
+        "mean error",
+        "max % bw",
+        "max vs quad",
+        "ms / M verts",
+        "× ref",
+        "B / vtx"
     );
     let mut csv = String::from(
-        "switch,max_error_m,mean_error_m,max_error_percent_bundle_width,max_error_vs_f64_quadratics_m,ms_per_million_vertices,time_ratio_to_reference\n",
+        "switch,max_error_m,mean_error_m,max_error_percent_bundle_width,max_error_vs_f64_quadratics_m,ms_per_million_vertices,time_ratio_to_reference,texture_bytes_per_hair_mesh_vertex\n",
     );
     for row in &rows {
         let percent = 100.0 * row.max_error / bundle_width;
@@ -219,18 +234,23 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
             .max_vs_quadratics
             .map(|v| format!("{v:.3e}"))
             .unwrap_or_else(|| "-".into());
+        let bytes = row
+            .texture_bytes_per_vertex
+            .map(|b| format!("{b:.1}"))
+            .unwrap_or_else(|| "-".into());
         println!(
-            "{:<48} {:>11.3e} {:>11.3e} {:>9.3} {:>12} {:>13.1} {:>7.2}",
+            "{:<48} {:>11.3e} {:>11.3e} {:>9.3} {:>12} {:>13.1} {:>7.2} {:>8}",
             row.switch,
             row.max_error,
             row.mean_error,
             percent,
             vs_quadratics,
             row.ms_per_million,
-            ratio
+            ratio,
+            bytes
         );
         csv.push_str(&format!(
-            "\"{}\",{:e},{:e},{},{},{},{}\n",
+            "\"{}\",{:e},{:e},{},{},{},{},{}\n",
             row.switch,
             row.max_error,
             row.mean_error,
@@ -239,7 +259,10 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
                 .map(|v| format!("{v:e}"))
                 .unwrap_or_default(),
             row.ms_per_million,
-            ratio
+            ratio,
+            row.texture_bytes_per_vertex
+                .map(|b| b.to_string())
+                .unwrap_or_default()
         ));
     }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -400,6 +423,7 @@ fn vertex_count_rows(
             mean_error: sum / count.max(1) as f64,
             max_vs_quadratics: None,
             ms_per_million: ms,
+            texture_bytes_per_vertex: None,
         });
     }
     Ok(rows)
