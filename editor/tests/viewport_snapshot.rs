@@ -76,11 +76,11 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
     assert!(!adapter.contains("no GPU"), "{adapter}");
     let image = viewport_image(&mut harness);
     assert!(
-        harness.state().viewport.error.is_none(),
+        harness.state().viewport.error().is_none(),
         "{:?}",
-        harness.state().viewport.error
+        harness.state().viewport.error()
     );
-    assert!(harness.state().viewport.drawn_strands > 1000);
+    assert!(harness.state().viewport.drawn().0 > 1000);
     let frame_ms = harness
         .state()
         .viewport
@@ -254,8 +254,7 @@ fn a_gpu_error_is_shown_in_the_viewport_instead_of_panicking() {
     let error = harness
         .state()
         .viewport
-        .error
-        .clone()
+        .error()
         .expect("the error is shown");
     assert!(error.contains("GPU error"), "{error}");
     // The document is untouched and can still be saved.

@@ -58,6 +58,10 @@ fn embedded() -> Vec<(String, String)> {
             oit_composite_shader(samples),
         ));
     }
+    sources.push((
+        "viewport_blit".to_string(),
+        hairloom_render::renderer::viewport_blit::VIEWPORT_BLIT_SHADER.to_string(),
+    ));
     sources
 }
 

@@ -56,7 +56,7 @@ const MIN_KNOT_INTERVAL: f64 = 1e-150;
 /// `b1 = p1 + (d1² (p2 − p1) + d2² (p1 − p0)) / (3 d1 (d1 + d2))`,
 /// `b2 = p2 + (d3² (p1 − p2) + d2² (p2 − p3)) / (3 d3 (d3 + d2))` — written with the
 /// symmetric form below.
-pub fn centripetal_bezier(p0: DVec3, p1: DVec3, p2: DVec3, p3: DVec3) -> [DVec3; 4] {
+pub(crate) fn centripetal_bezier(p0: DVec3, p1: DVec3, p2: DVec3, p3: DVec3) -> [DVec3; 4] {
     let d1 = p1.distance(p0).sqrt();
     let d2 = p2.distance(p1).sqrt();
     let d3 = p3.distance(p2).sqrt();
@@ -74,7 +74,7 @@ pub fn centripetal_bezier(p0: DVec3, p1: DVec3, p2: DVec3, p3: DVec3) -> [DVec3;
 }
 
 /// Evaluates a cubic Bézier at `t ∈ [0, 1]`.
-pub fn cubic_point(b: &[DVec3; 4], t: f64) -> DVec3 {
+pub(crate) fn cubic_point(b: &[DVec3; 4], t: f64) -> DVec3 {
     let s = 1.0 - t;
     b[0] * (s * s * s) + b[1] * (3.0 * s * s * t) + b[2] * (3.0 * s * t * t) + b[3] * (t * t * t)
 }
@@ -89,13 +89,13 @@ pub fn cubic_to_quadratics(b: &[DVec3; 4]) -> [[DVec3; 3]; 2] {
 }
 
 /// Evaluates a quadratic Bézier at `t ∈ [0, 1]`.
-pub fn quadratic_point(q: &[DVec3; 3], t: f64) -> DVec3 {
+pub(crate) fn quadratic_point(q: &[DVec3; 3], t: f64) -> DVec3 {
     let s = 1.0 - t;
     q[0] * (s * s) + q[1] * (2.0 * s * t) + q[2] * (t * t)
 }
 
 /// Evaluates a segment's cubic (exact, or as two quadratics) at `t ∈ [0, 1]`.
-pub fn segment_point(b: &[DVec3; 4], t: f64, form: SegmentForm) -> DVec3 {
+pub(crate) fn segment_point(b: &[DVec3; 4], t: f64, form: SegmentForm) -> DVec3 {
     match form {
         SegmentForm::ExactCubic => cubic_point(b, t),
         SegmentForm::TwoQuadratics => {
@@ -132,7 +132,7 @@ pub fn curve_segments(points: &[DVec3]) -> Vec<[DVec3; 4]> {
 }
 
 /// Evaluates a curve given by segments at `t ∈ [0, segments.len()]` (layer units), clamped.
-pub fn curve_point(segments: &[[DVec3; 4]], t: f64, form: SegmentForm) -> DVec3 {
+pub(crate) fn curve_point(segments: &[[DVec3; 4]], t: f64, form: SegmentForm) -> DVec3 {
     let Some(last) = segments.len().checked_sub(1) else {
         return DVec3::ZERO;
     };

@@ -95,7 +95,11 @@ pub fn layer_frames(mesh: &HairMesh, layer: usize) -> Vec<Option<Frame>> {
 
 /// Eq. 2-3 for one triangle: the object-space images of the uv axes, and the uv area.
 /// `None` when the uv triangle has zero area or the result is not finite.
-pub fn triangle_uv_axes(e1: DVec3, e2: DVec3, uv: [DVec2; 3]) -> Option<(DVec3, DVec3, f64)> {
+pub(crate) fn triangle_uv_axes(
+    e1: DVec3,
+    e2: DVec3,
+    uv: [DVec2; 3],
+) -> Option<(DVec3, DVec3, f64)> {
     let du1 = uv[1] - uv[0];
     let du2 = uv[2] - uv[0];
     // T = [[du1.x, du2.x], [du1.y, du2.y]]; [u v] = [e1 e2] T⁻¹.
@@ -158,7 +162,7 @@ fn complete_from_u(u: DVec3, normal: DVec3) -> Frame {
 
 /// An orthonormal frame with ŵ = `normal`, û and v̂ from the branchless basis of Duff et al.
 /// 2017 ("Building an Orthonormal Basis, Revisited"), continuous except at normal = −z.
-pub fn fallback_frame(normal: DVec3) -> Frame {
+pub(crate) fn fallback_frame(normal: DVec3) -> Frame {
     let n = normal.try_normalize().unwrap_or(DVec3::Z);
     let sign = 1.0f64.copysign(n.z);
     let a = -1.0 / (sign + n.z);

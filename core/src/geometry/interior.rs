@@ -57,7 +57,7 @@ impl AffineMap {
 /// of the images of the two other directions, scaled so that rotations and uniform scalings
 /// are reproduced exactly: `m = (L e1 × L e2) / sqrt(|L e1 × L e2|)`. Other directions use the
 /// identity as prior. With no points, the identity map is returned.
-pub fn fit_affine(from: &[DVec3], to: &[DVec3]) -> AffineMap {
+pub(crate) fn fit_affine(from: &[DVec3], to: &[DVec3]) -> AffineMap {
     let count = from.len().min(to.len());
     if count == 0 {
         return AffineMap {
@@ -150,7 +150,7 @@ fn outer(a: DVec3, b: DVec3) -> DMat3 {
     clippy::needless_range_loop,
     reason = "a Jacobi rotation updates rows and columns p and q in lockstep; indices mirror the textbook form"
 )]
-pub fn symmetric_eigen(matrix: DMat3) -> (DVec3, DMat3) {
+pub(crate) fn symmetric_eigen(matrix: DMat3) -> (DVec3, DMat3) {
     let mut a = matrix.to_cols_array_2d(); // a[col][row]; symmetric so a[i][j] == a[j][i]
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     for _sweep in 0..32 {

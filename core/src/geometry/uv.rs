@@ -12,7 +12,7 @@ use crate::model::mesh::HairMesh;
 
 /// uv of `point` by the azimuthal-equidistant projection described in the module docs.
 /// `reference` fixes φ = 0 (any vector not parallel to `axis`).
-pub fn azimuthal_uv(point: DVec3, center: DVec3, axis: DVec3, reference: DVec3) -> DVec2 {
+pub(crate) fn azimuthal_uv(point: DVec3, center: DVec3, axis: DVec3, reference: DVec3) -> DVec2 {
     let axis = axis.try_normalize().unwrap_or(DVec3::Y);
     let e1 = (reference - axis * reference.dot(axis))
         .try_normalize()

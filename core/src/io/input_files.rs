@@ -134,7 +134,7 @@ impl InputFolder {
 }
 
 /// Reads a regular file of at most `cap_bytes` (the file the user named: no folder rule).
-pub fn read_regular_file(
+pub(crate) fn read_regular_file(
     path: &Path,
     cap_bytes: u64,
     what: &'static str,

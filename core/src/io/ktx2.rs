@@ -94,7 +94,7 @@ pub fn texel_bytes(texels: &[Vec4], format: TexelFormat) -> Vec<u8> {
 }
 
 /// A single-level, uncompressed KTX2 file (2D when `depth == 0`, else 3D).
-pub fn ktx2_bytes(
+pub(crate) fn ktx2_bytes(
     format: TexelFormat,
     width: u32,
     height: u32,

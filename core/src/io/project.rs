@@ -272,7 +272,7 @@ pub fn write_atomic(
 }
 
 /// Start of the names of [`write_atomic`]'s temporaries for a file called `file_name`.
-pub fn temp_prefix(file_name: &str) -> String {
+pub(crate) fn temp_prefix(file_name: &str) -> String {
     format!(".{file_name}.tmp-")
 }
 

@@ -115,7 +115,7 @@ pub const MANIFEST_FILE: &str = "manifest.json";
 /// with fixed keys, so the name is stable across builds). Because a name never changes its
 /// content, writing a new bundle over an old one never alters a file the old manifest
 /// names: a reader sees the old bundle or the new one, never a mix.
-pub fn content_addressed_name(stem: &str, extension: &str, bytes: &[u8]) -> String {
+pub(crate) fn content_addressed_name(stem: &str, extension: &str, bytes: &[u8]) -> String {
     use std::hash::Hasher as _;
     let mut hasher = siphasher::sip::SipHasher13::new();
     hasher.write(bytes);

@@ -138,7 +138,7 @@ fn usda_extent(strands: &[Strand], width_m: f32) -> String {
 
 /// The box around every point of `strands`, widened by half of `width_m`; zero when there
 /// are no points.
-pub fn strand_bounds(strands: &[Strand], width_m: f32) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn strand_bounds(strands: &[Strand], width_m: f32) -> ([f32; 3], [f32; 3]) {
     let points = strands
         .iter()
         .flat_map(|s| s.points.iter())
@@ -236,7 +236,7 @@ fn usda_scalp(out: &mut String, scalp: &ScalpMesh, points: &str, extent: &str) {
 
 /// The first of an animation's `frames`, once they and their rate are checked: an empty
 /// list and a rate that is not a positive number are refused (every animated export).
-pub fn first_frame<T>(frames: &[T], frames_per_second: f64) -> Result<&T, String> {
+pub(crate) fn first_frame<T>(frames: &[T], frames_per_second: f64) -> Result<&T, String> {
     let Some(first) = frames.first() else {
         return Err("an animation needs at least one frame".into());
     };
@@ -326,7 +326,7 @@ const GLTF_MODE_TRIANGLES: u32 = 4;
 
 /// The opaque body (scalp/head) as a triangle GLB: what the runtime bundle carries so a
 /// preview of the bundle alone can depth-test hair against the same mesh.
-pub fn glb_body(body: &crate::model::document::BodyMesh) -> Vec<u8> {
+pub(crate) fn glb_body(body: &crate::model::document::BodyMesh) -> Vec<u8> {
     let indices: Vec<u32> = body.triangles.iter().flatten().copied().collect();
     glb_mesh("Body", &body.positions, &indices, GLTF_MODE_TRIANGLES)
 }

@@ -244,7 +244,7 @@ impl DualScatteringTables {
 /// `∫_a^b N_p(φ) dφ` for an interval no longer than a turn, exactly: `N_p` is a trimmed
 /// logistic on the circle, so the integral is a difference of its cumulative distribution
 /// (wrapped once when the interval crosses ±π).
-pub fn np_integral(a: f64, b: f64, p: usize, s: f64, gamma_o: f64, gamma_t: f64) -> f64 {
+pub(crate) fn np_integral(a: f64, b: f64, p: usize, s: f64, gamma_o: f64, gamma_t: f64) -> f64 {
     let length = (b - a).clamp(0.0, 2.0 * PI);
     let cdf_lo = logistic_cdf(-PI, s);
     let k = logistic_cdf(PI, s) - cdf_lo;
@@ -265,7 +265,7 @@ pub fn np_integral(a: f64, b: f64, p: usize, s: f64, gamma_o: f64, gamma_t: f64)
 
 /// A normalised Gaussian of variance `variance` at `x` (the variance is kept above a floor so
 /// that a lobe of zero width stays finite).
-pub fn ds_gaussian(x: f64, variance: f64) -> f64 {
+pub(crate) fn ds_gaussian(x: f64, variance: f64) -> f64 {
     let variance = variance.max(1e-6);
     (-x * x / (2.0 * variance)).exp() / (2.0 * PI * variance).sqrt()
 }
@@ -296,7 +296,7 @@ fn gamma(bsdf: &HairBsdf, w: DVec3, h: f64) -> Gamma {
 
 /// `A_b = A₁ + A₃` (Zinke et al. 2008 eq. 12-13): light returned after one or three backward
 /// scatterings among forward ones.
-pub fn back_scattering(a_f: f64, a_b: f64) -> f64 {
+pub(crate) fn back_scattering(a_f: f64, a_b: f64) -> f64 {
     let one_minus = (1.0 - a_f * a_f).max(1e-6);
     let a1 = a_b * a_f * a_f / one_minus;
     let a3 = a_b.powi(3) * a_f * a_f / one_minus.powi(3);
@@ -305,7 +305,7 @@ pub fn back_scattering(a_f: f64, a_b: f64) -> f64 {
 }
 
 /// The shift `Δ_b` and variance `σ_b²` of back scattering (Zinke et al. 2008 eq. 14-16).
-pub fn back_shift_and_spread(
+pub(crate) fn back_shift_and_spread(
     a_f: f64,
     a_b: f64,
     alpha_f: f64,

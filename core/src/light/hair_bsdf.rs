@@ -246,7 +246,7 @@ pub fn azimuth(w: DVec3) -> f64 {
     w.z.atan2(w.y)
 }
 
-pub fn safe_sqrt(x: f64) -> f64 {
+pub(crate) fn safe_sqrt(x: f64) -> f64 {
     x.max(0.0).sqrt()
 }
 
@@ -265,7 +265,7 @@ pub fn i0(x: f64) -> f64 {
 }
 
 /// `ln I₀(x)`, with the asymptotic form above 12 where the series would overflow.
-pub fn log_i0(x: f64) -> f64 {
+pub(crate) fn log_i0(x: f64) -> f64 {
     if x > 12.0 {
         x + 0.5 * (-(std::f64::consts::TAU).ln() + (1.0 / x).ln() + 1.0 / (8.0 * x))
     } else {
@@ -275,7 +275,13 @@ pub fn log_i0(x: f64) -> f64 {
 
 /// The longitudinal lobe `M_p` (d'Eon et al. 2011), normalised so that
 /// `∫ M_p cos θ_i dθ_i = 1`; the log form keeps narrow lobes (`v ≤ 0.1`) finite.
-pub fn mp(cos_theta_i: f64, cos_theta_o: f64, sin_theta_i: f64, sin_theta_o: f64, v: f64) -> f64 {
+pub(crate) fn mp(
+    cos_theta_i: f64,
+    cos_theta_o: f64,
+    sin_theta_i: f64,
+    sin_theta_o: f64,
+    v: f64,
+) -> f64 {
     let a = cos_theta_i * cos_theta_o / v;
     let b = sin_theta_i * sin_theta_o / v;
     let m = if v <= 0.1 {
@@ -287,7 +293,7 @@ pub fn mp(cos_theta_i: f64, cos_theta_o: f64, sin_theta_i: f64, sin_theta_o: f64
 }
 
 /// Unpolarised Fresnel reflectance of a dielectric of relative index `eta`.
-pub fn fr_dielectric(cos_theta_i: f64, eta: f64) -> f64 {
+pub(crate) fn fr_dielectric(cos_theta_i: f64, eta: f64) -> f64 {
     let mut cos_i = cos_theta_i.clamp(-1.0, 1.0);
     let mut eta = eta;
     if cos_i < 0.0 {
@@ -311,29 +317,29 @@ pub fn phi(p: usize, gamma_o: f64, gamma_t: f64) -> f64 {
     2.0 * p * gamma_t - 2.0 * gamma_o + p * std::f64::consts::PI
 }
 
-pub fn logistic(x: f64, s: f64) -> f64 {
+pub(crate) fn logistic(x: f64, s: f64) -> f64 {
     let x = x.abs();
     let e = (-x / s).exp();
     e / (s * (1.0 + e) * (1.0 + e))
 }
 
-pub fn logistic_cdf(x: f64, s: f64) -> f64 {
+pub(crate) fn logistic_cdf(x: f64, s: f64) -> f64 {
     1.0 / (1.0 + (-x / s).exp())
 }
 
 /// The logistic restricted to `[a, b]` and normalised there.
-pub fn trimmed_logistic(x: f64, s: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn trimmed_logistic(x: f64, s: f64, a: f64, b: f64) -> f64 {
     logistic(x, s) / (logistic_cdf(b, s) - logistic_cdf(a, s))
 }
 
-pub fn sample_trimmed_logistic(u: f64, s: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn sample_trimmed_logistic(u: f64, s: f64, a: f64, b: f64) -> f64 {
     let k = logistic_cdf(b, s) - logistic_cdf(a, s);
     let x = -s * (1.0 / (u * k + logistic_cdf(a, s)) - 1.0).ln();
     if x.is_finite() { x.clamp(a, b) } else { 0.0 }
 }
 
 /// Wraps an angle into `[−π, π]`.
-pub fn wrap_angle(mut x: f64) -> f64 {
+pub(crate) fn wrap_angle(mut x: f64) -> f64 {
     use std::f64::consts::{PI, TAU};
     if !x.is_finite() {
         return 0.0;
@@ -343,7 +349,7 @@ pub fn wrap_angle(mut x: f64) -> f64 {
 }
 
 /// The azimuthal lobe `N_p`: a trimmed logistic around `Φ(p)`.
-pub fn np(phi_diff: f64, p: usize, s: f64, gamma_o: f64, gamma_t: f64) -> f64 {
+pub(crate) fn np(phi_diff: f64, p: usize, s: f64, gamma_o: f64, gamma_t: f64) -> f64 {
     use std::f64::consts::PI;
     let dphi = wrap_angle(phi_diff - phi(p, gamma_o, gamma_t));
     trimmed_logistic(dphi, s, -PI, PI)

@@ -21,19 +21,19 @@ pub const MIN_COLOR: f64 = 1e-4;
 pub const MAX_COLOR: f64 = 0.9999;
 
 /// Chiang et al. 2016 eq. 9's polynomial in the azimuthal roughness.
-pub fn color_polynomial(beta_n: f64) -> f64 {
+pub(crate) fn color_polynomial(beta_n: f64) -> f64 {
     let b = beta_n;
     5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b.powi(3) + 5.574 * b.powi(4) + 0.245 * b.powi(5)
 }
 
-pub fn sigma_a_from_melanin(eumelanin: f64, pheomelanin: f64) -> [f64; 3] {
+pub(crate) fn sigma_a_from_melanin(eumelanin: f64, pheomelanin: f64) -> [f64; 3] {
     std::array::from_fn(|c| {
         eumelanin.max(0.0) * EUMELANIN_SIGMA_A[c] + pheomelanin.max(0.0) * PHEOMELANIN_SIGMA_A[c]
     })
 }
 
 /// The absorption that shows `rgb` on a thick mass of hair with azimuthal roughness `beta_n`.
-pub fn sigma_a_from_color(rgb: [f64; 3], beta_n: f64) -> [f64; 3] {
+pub(crate) fn sigma_a_from_color(rgb: [f64; 3], beta_n: f64) -> [f64; 3] {
     let p = color_polynomial(beta_n);
     rgb.map(|c| {
         let c = if c.is_finite() { c } else { MIN_COLOR };
@@ -43,7 +43,7 @@ pub fn sigma_a_from_color(rgb: [f64; 3], beta_n: f64) -> [f64; 3] {
 
 /// The inverse of [`sigma_a_from_color`]: the colour a thick mass of hair with this
 /// absorption shows. Used for ambient light and for Kajiya-Kay's base colour.
-pub fn color_from_sigma_a(sigma_a: [f64; 3], beta_n: f64) -> [f64; 3] {
+pub(crate) fn color_from_sigma_a(sigma_a: [f64; 3], beta_n: f64) -> [f64; 3] {
     let p = color_polynomial(beta_n);
     sigma_a.map(|s| (-s.max(0.0).sqrt() * p).exp())
 }
@@ -116,7 +116,7 @@ impl Fibre {
 
 /// The random value of a strand's absorption variation, from its root index (bundle ×
 /// roots per bundle + sample: stable when LOD drops strands). The shaders' `strand_shading_random`.
-pub fn strand_shading_random(root: u32) -> f64 {
+pub(crate) fn strand_shading_random(root: u32) -> f64 {
     use crate::strands::random::{hash_to_unit, pcg_hash};
     hash_to_unit(pcg_hash(SHADING_SALT ^ root))
 }

@@ -20,13 +20,13 @@ pub mod scene_uniforms;
 
 /// The ACES filmic curve fitted by Narkowicz 2015, applied to linear radiance × exposure:
 /// what every Hairloom picture maps to display values (the shaders' `tonemap`).
-pub fn tonemap(x: f32) -> f32 {
+pub(crate) fn tonemap(x: f32) -> f32 {
     let x = if x.is_finite() { x.max(0.0) } else { 0.0 };
     ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0)
 }
 
 /// sRGB encoding of a display value in `[0, 1]` (what an sRGB render target does on write).
-pub fn linear_to_srgb(x: f32) -> f32 {
+pub(crate) fn linear_to_srgb(x: f32) -> f32 {
     let x = x.clamp(0.0, 1.0);
     if x <= 0.003_130_8 {
         12.92 * x

@@ -136,7 +136,7 @@ pub fn light_distance(z: f32, near: f32, far: f32, perspective: bool) -> f32 {
 /// The distance from the light at which layer `k` of `layers` ends. `start` is the first
 /// hair's distance (deep opacity maps) or the view's near plane (opacity shadow maps);
 /// `depth` the distance the layers span (`far − near` for opacity shadow maps).
-pub fn layer_end(kind: SelfShadowing, k: u32, layers: u32, start: f32, depth: f32) -> f32 {
+pub(crate) fn layer_end(kind: SelfShadowing, k: u32, layers: u32, start: f32, depth: f32) -> f32 {
     let fraction = (k + 1) as f32 / layers.max(1) as f32;
     match kind {
         SelfShadowing::DeepOpacityMaps => start + depth * fraction * fraction,

@@ -516,7 +516,7 @@ impl HairMesh {
 }
 
 /// Cumulative polyline length along a column, starting at 0.
-pub fn path_length_w(positions: &[DVec3]) -> Vec<f64> {
+pub(crate) fn path_length_w(positions: &[DVec3]) -> Vec<f64> {
     let mut w = Vec::with_capacity(positions.len());
     let mut total = 0.0;
     for (i, p) in positions.iter().enumerate() {

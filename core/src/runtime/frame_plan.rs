@@ -94,7 +94,11 @@ impl FramePlan {
 }
 
 /// Whether a sphere is at least partly inside the view frustum of `view_projection`.
-pub fn sphere_in_view(view_projection: &glam::Mat4, centre: glam::Vec3, radius: f32) -> bool {
+pub(crate) fn sphere_in_view(
+    view_projection: &glam::Mat4,
+    centre: glam::Vec3,
+    radius: f32,
+) -> bool {
     let m = view_projection.transpose(); // rows of the matrix as columns
     let (r0, r1, r2, r3) = (m.x_axis, m.y_axis, m.z_axis, m.w_axis);
     let point = centre.extend(1.0);

@@ -9,7 +9,7 @@ use half::f16;
 const F16_MAX: f32 = 65504.0;
 
 /// IEEE binary16 bits of `value` (round to nearest even, overflow clamped to ±65504, NaN 0).
-pub fn f16_bits(value: f32) -> u16 {
+pub(crate) fn f16_bits(value: f32) -> u16 {
     let value = if value.is_nan() {
         0.0
     } else {
@@ -19,12 +19,12 @@ pub fn f16_bits(value: f32) -> u16 {
 }
 
 /// The f32 value of half-precision `bits`.
-pub fn f16_to_f32(bits: u16) -> f32 {
+pub(crate) fn f16_to_f32(bits: u16) -> f32 {
     f16::from_bits(bits).to_f32()
 }
 
 /// `value` as an f16 texture stores it: [`f16_bits`] and back.
-pub fn round_to_f16(value: f32) -> f32 {
+pub(crate) fn round_to_f16(value: f32) -> f32 {
     f16_to_f32(f16_bits(value))
 }
 

@@ -8,7 +8,7 @@ use glam::Vec3;
 use crate::runtime::gpu_types::StrandRun;
 
 /// Mirror of `safe_normalize`: the unit vector, or zero when `v` has (almost) no length.
-pub fn safe_normalize(v: Vec3) -> Vec3 {
+pub(crate) fn safe_normalize(v: Vec3) -> Vec3 {
     let length_squared = v.dot(v);
     // As the shader's `!(x > 1e-24)`: NaN lengths give zero too.
     if length_squared.is_nan() || length_squared <= 1e-24 {

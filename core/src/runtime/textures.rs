@@ -46,7 +46,7 @@ pub const MAX_REGION_SIDE: usize = 64;
 /// q0 → q1 per half unit of `q`). Second half (`m, q1, p_{k+1}`): `z_a = 3k + 1.5 + q/2`
 /// (m → q1), `z_b = 3k + 2 + q` (q1 → p_{k+1}). Mirror: `curve_fetch_slices` in
 /// `shaders/shared/strand_vertex.wgsl`.
-pub fn curve_fetch_slices(layers: u32, tau: f32) -> (f32, f32, f32) {
+pub(crate) fn curve_fetch_slices(layers: u32, tau: f32) -> (f32, f32, f32) {
     let layers = layers.max(1);
     let tau = tau.clamp(0.0, layers as f32);
     let segment = (tau.floor() as u32).min(layers - 1);

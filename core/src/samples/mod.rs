@@ -52,7 +52,7 @@ pub const HEAD_CRANIUM_RADII: DVec3 = DVec3::new(1.75, 2.1, 2.05);
 /// above a hairline plane that rises from the nape (y ≈ 0.3 at the back) to the forehead
 /// (y ≈ 3.0 at the front), excluding the ears (far to the side and low) and faces that
 /// point down.
-pub fn is_head_scalp(p: DVec3, n: DVec3) -> bool {
+pub(crate) fn is_head_scalp(p: DVec3, n: DVec3) -> bool {
     let above_hairline = p.y > 1.6 + 0.69 * p.z;
     let ear = p.x.abs() > 1.35 && p.y < 2.2;
     above_hairline && !ear && n.y > -0.35
@@ -60,7 +60,7 @@ pub fn is_head_scalp(p: DVec3, n: DVec3) -> bool {
 
 /// The head scan: its scalp as a hair mesh with generated uv (metres, cranium at the
 /// origin) and the whole scan as the body.
-pub fn head_scalp(glb: &[u8]) -> Result<(HairMesh, BodyMesh), ImportError> {
+pub(crate) fn head_scalp(glb: &[u8]) -> Result<(HairMesh, BodyMesh), ImportError> {
     let options = ImportOptions {
         scale: 1.0,
         ..ImportOptions::default()
@@ -297,7 +297,7 @@ fn comb_column(
 /// it). Interior vertices keep their simulated places: re-placing them from the exterior
 /// would put some back inside (the placement knows nothing of the body), so the next edit of
 /// one of their layers may too — a limit of automatic interior placement on curved bodies.
-pub fn keep_out_of_body(mesh: &HairMesh, body: &BodyMesh) -> HairMesh {
+pub(crate) fn keep_out_of_body(mesh: &HairMesh, body: &BodyMesh) -> HairMesh {
     use crate::model::motion::{HairPhysics, Motion};
     let motion = Motion {
         gravity_m_per_s2: 0.0,
@@ -446,7 +446,7 @@ pub const HAIRLINE_DENSITY: [f64; 2] = [0.35, 0.7];
 
 /// Sets the density of the bundles on the scalp's rim to `densities[0]`, of those touching
 /// them to `densities[1]`, and so on inward (rings of bundles sharing a corner).
-pub fn thin_hairline(mesh: &mut HairMesh, densities: &[f64]) {
+pub(crate) fn thin_hairline(mesh: &mut HairMesh, densities: &[f64]) {
     // Columns of the current ring's outer side: the rim (root boundary) first.
     let topology = crate::model::mesh::Topology::build(mesh);
     let mut front: std::collections::HashSet<u32> = (0..mesh.columns.len() as u32)
@@ -524,7 +524,7 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
 ];
 
 /// The styling of each head sample.
-pub fn head_style(name: &str) -> StylingParams {
+pub(crate) fn head_style(name: &str) -> StylingParams {
     let base = StylingParams {
         noise: Noise {
             amplitude_m: 0.0015,
@@ -577,7 +577,7 @@ pub fn head_style(name: &str) -> StylingParams {
 
 /// The fibre material of each head sample: three hair colours from melanin, so the samples
 /// show what the material does.
-pub fn head_material(name: &str) -> HairMaterial {
+pub(crate) fn head_material(name: &str) -> HairMaterial {
     let base = HairMaterial::default();
     match name {
         // Auburn: little eumelanin, much pheomelanin.

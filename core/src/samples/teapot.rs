@@ -127,7 +127,7 @@ fn bernstein(t: f64) -> [f64; 4] {
 /// `1e-9` of the model size), turns quads with a collapsed edge into triangles and drops
 /// fully collapsed ones. The teapot's z-up data is rotated to y-up. uv is the patch
 /// parameter mapped into a 8×4 atlas of the 32 patches.
-pub fn tessellate(patches: &Patches, n: usize) -> HairMesh {
+pub(crate) fn tessellate(patches: &Patches, n: usize) -> HairMesh {
     let n = n.max(1);
     let mut positions: Vec<DVec3> = Vec::new();
     let mut faces: Vec<Vec<u32>> = Vec::new();

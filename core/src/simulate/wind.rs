@@ -23,7 +23,7 @@ fn value_noise(x: f64, channel: u32) -> f64 {
 }
 
 /// The air's velocity at `p` and `time_s`.
-pub fn wind_velocity(wind: &Wind, p: DVec3, time_s: f64) -> DVec3 {
+pub(crate) fn wind_velocity(wind: &Wind, p: DVec3, time_s: f64) -> DVec3 {
     let speed = wind.speed_m_per_s;
     let direction = DVec3::from(wind.direction).normalize_or_zero();
     if speed.is_nan() || speed <= 0.0 || direction == DVec3::ZERO {

@@ -52,7 +52,7 @@ pub const TELEPORT_TURN_RAD_PER_S: f64 = 4.0 * std::f64::consts::PI;
 pub const MAX_SPEED_M_PER_S: f64 = 500.0;
 
 /// XPBD compliance of a stiffness in `[0, 1]`.
-pub fn compliance(stiffness: f64) -> f64 {
+pub(crate) fn compliance(stiffness: f64) -> f64 {
     10f64.powf(-1.0 - 8.0 * stiffness.clamp(0.0, 1.0))
 }
 

@@ -11,7 +11,7 @@ use glam::DVec3;
 /// vertex LOD), `R` the vertical resolution in pixels, `d` the distance to the camera and
 /// `θ` the camera's field of view. Non-positive or non-finite denominators give `L = 1`
 /// (the camera is at the hair, draw everything); negative or NaN numerators give `L = 0`.
-pub fn detail_level(
+pub(crate) fn detail_level(
     size_m: f64,
     resolution_px: f64,
     distance_m: f64,
@@ -23,7 +23,7 @@ pub fn detail_level(
 
 /// Eq. 7 with the view extent given directly: `L = min(1, h R α / extent)`. For an
 /// orthographic camera (shadow maps of directional lights) the extent is the view height.
-pub fn detail_level_for_extent(
+pub(crate) fn detail_level_for_extent(
     size_m: f64,
     resolution_px: f64,
     view_extent_m: f64,
@@ -61,7 +61,7 @@ pub fn strand_count(level: f64, strands: u32, delta: f64) -> u32 {
 
 /// Strands a bundle of `strands` grows at `density` (the fraction that grow, see
 /// `Bundle::density`): `⌈density · N⌉`, none for 0 (or NaN), all for 1.
-pub fn density_count(density: f64, strands: u32) -> u32 {
+pub(crate) fn density_count(density: f64, strands: u32) -> u32 {
     let density = if density.is_nan() {
         0.0
     } else {

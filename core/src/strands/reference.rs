@@ -166,7 +166,7 @@ impl<'a> StrandContext<'a> {
 
 /// Size of the root sample sets: strand counts up to this take a prefix of one fixed set, so
 /// a bundle drawn with fewer strands (LOD) shows a subset of the strands it shows with more.
-pub fn sample_set_size(strands_per_bundle: u32) -> usize {
+pub(crate) fn sample_set_size(strands_per_bundle: u32) -> usize {
     (strands_per_bundle as usize)
         .next_power_of_two()
         .max(MIN_SAMPLE_SET)

@@ -45,7 +45,7 @@ const LIMIT_BETA: f64 = 0.65;
 const LIMIT_GAMMA: f64 = 1.5;
 
 /// The maximum Poisson-disk radius for `count` samples in `area`: hexagonal packing.
-pub fn max_radius(count: usize, area: f64) -> f64 {
+pub(crate) fn max_radius(count: usize, area: f64) -> f64 {
     (area / (2.0 * 3f64.sqrt() * count.max(1) as f64)).sqrt()
 }
 
@@ -211,7 +211,7 @@ impl Ord for OrderedWeight {
 /// Maps a triangle sample `(s, t)` (barycentric `1−s−t, s, t`) to the 2×2 texel block of a
 /// triangle bundle: `(s / (1 − t), t)`. At the duplicated corner (`t = 1`) any first
 /// coordinate gives the same point; 0 is returned.
-pub fn triangle_to_block(sample: DVec2) -> DVec2 {
+pub(crate) fn triangle_to_block(sample: DVec2) -> DVec2 {
     let denominator = 1.0 - sample.y;
     let s = if denominator > 0.0 {
         (sample.x / denominator).clamp(0.0, 1.0)

@@ -32,7 +32,7 @@ fn fade(t: f64) -> f64 {
 }
 
 /// Smooth 2D value noise in `[0, 1)` at `p` (lattice values from [`hash_values`]).
-pub fn value_noise_2d(p: DVec2, seed: u32, channel: u32) -> f64 {
+pub(crate) fn value_noise_2d(p: DVec2, seed: u32, channel: u32) -> f64 {
     let p = if p.is_finite() { p } else { DVec2::ZERO };
     let cell = p.floor();
     let f = p - cell;
@@ -157,7 +157,7 @@ pub fn styling_offset(params: &StylingParams, input: &StylingInput) -> DVec3 {
 }
 
 /// [`styling_offset`] with the strand's constant part computed already (once per strand).
-pub fn styling_offset_of(
+pub(crate) fn styling_offset_of(
     params: &StylingParams,
     strand: &StrandStyling,
     input: &StylingInput,

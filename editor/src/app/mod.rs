@@ -768,10 +768,8 @@ impl HairloomApp {
         ui.horizontal(|ui| {
             ui.label(&self.state.message);
             ui.separator();
-            ui.label(format!(
-                "{} strands, {} vertices drawn",
-                self.viewport.drawn_strands, self.viewport.drawn_vertices
-            ));
+            let (strands, vertices) = self.viewport.drawn();
+            ui.label(format!("{strands} strands, {vertices} vertices drawn"));
             if let Some(ms) = self.viewport.frame_ms() {
                 // The viewport's real rate: from its last frame's cost, not the UI's repaints
                 // (which idle between frames).

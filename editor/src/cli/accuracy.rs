@@ -1,25 +1,14 @@
-//! `hairloom bench accuracy` and `hairloom bench cpu`.
-//!
-//! Accuracy: every switch of the strand-evaluation path is compared with the f64 reference
-//! (column blend of centripetal Catmull-Rom columns, exact cubics) at the same strands and
-//! curve parameters, and timed on the CPU. Vertex counts are compared, styled, against a
-//! 257-vertex styled reference. Errors are in model units (metres for the samples) and in
-//! percent of the mean root-edge length ("bundle width").
+//! `hairloom bench accuracy` and `hairloom bench cpu`: printing and plotting what
+//! `hairloom_core::strands::accuracy` measures (every switch of the strand-evaluation path
+//! against the f64 reference; errors in model units and in percent of the mean root-edge
+//! length, "bundle width"), and timing the CPU reference generator.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use glam::{DVec2, DVec3};
-use hairloom_core::geometry::curve::{CurveDefinition, ReferenceStrand, SegmentForm};
-use hairloom_core::runtime::atlas::Atlas;
-use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
-use hairloom_core::runtime::textures::{Precision, RuntimeTextures};
+use hairloom_core::strands::accuracy::{CpuAccuracy, CpuAccuracyRow, measure_cpu_accuracy};
 use hairloom_core::strands::reference::{StrandOptions, generate, generate_parallel};
-use hairloom_core::strands::roots::{SampleDomain, progressive_samples};
-
-/// Vertices per strand used for the curve switches.
-const CURVE_VERTICES: usize = 33;
 
 fn default_project() -> PathBuf {
     hairloom_core::samples::default_sample_path()
@@ -32,184 +21,18 @@ fn load(project: Option<PathBuf>) -> anyhow::Result<(PathBuf, hairloom_core::Pro
     Ok((path, loaded))
 }
 
-/// One measured switch.
-struct Row {
-    switch: String,
-    max_error: f64,
-    mean_error: f64,
-    /// Max error against the f64 two-quadratic model (what the texture path implements):
-    /// isolates filtering and storage error from the curve approximation.
-    max_vs_quadratics: Option<f64>,
-    ms_per_million: f64,
-    /// What the storage costs: the five textures' GPU bytes per hair-mesh vertex (texture
-    /// path rows only).
-    texture_bytes_per_vertex: Option<f64>,
-}
-
-/// Strands to measure: (atlas block index, block coords, bundle-corner weights).
-fn strand_set(textures: &RuntimeTextures, per_bundle: u32) -> Vec<(usize, DVec2, [f64; 4])> {
-    let quad = progressive_samples(per_bundle as usize, SampleDomain::Square, 7);
-    let triangle = progressive_samples(per_bundle as usize, SampleDomain::Triangle, 7);
-    let mut out = Vec::new();
-    for (index, block) in textures.atlas.blocks.iter().enumerate() {
-        let samples = if Atlas::is_triangle(block) {
-            &triangle
-        } else {
-            &quad
-        };
-        for sample in samples {
-            let (s, t) = Atlas::sample_block_coords(block, *sample);
-            let coords = DVec2::new(s, t);
-            out.push((
-                index,
-                coords,
-                Atlas::corner_weights(block, coords.x, coords.y),
-            ));
-        }
-    }
-    out
-}
-
-fn taus(layers: u32) -> impl Iterator<Item = f64> {
-    (0..CURVE_VERTICES).map(move |k| layers as f64 * k as f64 / (CURVE_VERTICES - 1) as f64)
-}
-
 pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Result<()> {
     let (path, project) = load(project)?;
-    let document = &project.document;
-    let mesh = &document.hair_mesh;
-    let f32_textures = RuntimeTextures::build(mesh, Precision::F32);
-    let f16_textures = RuntimeTextures::build(mesh, Precision::F16);
-    let strands = strand_set(&f32_textures, per_bundle);
-    let bundle_width = mean_root_edge(mesh);
-    let layers_of = |block: usize| f32_textures.atlas.blocks[block].layers;
-
-    // Every measured strand by the f64 evaluator, with the time it took.
-    let evaluate = |definition: CurveDefinition, form: SegmentForm| -> (Vec<Vec<DVec3>>, f64) {
-        let start = Instant::now();
-        let points: Vec<Vec<DVec3>> = strands
-            .iter()
-            .filter_map(|(block, _, weights)| {
-                let bundle = f32_textures.atlas.blocks[*block].bundle as usize;
-                let strand = ReferenceStrand::with_weights(mesh, bundle, *weights)?;
-                Some(
-                    taus(layers_of(*block))
-                        .map(|t| strand.point(t, definition, form))
-                        .collect(),
-                )
-            })
-            .collect();
-        let vertices = (points.len() * CURVE_VERTICES).max(1) as f64;
-        (points, start.elapsed().as_secs_f64() * 1e3 * 1e6 / vertices)
-    };
-    let (reference, reference_ms) = evaluate(CurveDefinition::ColumnBlend, SegmentForm::ExactCubic);
-    let vertex_total = (reference.len() * CURVE_VERTICES) as f64;
-
-    let (quadratic_model, _) = evaluate(CurveDefinition::ColumnBlend, SegmentForm::TwoQuadratics);
-    let compare_with = |points: &[Vec<DVec3>], against: &[Vec<DVec3>]| -> (f64, f64) {
-        let mut max: f64 = 0.0;
-        let mut sum = 0.0;
-        let mut count = 0usize;
-        for (a, b) in points.iter().zip(against) {
-            for (p, q) in a.iter().zip(b) {
-                let d = p.distance(*q);
-                max = max.max(d);
-                sum += d;
-                count += 1;
-            }
-        }
-        (max, sum / count.max(1) as f64)
-    };
-    let compare = |points: &[Vec<DVec3>]| compare_with(points, &reference);
-    let mut rows = vec![Row {
-        switch: "reference: f64, column blend, exact cubic".into(),
-        max_error: 0.0,
-        mean_error: 0.0,
-        max_vs_quadratics: None,
-        ms_per_million: reference_ms,
-        texture_bytes_per_vertex: None,
-    }];
-    for (name, definition, form) in [
-        (
-            "f64, per-strand centripetal (2009 definition)",
-            CurveDefinition::PerStrandCentripetal,
-            SegmentForm::ExactCubic,
-        ),
-        (
-            "f64, column blend, two quadratics",
-            CurveDefinition::ColumnBlend,
-            SegmentForm::TwoQuadratics,
-        ),
-    ] {
-        let (points, ms) = evaluate(definition, form);
-        let (max, mean) = compare(&points);
-        rows.push(Row {
-            switch: name.into(),
-            max_error: max,
-            mean_error: mean,
-            max_vs_quadratics: None,
-            ms_per_million: ms,
-            texture_bytes_per_vertex: None,
-        });
-    }
-    for (name, textures, filtering) in [
-        (
-            "texture path f32, exact filtering",
-            &f32_textures,
-            Filtering::Exact,
-        ),
-        (
-            "texture path f32, 8-bit hardware weights",
-            &f32_textures,
-            Filtering::Hardware8Bit,
-        ),
-        (
-            "texture path f16, exact filtering",
-            &f16_textures,
-            Filtering::Exact,
-        ),
-        (
-            "texture path f16, 8-bit hardware weights",
-            &f16_textures,
-            Filtering::Hardware8Bit,
-        ),
-    ] {
-        let path = StrandGen {
-            textures,
-            filtering,
-        };
-        let start = Instant::now();
-        let points: Vec<Vec<DVec3>> = strands
-            .iter()
-            .map(|(block, coords, _)| {
-                taus(layers_of(*block))
-                    .map(|t| {
-                        path.position(*block, coords.x as f32, coords.y as f32, t as f32)
-                            .as_dvec3()
-                    })
-                    .collect()
-            })
-            .collect();
-        let ms = start.elapsed().as_secs_f64() * 1e3 * 1e6 / vertex_total;
-        let (max, mean) = compare(&points);
-        let (vs_quadratics, _) = compare_with(&points, &quadratic_model);
-        rows.push(Row {
-            switch: name.into(),
-            max_error: max,
-            mean_error: mean,
-            max_vs_quadratics: Some(vs_quadratics),
-            ms_per_million: ms,
-            texture_bytes_per_vertex: Some(
-                textures.gpu_bytes() as f64 / mesh.vertex_count().max(1) as f64,
-            ),
-        });
-    }
-    rows.extend(vertex_count_rows(document, per_bundle)?);
-
+    let CpuAccuracy {
+        rows,
+        strands,
+        bundle_width,
+    } = measure_cpu_accuracy(&project.document, per_bundle);
+    let reference_ms = rows.first().map_or(1.0, |r| r.ms_per_million);
     println!(
         "Accuracy vs time: {} ({} strands, bundle width {:.2} mm)",
         path.display(),
-        reference.len(),
+        strands,
         bundle_width * 1e3
     );
     println!("machine: {} (CPU evaluation, one thread)", super::machine());
@@ -277,7 +100,7 @@ pub fn run(project: Option<PathBuf>, out: &Path, per_bundle: u32) -> anyhow::Res
 
 /// Two bar panels sharing one row per switch: max error (log) on the left, CPU time on the
 /// right — what each accuracy option costs, side by side.
-fn chart(rows: &[Row], bundle_width: f64, path: &Path) -> anyhow::Result<()> {
+fn chart(rows: &[CpuAccuracyRow], bundle_width: f64, path: &Path) -> anyhow::Result<()> {
     use plotters::prelude::*;
     let fail = |e: &dyn std::fmt::Debug| anyhow::anyhow!("{e:?}");
     // Registering again in the same process fails harmlessly.
@@ -286,7 +109,7 @@ fn chart(rows: &[Row], bundle_width: f64, path: &Path) -> anyhow::Result<()> {
         FontStyle::Normal,
         epaint_default_fonts::UBUNTU_LIGHT,
     );
-    let plotted: Vec<&Row> = rows.iter().filter(|r| r.max_error > 0.0).collect();
+    let plotted: Vec<&CpuAccuracyRow> = rows.iter().filter(|r| r.max_error > 0.0).collect();
     let n = plotted.len() as i32;
     let names: Vec<String> = plotted.iter().map(|r| r.switch.clone()).collect();
     let e_min = plotted
@@ -384,68 +207,6 @@ fn chart(rows: &[Row], bundle_width: f64, path: &Path) -> anyhow::Result<()> {
     }
     root.present().map_err(|e| fail(&e))?;
     Ok(())
-}
-
-/// Styled strands with 5, 9, 17, 33 and 65 vertices against a 257-vertex styled reference:
-/// each reference vertex is compared with the coarse polyline at the same curve parameter.
-fn vertex_count_rows(
-    document: &hairloom_core::Document,
-    per_bundle: u32,
-) -> anyhow::Result<Vec<Row>> {
-    let options = |log2: u32| StrandOptions {
-        strands_per_bundle: per_bundle,
-        vertices_log2: log2,
-        ..StrandOptions::default()
-    };
-    let reference = generate(document, &options(8));
-    let mut rows = Vec::new();
-    for log2 in 2..=6u32 {
-        let start = Instant::now();
-        let coarse = generate(document, &options(log2));
-        let vertices = coarse.iter().map(|s| s.points.len()).sum::<usize>() as f64;
-        let ms = start.elapsed().as_secs_f64() * 1e3 * 1e6 / vertices;
-        let (mut max, mut sum, mut count): (f64, f64, usize) = (0.0, 0.0, 0);
-        for (fine, coarse) in reference.iter().zip(&coarse) {
-            let segments = coarse.points.len() - 1;
-            for (i, p) in fine.points.iter().enumerate() {
-                let t = i as f64 / (fine.points.len() - 1) as f64 * segments as f64;
-                let k = (t.floor() as usize).min(segments - 1);
-                let q = coarse.points[k].lerp(coarse.points[k + 1], t - k as f64);
-                let d = p.distance(q);
-                max = max.max(d);
-                sum += d;
-                count += 1;
-            }
-        }
-        rows.push(Row {
-            switch: format!("styled, {} vertices vs 257", (1 << log2) + 1),
-            max_error: max,
-            mean_error: sum / count.max(1) as f64,
-            max_vs_quadratics: None,
-            ms_per_million: ms,
-            texture_bytes_per_vertex: None,
-        });
-    }
-    Ok(rows)
-}
-
-fn mean_root_edge(mesh: &hairloom_core::HairMesh) -> f64 {
-    let mut total = 0.0;
-    let mut count = 0;
-    for bundle in &mesh.bundles {
-        let n = bundle.vertices.len();
-        for i in 0..n {
-            let a = mesh.columns[bundle.vertices[i] as usize].positions[0];
-            let b = mesh.columns[bundle.vertices[(i + 1) % n] as usize].positions[0];
-            total += a.distance(b);
-            count += 1;
-        }
-    }
-    if count == 0 {
-        1.0
-    } else {
-        total / count as f64
-    }
 }
 
 pub fn cpu(project: Option<PathBuf>) -> anyhow::Result<()> {

@@ -13,6 +13,7 @@
 //! | [`body_shadow`] | `preview_body.wgsl` (`vs_shadow`) | body shadows |
 //! | [`oit_composite`] | `oit_composite.wgsl` | width-based coverage |
 //! | [`scene_lighting`] | `shared/scene.wgsl`, `light/dual_scattering.wgsl` | always (tables: dual scattering) |
+//! | [`viewport_blit`] | `viewport_blit.wgsl` | the editor's viewport (an egui paint callback) |
 
 pub mod body_shadow;
 pub mod hair_shadow;
@@ -21,6 +22,7 @@ pub mod preview_body;
 pub mod preview_hair;
 pub mod scene_lighting;
 pub mod strand_gen;
+pub mod viewport_blit;
 
 use crate::device::GpuContext;
 use crate::resources::Tracked;

@@ -388,7 +388,7 @@ fn compound_node(properties: &[Property], table: &mut MetadataTable) -> Node {
 }
 
 /// MurmurHash3 x64 128 with seed 0, as two little-endian u64 (Alembic's sample key).
-pub fn murmur3_x64_128(data: &[u8]) -> [u8; 16] {
+pub(crate) fn murmur3_x64_128(data: &[u8]) -> [u8; 16] {
     const C1: u64 = 0x87c3_7b91_1142_53d5;
     const C2: u64 = 0x4cf5_ad43_2745_937f;
     fn mix(mut k: u64) -> u64 {

@@ -22,8 +22,7 @@ impl Viewport {
         document: &hairloom_core::Document,
         ctx: &egui::Context,
     ) -> Option<std::sync::mpsc::Receiver<EffectCostResult>> {
-        let gpu = self.gpu.as_ref()?;
-        let (context, generator) = (gpu.context.clone(), Arc::clone(&gpu.generator));
+        let (context, generator) = self.gpu_handles()?;
         let document = document.clone();
         let settings = self.settings;
         let orbit = self.orbit;

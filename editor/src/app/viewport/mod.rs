@@ -1,6 +1,6 @@
 //! 3D viewport: the document's strands generated on the GPU from its runtime textures every
 //! time the document or the view changes (the same path as `hairloom render` and a game),
-//! drawn offscreen by the render crate and shown as an egui image.
+//! rendered and shown through an `egui_wgpu` paint callback (`paint.rs`).
 //!
 //! Navigation (Blender's): middle-drag orbits, shift+middle-drag pans, the wheel zooms; on a
 //! trackpad alt+left-drag orbits and shift+alt+left-drag pans. F frames the selection (the
@@ -78,18 +78,6 @@ impl Default for ViewSettings {
     }
 }
 
-struct UploadedHair {
-    gpu: GpuHair,
-    bounds: (Vec3, Vec3),
-    /// The asset on the CPU (its body is drawn; its styling is restyled in place).
-    hair: RuntimeHair,
-    /// The hair mesh the textures were built from: a change that leaves it (and the body)
-    /// alone is styling only.
-    mesh: hairloom_core::HairMesh,
-    /// The body on the GPU, uploaded with the hair (not per frame).
-    body: GpuBody,
-}
-
 /// Uploads of the hair since the viewport was made.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct UploadCounts {
@@ -97,17 +85,6 @@ pub struct UploadCounts {
     pub full: u64,
     /// Only the styling buffers rewritten (a styling-only edit).
     pub styling: u64,
-}
-
-/// GPU resources of the viewport (absent without a wgpu device).
-struct GpuView {
-    context: GpuContext,
-    /// Shared with accuracy measurements on a worker thread.
-    generator: Arc<StrandGenRenderer>,
-    preview: PreviewRenderer,
-    egui_renderer: Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>,
-    hair: Option<UploadedHair>,
-    texture: Option<(wgpu::Texture, egui::TextureId)>,
 }
 
 /// Key of what was last drawn, to draw again only when something changed.
@@ -145,12 +122,19 @@ impl Viewport {
     /// Wall time from submitting the last drawn frame to the GPU finishing it (generation
     /// and drawing); `None` until one has finished.
     pub fn frame_ms(&self) -> Option<f64> {
-        self.frame_ms.lock().ok().and_then(|slot| *slot)
+        self.shared.frame_ms.lock().ok().and_then(|slot| *slot)
     }
 }
 
 pub struct Viewport {
-    gpu: Option<GpuView>,
+    /// egui's renderer, whose callback resources hold the viewport's GPU side
+    /// ([`paint::ViewportGpu`]); `None` without a usable wgpu device.
+    gpu: Option<Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>>,
+    /// What the panel hands to its paint callback and what the callback reports back.
+    shared: paint::CallbackShared,
+    /// The hair last sent to the GPU (its mesh and body, to tell a styling-only edit), and
+    /// its box; `None` when no bundle grows hair.
+    hair_shown: Option<paint::ShownHair>,
     /// A lost device or a GPU error the device reported outside any error scope: shown in
     /// the viewport instead of panicking (wgpu's default).
     device_problem: Arc<std::sync::Mutex<Option<String>>>,
@@ -160,14 +144,7 @@ pub struct Viewport {
     /// How often the hair went to the GPU, whole or restyled (tests count them).
     pub uploads: UploadCounts,
     drawn: Option<DrawnKey>,
-    /// Strands and vertices of the last frame, after culling and LOD.
-    pub drawn_strands: usize,
-    pub drawn_vertices: usize,
-    /// Wall time of generating and drawing the last frame on the GPU (submit to idle).
-    /// Written by the queue's work-done callback, so drawing never waits on the GPU.
-    frame_ms: Arc<std::sync::Mutex<Option<f64>>>,
-    /// The quality of the frame `frame_ms` timed, and the last full frame's time.
-    frame_quality: Arc<std::sync::Mutex<Option<FrameQuality>>>,
+    /// The last full frame's time.
     full_frame_ms: Option<f64>,
     /// When what the viewport shows last changed (an edit, the camera, the size).
     last_change: Option<std::time::Instant>,
@@ -176,9 +153,9 @@ pub struct Viewport {
     /// The quality of the picture shown now (the status bar says when it is reduced).
     pub shown_quality: FrameQuality,
     pub adapter: String,
-    pub error: Option<String>,
-    /// Why the hair could not be uploaded (an adapter limit); the document is kept.
-    pub upload_error: Option<String>,
+    /// What the panel shows instead of the picture, as of its last pass (see
+    /// [`Self::error`]).
+    error: Option<String>,
     /// A dialog owns the keyboard this frame (set by the app): no single-key commands.
     pub keyboard_blocked: bool,
     /// Where the viewport was last drawn, in points (snapshot tests crop to it).
@@ -257,43 +234,39 @@ impl Viewport {
                 }
             }));
         }
+        let adapter = render_state.map_or_else(
+            || unsupported.clone().unwrap_or("no GPU device".into()),
+            |state| describe(&state.adapter.get_info()),
+        );
         let gpu = render_state.map(|state| {
             let context = GpuContext::from_parts(
                 state.adapter.clone(),
                 state.device.clone(),
                 state.queue.clone(),
             );
-            GpuView {
-                generator: Arc::new(StrandGenRenderer::new(&context)),
-                preview: PreviewRenderer::new(&context),
-                egui_renderer: state.renderer.clone(),
-                context,
-                hair: None,
-                texture: None,
-            }
+            state
+                .renderer
+                .write()
+                .callback_resources
+                .insert(paint::ViewportGpu::new(context, state.target_format));
+            state.renderer.clone()
         });
         Self {
-            adapter: gpu.as_ref().map_or_else(
-                || unsupported.clone().unwrap_or("no GPU device".into()),
-                |g| describe(&g.context.adapter_info),
-            ),
+            adapter,
             gpu,
+            shared: paint::CallbackShared::default(),
+            hair_shown: None,
             device_problem,
             orbit: Orbit::default(),
             settings: ViewSettings::default(),
             uploaded: None,
             uploads: UploadCounts::default(),
             drawn: None,
-            drawn_strands: 0,
-            drawn_vertices: 0,
-            frame_ms: Arc::default(),
-            frame_quality: Arc::default(),
             full_frame_ms: None,
             last_change: None,
             interactive_scale: 0.5,
             shown_quality: FrameQuality::Full,
             error: None,
-            upload_error: None,
             keyboard_blocked: false,
             rect: None,
             transform: None,
@@ -351,8 +324,15 @@ impl Viewport {
     }
 
     /// The wgpu device the viewport draws with (tests provoke device errors on it).
-    pub fn device(&self) -> Option<&wgpu::Device> {
-        self.gpu.as_ref().map(|g| &g.context.device)
+    pub fn device(&self) -> Option<wgpu::Device> {
+        self.gpu_handles().map(|(context, _)| context.device)
+    }
+
+    /// The device and the strand generator, for measurements on a worker thread.
+    fn gpu_handles(&self) -> Option<(GpuContext, Arc<StrandGenRenderer>)> {
+        let renderer = self.gpu.as_ref()?.read();
+        let gpu = renderer.callback_resources.get::<paint::ViewportGpu>()?;
+        Some((gpu.context.clone(), Arc::clone(&gpu.generator)))
     }
 }
 

@@ -132,10 +132,9 @@ impl Viewport {
                      each setting on this GPU, on a worker thread; errors against f32 / exact",
                 );
             if measure.clicked()
-                && let Some(gpu) = &self.gpu
+                && let Some((context, generator)) = self.gpu_handles()
             {
                 let (sender, receiver) = std::sync::mpsc::channel();
-                let (context, generator) = (gpu.context.clone(), Arc::clone(&gpu.generator));
                 let document = state.document().clone();
                 let strands_per_bundle = self.settings.strands_per_bundle;
                 let ctx = ui.ctx().clone();
