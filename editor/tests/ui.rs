@@ -322,12 +322,7 @@ fn save_on_the_sample_asks_where_and_the_file_becomes_recent() {
             .bundles
             .is_empty()
     );
-    harness.get_by_label("File").click();
-    harness.run();
-    harness.get_by_label("Open Recent").hover();
-    harness.run();
-    harness.get_by_label(&saved.display().to_string()).click();
-    harness.run();
+    open_recent(&mut harness, &saved);
     assert_eq!(harness.state().state.project, reopened.project);
 }
 
@@ -1382,4 +1377,114 @@ fn set_density_thins_the_selected_bundles_as_an_undo_step() {
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     harness.run();
     assert_eq!(harness.state().state.document(), &original, "one undo step");
+}
+
+/// Opens `path` through File ▸ Open Recent (it must be in the list).
+fn open_recent(harness: &mut Harness<'static, HairloomApp>, path: &std::path::Path) {
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label("Open Recent").hover();
+    harness.run();
+    harness.get_by_label(&path.display().to_string()).click();
+    harness.run();
+}
+
+#[test]
+fn a_project_reopens_as_it_was_viewed_and_looking_around_is_not_an_edit() {
+    use hairloom_core::runtime::strand_gen::Filtering;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("viewed.hairloom");
+    let recovery_dir = fresh_recovery_dir();
+    let mut harness = harness_with(
+        &recovery_dir,
+        ScriptedDialogs::new([DialogAnswer::Chosen(path.clone())]),
+    );
+    make_unsaved_change(&mut harness);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    harness.run();
+    assert!(path.exists(), "{}", harness.state().state.message);
+    let project = harness.state().state.project.clone();
+
+    // Look from the side (key 3 over the viewport), zoom, and switch what is drawn.
+    harness.hover_at(viewport_rect(&harness).center());
+    harness.key_press(egui::Key::Num3);
+    harness.run();
+    {
+        let viewport = &mut harness.state_mut().viewport;
+        viewport.orbit.zoom = 0.6;
+        viewport.settings.wireframe = true;
+        viewport.settings.strands_per_bundle = 8;
+        viewport.settings.filtering = Filtering::Hardware8Bit;
+    }
+    harness.run();
+    let seen = (
+        harness.state().viewport.orbit,
+        harness.state().viewport.settings,
+    );
+    assert_ne!(seen.0, hairloom_editor::app::viewport::Orbit::default());
+    // The view is not part of the document: nothing to save, nothing to undo.
+    assert!(!harness.state().state.is_dirty());
+    assert_eq!(harness.state().state.project, project);
+
+    // Another document starts framed afresh; reopening the project brings its view back.
+    file_menu(&mut harness, "New");
+    assert_eq!(
+        harness.state().viewport.orbit,
+        hairloom_editor::app::viewport::Orbit::default()
+    );
+    open_recent(&mut harness, &path);
+    assert_eq!(harness.state().state.path.as_deref(), Some(path.as_path()));
+    assert_eq!(
+        (
+            harness.state().viewport.orbit,
+            harness.state().viewport.settings
+        ),
+        seen
+    );
+
+    // And in the next session (the same user's folder).
+    drop(harness);
+    let mut next = harness_with(&recovery_dir, ScriptedDialogs::default());
+    open_recent(&mut next, &path);
+    assert_eq!(next.state().viewport.orbit, seen.0);
+    assert!(next.state().viewport.settings.wireframe);
+    assert_eq!(next.state().viewport.settings.strands_per_bundle, 8);
+}
+
+/// Points of the overlay's selection outlines (orange strokes) in the last frame.
+fn outline_points(harness: &Harness<'static, HairloomApp>) -> usize {
+    let orange = egui::Color32::from_rgb(255, 150, 40);
+    harness
+        .output()
+        .shapes
+        .iter()
+        .map(|clipped| match &clipped.shape {
+            egui::Shape::Path(path)
+                if path.stroke.color == egui::epaint::ColorMode::Solid(orange) =>
+            {
+                path.points.len()
+            }
+            _ => 0,
+        })
+        .sum()
+}
+
+#[test]
+fn outlines_stop_at_the_head_unless_x_ray_is_on() {
+    let mut harness = harness();
+    let bundles = harness.state().state.document().hair_mesh.bundles.len() as u32;
+    harness.state_mut().state.selection.extend(0..bundles);
+    harness.state_mut().state.tool.xray = true;
+    harness.run();
+    let through = outline_points(&harness);
+    harness.state_mut().state.tool.xray = false;
+    harness.run();
+    let seen = outline_points(&harness);
+    eprintln!("outline points: {seen} seen of {through} with X-ray");
+    // From the default three-quarter view the head hides the far side's bundles.
+    assert!(seen > 0, "nothing outlined");
+    assert!(
+        seen * 10 < through * 9,
+        "depth test hid too little: {seen} of {through} outline points"
+    );
 }

@@ -61,9 +61,46 @@ pub fn point_in_polygon(p: [f64; 2], polygon: &[[f64; 2]]) -> bool {
     inside
 }
 
-/// What occludes picking: a coarse screen-space depth buffer of the body, so a click or a
-/// region selects only what the artist sees (no selecting through the head), unless X-ray
-/// is on. Built on the CPU per selection gesture: the head scan's 35K triangles rasterise
+/// The visible runs of a polyline through `points` (closed: back to the first point), each
+/// edge cut into `pieces` and a piece kept when `seen` says its middle is visible: what a
+/// depth-tested outline draws. Consecutive visible pieces join into one run.
+pub fn visible_runs(
+    points: &[DVec3],
+    closed: bool,
+    pieces: usize,
+    seen: impl Fn(DVec3) -> bool,
+) -> Vec<Vec<DVec3>> {
+    let pieces = pieces.max(1);
+    let edges = if closed && points.len() > 2 {
+        points.len()
+    } else {
+        points.len().saturating_sub(1)
+    };
+    let mut runs: Vec<Vec<DVec3>> = Vec::new();
+    let mut open = false;
+    for i in 0..edges {
+        let (a, b) = (points[i], points[(i + 1) % points.len()]);
+        for k in 0..pieces {
+            let (t0, t1) = (k as f64 / pieces as f64, (k + 1) as f64 / pieces as f64);
+            if seen(a.lerp(b, 0.5 * (t0 + t1))) {
+                if !open {
+                    runs.push(vec![a.lerp(b, t0)]);
+                    open = true;
+                }
+                if let Some(run) = runs.last_mut() {
+                    run.push(a.lerp(b, t1));
+                }
+            } else {
+                open = false;
+            }
+        }
+    }
+    runs
+}
+
+/// What occludes picking and the viewport's outlines: a coarse screen-space depth buffer of
+/// the body, so a click or a region selects (and an outline shows) only what the artist
+/// sees (no selecting through the head), unless X-ray is on. Built on the CPU per selection gesture: the head scan's 35K triangles rasterise
 /// into a 2-pixel grid in milliseconds, far cheaper than a ray test per vertex.
 #[derive(Clone, Debug)]
 pub struct DepthMap {
@@ -441,6 +478,33 @@ mod tests {
     }
 
     use super::*;
+
+    #[test]
+    fn visible_runs_keep_only_what_is_seen_and_join_across_edges() {
+        let square = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ];
+        // Everything seen: one run round the whole closed square (4 edges × 2 pieces).
+        let all = visible_runs(&square, true, 2, |_| true);
+        assert_eq!(all.len(), 1);
+        assert_eq!(all[0].len(), 9);
+        assert_eq!(all[0][0], all[0][8]);
+        // Nothing seen: nothing drawn.
+        assert!(visible_runs(&square, true, 4, |_| false).is_empty());
+        // An occluder over x > 0.6 hides the right edge and the ends of the two edges
+        // touching it: the open polyline splits into two runs.
+        let runs = visible_runs(&square, false, 4, |p| p.x < 0.6);
+        assert_eq!(runs.len(), 2);
+        assert!(runs.iter().flatten().all(|p| p.x <= 0.75 + 1e-12));
+        assert_eq!(runs[0][0], square[0]);
+        assert_eq!(runs[1].last(), Some(&square[3]));
+        // One point or none: no edge.
+        assert!(visible_runs(&square[..1], true, 4, |_| true).is_empty());
+        assert!(visible_runs(&[], false, 4, |_| true).is_empty());
+    }
     use crate::model::mesh::test_meshes::grid;
 
     /// Looks down the z axis: x, y in model units become pixels ×100.

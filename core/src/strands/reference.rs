@@ -270,7 +270,7 @@ pub fn generate_parallel(
 mod tests {
     use super::*;
     use crate::model::mesh::test_meshes::grid;
-    use crate::model::styling::{Clump, Curl, Frizz, LengthVariation, Noise, Twist, Wave};
+    use crate::model::styling::{LengthVariation, Twist};
 
     fn styled(params: StylingParams) -> Document {
         // Hair-sized: 1 cm quads, three 1 cm layers.
@@ -285,32 +285,11 @@ mod tests {
         document
     }
 
+    /// The shared every-op set without twist (twist has its own test below).
     fn everything_but_twist() -> StylingParams {
         StylingParams {
-            curl: Curl {
-                radius_m: 0.002,
-                turns_per_m: 40.0,
-                ..Curl::default()
-            },
-            noise: Noise {
-                amplitude_m: 0.001,
-                ..Noise::default()
-            },
-            clump: Clump {
-                strength: 0.6,
-                ..Clump::default()
-            },
-            frizz: Frizz {
-                amplitude_m: 0.001,
-                fraction: 1.0,
-                ..Frizz::default()
-            },
-            wave: Wave {
-                amplitude_m: 0.003,
-                ..Wave::default()
-            },
-            length: LengthVariation { fraction: 0.3 },
-            ..StylingParams::default()
+            twist: Twist::default(),
+            ..StylingParams::every_op()
         }
     }
 

@@ -13,6 +13,7 @@ pub mod scene_panel;
 pub mod state;
 pub mod styling_panel;
 pub mod tools_panel;
+pub mod view_memory;
 pub mod viewport;
 
 pub use state::EditorState;
@@ -137,6 +138,8 @@ pub struct HairloomApp {
     pub offer: Option<PendingRecovery>,
     pub dialogs: Box<dyn FileDialogs>,
     pub recent: RecentFiles,
+    /// How each project was last viewed (per user; not part of any document).
+    pub views: view_memory::ViewMemory,
     /// The typed-path prompt, where no native dialog exists.
     pub prompt: Option<PathPrompt>,
     pub export: Option<ExportJob>,
@@ -164,11 +167,12 @@ impl HairloomApp {
         state: EditorState,
         recovery: Recovery,
     ) -> Self {
-        Self {
+        let mut app = Self {
             viewport: Viewport::new(cc.wgpu_render_state.as_ref()),
             offer: recovery.pending(),
             autosaved: (0.0, state.revision),
             recent: RecentFiles::load(recovery.dir().join("recent.txt")),
+            views: view_memory::ViewMemory::load(recovery.dir().join("views.json")),
             recovery,
             state,
             styling: StylingPanel::default(),
@@ -186,7 +190,9 @@ impl HairloomApp {
             quitting: false,
             close_sent: false,
             title: String::new(),
-        }
+        };
+        app.recall_view();
+        app
     }
 
     /// Replaces the file dialogs (tests script them).
@@ -245,8 +251,10 @@ impl HairloomApp {
         match choice {
             Some(true) => match self.recovery.load() {
                 Ok(state) => {
+                    self.remember_view();
                     self.state = state;
                     self.viewport.reframe();
+                    self.recall_view();
                     self.offer = None;
                 }
                 Err(error) => {
@@ -385,6 +393,23 @@ impl HairloomApp {
     fn saved_to(&mut self, path: &std::path::Path) {
         self.recovery.discard();
         self.recent.push(path);
+        self.remember_view();
+    }
+
+    /// Keeps how the open project is viewed (per user, outside the document and its undo
+    /// history); projects without a file have no view to keep.
+    fn remember_view(&mut self) {
+        if let Some(path) = &self.state.path {
+            let view = view_memory::SavedView::of(&self.viewport.orbit, &self.viewport.settings);
+            self.views.remember(path, view);
+        }
+    }
+
+    /// Shows the open project as it was last viewed, if it was.
+    fn recall_view(&mut self) {
+        if let Some(view) = self.state.path.as_ref().and_then(|p| self.views.recall(p)) {
+            view.apply(&mut self.viewport.orbit, &mut self.viewport.settings);
+        }
     }
 
     /// Asks a dialog for a path; `None` when cancelled or when the typed-path prompt was
@@ -485,8 +510,10 @@ impl HairloomApp {
     }
 
     fn replace_state(&mut self, state: EditorState) {
+        self.remember_view();
         self.state = state;
         self.viewport.reframe();
+        self.recall_view();
         self.recovery.discard();
         self.autosaved.1 = self.state.revision;
     }
@@ -856,6 +883,7 @@ impl egui_tiles::Behavior<Pane> for PaneUi<'_> {
 
 impl eframe::App for HairloomApp {
     fn on_exit(&mut self) {
+        self.remember_view();
         if let Some(job) = &self.export {
             // Let the export finish writing (each file is atomic either way).
             let _ = job.wait();

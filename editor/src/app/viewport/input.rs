@@ -44,19 +44,7 @@ impl Viewport {
             state.stop_playback_for_editing();
         }
         let mesh = &state.document().hair_mesh;
-        let depth = (gesture_ends && !state.tool.xray).then(|| {
-            let body = &state.document().body;
-            select::DepthMap::rasterize(
-                &body.positions,
-                &body.triangles,
-                |p| projector.project_local_depth(p),
-                [
-                    projector.rect.width() as f64,
-                    projector.rect.height() as f64,
-                ],
-                2.0,
-            )
-        });
+        let depth = (gesture_ends && !state.tool.xray).then(|| self.body_depth(state, &projector));
         let seen = |p: DVec3| {
             depth.as_ref().is_none_or(|depth| {
                 projector

@@ -49,6 +49,9 @@ use hairloom_render::renderer::preview_body::GpuBody;
 /// Storage buffers per shader stage the generation and preview pipelines bind.
 const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
 
+/// The Strands & accuracy panel's largest strand count per bundle.
+pub const MAX_STRANDS_PER_BUNDLE: u32 = 256;
+
 /// What the viewport shows and how it generates strands.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
@@ -95,6 +98,15 @@ struct DrawnKey {
     orbit: Orbit,
     size: [u32; 2],
     quality: FrameQuality,
+}
+
+/// What the overlay's body depth was rasterised for.
+#[derive(Clone, Copy, PartialEq)]
+struct BodyDepthKey {
+    revision: u64,
+    orbit: Orbit,
+    size: [f32; 2],
+    bounds: Option<(Vec3, Vec3)>,
 }
 
 /// How much of the picture a frame draws (see [`FRAME_BUDGET_MS`]).
@@ -191,6 +203,8 @@ pub struct Viewport {
     /// Per column and layer, whether the vertex is interior, for the document revision it
     /// was computed at (the wireframe marks them; recomputed only when the document changes).
     interior: Option<(u64, Vec<Vec<bool>>)>,
+    /// The body's depth for the overlay, with what it was rasterised for.
+    body_depth: Option<(BodyDepthKey, Arc<select::DepthMap>)>,
     /// Styling frames per layer and column for the document revision they were computed at.
     frames: Option<(
         u64,
@@ -281,6 +295,7 @@ impl Viewport {
             camera_bounds: None,
             framed_from_hair: false,
             interior: None,
+            body_depth: None,
             frames: None,
         }
     }

@@ -4,36 +4,82 @@
 use super::*;
 
 impl Viewport {
+    /// The body's depth in this view, for depth-testing the overlay; rebuilt only when the
+    /// document, the camera or the viewport's size changed.
+    pub(super) fn body_depth(
+        &mut self,
+        state: &EditorState,
+        projector: &Projector,
+    ) -> Arc<select::DepthMap> {
+        let key = BodyDepthKey {
+            revision: state.shown_revision(),
+            orbit: self.orbit,
+            size: [projector.rect.width(), projector.rect.height()],
+            bounds: self.camera_bounds,
+        };
+        if let Some((cached, depth)) = &self.body_depth
+            && *cached == key
+        {
+            return Arc::clone(depth);
+        }
+        let body = &state.shown_document().body;
+        let depth = Arc::new(select::DepthMap::rasterize(
+            &body.positions,
+            &body.triangles,
+            |p| projector.project_local_depth(p),
+            [
+                projector.rect.width() as f64,
+                projector.rect.height() as f64,
+            ],
+            2.0,
+        ));
+        self.body_depth = Some((key, Arc::clone(&depth)));
+        depth
+    }
+
     /// The hair-mesh wireframe (when on) and the selected bundles' outlines, drawn over the
-    /// picture with the picture's camera (not depth-tested: an X-ray view).
+    /// picture with the picture's camera; depth-tested against the body (what is behind the
+    /// head is not drawn) unless X-ray is on.
     pub(super) fn paint_overlay(&mut self, ui: &egui::Ui, state: &EditorState, rect: egui::Rect) {
-        let mesh = &state.shown_document().hair_mesh;
         let Some(projector) = self.projector(state, rect) else {
             return;
         };
+        let depth = (!state.tool.xray).then(|| self.body_depth(state, &projector));
+        let mesh = &state.shown_document().hair_mesh;
+        let seen = |p: DVec3| {
+            depth.as_ref().is_none_or(|depth| {
+                projector
+                    .project_local_depth(p)
+                    .is_some_and(|q| depth.visible(q))
+            })
+        };
         let project = |p: DVec3| projector.project(p);
         let painter = ui.painter_at(rect);
+        // Each edge is cut in pieces so an outline stops where the body covers it.
+        const PIECES_PER_EDGE: usize = 4;
+        let polyline = |points: &[DVec3], closed: bool, stroke: egui::Stroke| {
+            for run in select::visible_runs(points, closed, PIECES_PER_EDGE, seen) {
+                let run: Vec<_> = run.into_iter().filter_map(project).collect();
+                painter.add(egui::Shape::line(run, stroke));
+            }
+        };
         let outline = |bundle: &hairloom_core::Bundle, stroke: egui::Stroke| {
             for layer in 0..=bundle.layers as usize {
-                let corners: Vec<_> = bundle
+                let corners: Vec<DVec3> = bundle
                     .vertices
                     .iter()
-                    .filter_map(|&c| project(*mesh.columns.get(c as usize)?.positions.get(layer)?))
+                    .filter_map(|&c| mesh.columns.get(c as usize)?.positions.get(layer).copied())
                     .collect();
                 if corners.len() == bundle.vertices.len() {
-                    painter.add(egui::Shape::closed_line(corners, stroke));
+                    polyline(&corners, true, stroke);
                 }
             }
             for &c in &bundle.vertices {
                 let Some(column) = mesh.columns.get(c as usize) else {
                     continue;
                 };
-                let points: Vec<_> = column.positions
-                    [..=(bundle.layers as usize).min(column.positions.len() - 1)]
-                    .iter()
-                    .filter_map(|p| project(*p))
-                    .collect();
-                painter.add(egui::Shape::line(points, stroke));
+                let end = (bundle.layers as usize).min(column.positions.len() - 1);
+                polyline(&column.positions[..=end], false, stroke);
             }
         };
         let vertex_mode = state.tool.mode == SelectMode::Vertices;
@@ -63,7 +109,9 @@ impl Viewport {
             let interior = self.interior.as_ref().map(|(_, i)| i);
             for (c, column) in mesh.columns.iter().enumerate() {
                 for (layer, p) in column.positions.iter().enumerate() {
-                    let Some(at) = project(*p) else { continue };
+                    let Some(at) = project(*p).filter(|_| seen(*p)) else {
+                        continue;
+                    };
                     let is_interior = interior
                         .and_then(|i| i.get(c)?.get(layer).copied())
                         .unwrap_or(false);
@@ -106,7 +154,9 @@ impl Viewport {
                         ) else {
                             continue;
                         };
-                        let Some(at) = project(p) else { continue };
+                        let Some(at) = project(p).filter(|_| seen(p)) else {
+                            continue;
+                        };
                         let alpha = if frame.fallback { 90 } else { 220 };
                         for (axis, (r, g, b)) in [
                             (frame.u, (235, 70, 60)),

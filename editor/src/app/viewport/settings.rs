@@ -11,7 +11,8 @@ impl Viewport {
         ui.heading("Strands");
         let settings = &mut self.settings;
         ui.add(
-            egui::Slider::new(&mut settings.strands_per_bundle, 1..=256).text("Strands per bundle"),
+            egui::Slider::new(&mut settings.strands_per_bundle, 1..=MAX_STRANDS_PER_BUNDLE)
+                .text("Strands per bundle"),
         );
         ui.checkbox(&mut settings.lod.enabled, "Level of detail");
         ui.add_enabled_ui(settings.lod.enabled, |ui| {
