@@ -1488,3 +1488,31 @@ fn outlines_stop_at_the_head_unless_x_ray_is_on() {
         "depth test hid too little: {seen} of {through} outline points"
     );
 }
+
+#[test]
+fn split_and_merge_are_one_undo_step_each() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    click_bundle_in_outliner(&mut harness, 0);
+    harness.get_by_label("Split").click();
+    harness.run();
+    let split = harness.state().state.document().hair_mesh.clone();
+    split.validate().expect("valid after split");
+    assert!(
+        split.columns.len() > original.hair_mesh.columns.len(),
+        "{}",
+        harness.state().state.message
+    );
+    harness.get_by_label("Merge").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().hair_mesh,
+        original.hair_mesh,
+        "{}",
+        harness.state().state.message
+    );
+    undo(&mut harness, 1);
+    assert_eq!(harness.state().state.document().hair_mesh, split);
+    undo(&mut harness, 1);
+    assert_eq!(harness.state().state.document(), &original);
+}

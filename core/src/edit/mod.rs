@@ -15,6 +15,7 @@
 pub mod coordinates;
 pub mod pick;
 pub mod select;
+pub mod split_merge;
 pub mod topology;
 pub mod transform;
 pub mod wisps;
@@ -26,6 +27,7 @@ use crate::model::mesh::{HairMesh, VertexRef};
 
 // The edit API in one place: callers write `edit::extrude`, whichever file it lives in.
 pub use coordinates::{set_corner_uvs, set_w, set_w_mode};
+pub use split_merge::{merge_bundles, split_bundles};
 pub use topology::{
     ExtrudeDirection, delete_layer, extrude, insert_layer, layer_closure, set_density, set_removed,
     subdivide,
@@ -56,6 +58,12 @@ pub enum EditError {
     LayerCap { bundle: u32, cap: u32 },
     #[error("{what} must be finite, got {value}")]
     NotFinite { what: &'static str, value: String },
+    #[error("the selected bundles share no vertex with other bundles: nothing to split")]
+    NothingToSplit,
+    #[error(
+        "no vertex of the selected bundles has a twin at the same root (what a split leaves): nothing to merge"
+    )]
+    NothingToMerge,
     #[error("the edit would leave an invalid mesh: {0}")]
     Invalid(#[from] crate::model::mesh::InvalidMesh),
 }

@@ -1,5 +1,5 @@
 //! Tools: the topology tools on the selection — extrude (E), insert and delete a layer,
-//! remove / restore, subdivide. Each tool is one undo step; errors go to the status bar.
+//! remove / restore, subdivide, split / merge. Each tool is one undo step; errors go to the status bar.
 
 use hairloom_core::edit::{self, ExtrudeDirection};
 
@@ -154,6 +154,26 @@ impl ToolsPanel {
             }
             if ui.button("Subdivide").clicked() {
                 state.edit_mesh("Subdivide", edit::subdivide);
+            }
+        });
+        ui.horizontal(|ui| {
+            if ui
+                .button("Split")
+                .on_hover_text(
+                    "Split the selected bundles off their neighbours (roots stay): shape them as their own lock",
+                )
+                .clicked()
+            {
+                state.edit_mesh("Split bundles", edit::split_bundles);
+            }
+            if ui
+                .button("Merge")
+                .on_hover_text(
+                    "Merge the selected bundles back with the bundles they were split from (shared vertices meet half-way)",
+                )
+                .clicked()
+            {
+                state.edit_mesh("Merge bundles", edit::merge_bundles);
             }
         });
         ui.horizontal(|ui| {
