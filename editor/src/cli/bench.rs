@@ -62,7 +62,9 @@ pub enum Which {
     /// Edit-to-frame latency in the editor's viewport setting: a styling slider tick through
     /// a full rebuild and re-upload (the old path) and through the in-place styling update
     /// (the new one), a vertex drag (mesh edit, rebuild, upload), and a frame alone; each from
-    /// the edit to the frame's pixels read back, median of `runs`.
+    /// the edit to the frame's pixels read back, median of `runs`. Then the slider tick while
+    /// the artist interacts: the viewport's interactive frames (no optional effect, fewer
+    /// pixels) against the full picture, the input-to-frame latency the frame budget buys.
     Edit {
         #[arg(long)]
         project: Option<std::path::PathBuf>,
@@ -667,7 +669,13 @@ fn edit_latency(
         bounds.1 + pad,
         glam::Vec3::new(0.75, 0.25, 1.0),
     );
-    let frame = |gpu: &GpuHair, body: &GpuBody| -> anyhow::Result<()> {
+    // The frame of `lighting` at `width × height` (the viewport's full picture with the
+    // document's scene; an interactive frame without effects and smaller).
+    let frame_of = |gpu: &GpuHair,
+                    body: &GpuBody,
+                    lighting: &hairloom_core::model::scene::Scene,
+                    [width, height]: [u32; 2]|
+     -> anyhow::Result<()> {
         let scene = hairloom_render::preview::default_scene(
             body,
             HairSource::Generated {
@@ -679,12 +687,14 @@ fn edit_latency(
             vertex_count,
             bounds,
             camera,
-            &document.scene,
+            lighting,
         );
         let plan = preview.plan(&scene, width, height);
         preview.render(&context, &scene, &plan, width, height)?;
         Ok(())
     };
+    let full_scene = document.scene.clone();
+    let frame = |gpu: &GpuHair, body: &GpuBody| frame_of(gpu, body, &full_scene, [width, height]);
     // The body is uploaded once per document, as the viewport does.
     let body = GpuBody::upload(&context, &hair.body);
     frame(&gpu, &body)?; // warm-up: pipelines, first allocations
@@ -794,5 +804,50 @@ fn edit_latency(
     );
     row("vertex drag, edit + rebuild + re-upload", drag, true);
     row("frame alone (no edit)", [0.0, frame_only], false);
+
+    // While the artist drags the slider the viewport draws interactive frames (see
+    // `FRAME_BUDGET_MS`): no optional effect, a fraction of the pixels.
+    let interactive_scene = hairloom_core::model::scene::Scene {
+        effects: full_scene.effects.none(),
+        ..full_scene.clone()
+    };
+    println!(
+        "input-to-frame while interacting (styling buffers in place; frame budget {} ms):",
+        hairloom_editor::app::viewport::FRAME_BUDGET_MS
+    );
+    println!(
+        "{:<46} {:>12} {:>8}",
+        "slider tick, frame", "to pixels ms", "ratio"
+    );
+    for (name, scale, lighting) in [
+        (
+            "full picture (every tick, before the budget)",
+            1.0,
+            &full_scene,
+        ),
+        (
+            "interactive, no effects, 100% size",
+            1.0,
+            &interactive_scene,
+        ),
+        ("interactive, no effects, 50% size", 0.5, &interactive_scene),
+        (
+            "interactive, no effects, 25% size",
+            0.25,
+            &interactive_scene,
+        ),
+    ] {
+        let size = [width, height].map(|side| ((side as f32 * scale).round() as u32).max(1));
+        let ms = timed(Box::new(|run| {
+            document.styling.global.curl.radius_m = curl(run);
+            hair.set_styling(&document.styling);
+            generator.update_styling(&context, &mut gpu, &hair);
+            frame_of(&gpu, &body, lighting, size)
+        }))?;
+        println!(
+            "{name:<46} {ms:>12.2} {:>8}",
+            format!("{:.3}×", ms / in_place[1])
+        );
+    }
     Ok(())
 }
