@@ -703,9 +703,14 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
     let mut harness = harness();
     let original = harness.state().state.document().clone();
     click_bundle_in_outliner(&mut harness, 0);
+    // The Wisps tools sit below the fold of the Tools pane at this window size.
+    harness.get_by_label("Copy shape").scroll_to_me();
+    harness.run();
     harness.get_by_label("Copy shape").click();
     harness.run();
     click_bundle_in_outliner(&mut harness, 5);
+    harness.get_by_label("Paste shape").scroll_to_me();
+    harness.run();
     harness.get_by_label("Paste shape").click();
     harness.run();
     let pasted = harness.state().state.document().clone();
@@ -719,6 +724,8 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
         harness.state().state.project.history.undo[0].label(),
         "Paste shape"
     );
+    harness.get_by_label("Mirror shape").scroll_to_me();
+    harness.run();
     harness.get_by_label("Mirror shape").click();
     harness.run();
     let selection = harness.state().state.selection.clone();

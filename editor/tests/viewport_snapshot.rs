@@ -53,6 +53,12 @@ fn wgpu_harness() -> Option<Harness<'static, HairloomApp>> {
 /// The rendered window cropped to the viewport.
 fn viewport_image(harness: &mut Harness<'static, HairloomApp>) -> image::RgbaImage {
     harness.run();
+    rendered_viewport(harness)
+}
+
+/// The window rendered now (no UI frame run first; the paint callback does the viewport's
+/// pending work), cropped to the viewport.
+fn rendered_viewport(harness: &mut Harness<'static, HairloomApp>) -> image::RgbaImage {
     let rect = harness
         .state()
         .viewport
@@ -335,18 +341,27 @@ fn motion_is_simulated_and_uploaded_only_when_the_scene_has_it() {
     harness.step();
     assert_eq!(harness.state().state.playback.steps, 0);
 
+    let still = rendered_viewport(&mut harness);
     harness.get_by_label("Play").click();
     let before = harness.state().viewport.uploads;
     for _ in 0..6 {
         harness.step();
     }
+    // The paint callback rewrites the moved hair into the GPU textures: the picture moves.
+    let moving = rendered_viewport(&mut harness);
+    let change = common::mean_error(&still, &moving);
+    eprintln!("motion moved the viewport picture by {change:.3} (mean channel difference)");
+    assert!(change > 0.5, "the hair moved by only {change:.3} on screen");
     let playback = &harness.state().state.playback;
     assert!(playback.steps > 0, "Play simulated nothing");
     assert!(playback.is_posed());
     assert!(playback.time_s() > 0.0);
-    // The drawn hair follows the simulation: uploads happened, and the shown mesh moved
-    // while the document (what is saved and undone) did not.
-    assert!(harness.state().viewport.uploads.full > before.full);
+    // The drawn hair follows the simulation: its textures were rewritten in place (same
+    // layout, nothing allocated or re-uploaded whole), and the shown mesh moved while the
+    // document (what is saved and undone) did not.
+    let after = harness.state().viewport.uploads;
+    assert!(after.shape > before.shape, "{before:?} -> {after:?}");
+    assert_eq!(after.full, before.full, "motion re-uploaded the whole hair");
     let state = &harness.state().state;
     assert_eq!(state.document(), &modelled);
     assert_ne!(state.shown_document().hair_mesh, modelled.hair_mesh);

@@ -308,6 +308,69 @@ fn restyling_in_place_generates_what_a_fresh_upload_does() {
     assert_ne!(restyled, unstyled, "the new styling must show");
 }
 
+/// A hair mesh that moved (as motion and drape move it every frame) is written into the
+/// uploaded textures in place and generates what a fresh upload does, in f16 too (whose
+/// position offset follows the box); a changed layout is refused, nothing written.
+#[test]
+fn reshaping_in_place_generates_what_a_fresh_upload_does() {
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let renderer = StrandGenRenderer::new(&context);
+    for precision in [Precision::F32, Precision::F16] {
+        let mut document = common::sample("head_curly");
+        let options = RuntimeOptions {
+            strands_per_bundle: 8,
+            precision,
+            ..RuntimeOptions::default()
+        };
+        let mut gpu = renderer
+            .upload(&context, &RuntimeHair::from_document(&document, &options))
+            .expect("upload");
+        let plan = full_detail_plan(gpu.root_count, 9);
+        let before = renderer
+            .generate_positions(&context, &gpu, &plan, Filtering::Exact)
+            .expect("before");
+        // Everything above the roots sways and sags (roots stay on the scalp).
+        for (c, column) in document.hair_mesh.columns.iter_mut().enumerate() {
+            for (k, p) in column.positions.iter_mut().enumerate().skip(1) {
+                p.x += 0.004 * k as f64 * (c as f64 * 0.37).sin();
+                p.y -= 0.003 * (k * k) as f64;
+            }
+        }
+        document.hair_mesh.update_w();
+        let moved = RuntimeHair::from_document(&document, &options);
+        assert!(renderer.update_shape(&context, &mut gpu, &moved));
+        let fresh = renderer.upload(&context, &moved).expect("upload");
+        let reshaped = renderer
+            .generate_positions(&context, &gpu, &plan, Filtering::Exact)
+            .expect("reshaped");
+        let uploaded = renderer
+            .generate_positions(&context, &fresh, &plan, Filtering::Exact)
+            .expect("fresh");
+        assert_eq!(reshaped, uploaded, "{precision:?}");
+        assert_ne!(reshaped, before, "{precision:?}: the motion must show");
+        assert_eq!(gpu.bundles, fresh.bundles, "LOD bounds follow the mesh");
+
+        // One more layer on a bundle changes the layout: refused, the GPU hair untouched.
+        let extruded = hairloom_core::edit::extrude(
+            &document.hair_mesh,
+            &[0],
+            hairloom_core::edit::ExtrudeDirection::Vector {
+                offset: [0.0, -0.02, 0.0],
+            },
+        )
+        .expect("extrude");
+        document.hair_mesh = extruded.mesh;
+        let taller = RuntimeHair::from_document(&document, &options);
+        assert!(!renderer.update_shape(&context, &mut gpu, &taller));
+        let unchanged = renderer
+            .generate_positions(&context, &gpu, &plan, Filtering::Exact)
+            .expect("unchanged");
+        assert_eq!(unchanged, uploaded);
+    }
+}
+
 /// Above the adapter's limits the upload is refused by name before wgpu sees a descriptor
 /// (wgpu would panic). Pure: runs without an adapter.
 #[test]

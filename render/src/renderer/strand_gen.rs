@@ -293,8 +293,9 @@ pub struct GenerationTiming {
 /// is stored per strand.
 pub struct GpuHair {
     pub position_offset: [f32; 3],
-    /// The five textures, kept so the registry lists them while the hair lives.
-    _textures: Vec<Tracked<wgpu::Texture>>,
+    /// The five textures (hair_mesh, uv, w, u, v): kept so the registry lists them while
+    /// the hair lives, and rewritten in place by [`StrandGenRenderer::update_shape`].
+    textures: Vec<Tracked<wgpu::Texture>>,
     hair_mesh: wgpu::TextureView,
     uv: wgpu::TextureView,
     w: wgpu::TextureView,
@@ -312,6 +313,7 @@ pub struct GpuHair {
     pub per_bundle: u32,
     /// Bytes of the textures, roots and styling on the GPU.
     pub bytes: u64,
+    layout: TextureLayout,
 }
 
 fn upload_texture(
@@ -349,24 +351,70 @@ fn upload_texture(
             view_formats: &[],
         },
     );
-    let texel_size = (channels * export_format.bytes_per_channel()) as u32;
+    write_texels(
+        context,
+        &gpu_texture,
+        texture,
+        &bytes,
+        channels,
+        export_format,
+    );
+    let view = gpu_texture.create_view(&wgpu::TextureViewDescriptor::default());
+    (gpu_texture, view, bytes.len() as u64)
+}
+
+/// Writes `bytes` (the texels of `texture` in `format`) into all of `gpu_texture`.
+fn write_texels(
+    context: &GpuContext,
+    gpu_texture: &wgpu::Texture,
+    texture: &Texture3d,
+    bytes: &[u8],
+    channels: usize,
+    format: TexelFormat,
+) {
+    let texel_size = (channels * format.bytes_per_channel()) as u32;
     context.queue.write_texture(
         wgpu::TexelCopyTextureInfo {
-            texture: &gpu_texture,
+            texture: gpu_texture,
             mip_level: 0,
             origin: wgpu::Origin3d::ZERO,
             aspect: wgpu::TextureAspect::All,
         },
-        &bytes,
+        bytes,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
             bytes_per_row: Some(texture.width * texel_size),
             rows_per_image: Some(texture.height),
         },
-        size,
+        wgpu::Extent3d {
+            width: texture.width,
+            height: texture.height,
+            depth_or_array_layers: texture.depth,
+        },
     );
-    let view = gpu_texture.create_view(&wgpu::TextureViewDescriptor::default());
-    (gpu_texture, view, bytes.len() as u64)
+}
+
+/// What the GPU textures and placements of a [`GpuHair`] were laid out for: a reshaped hair
+/// mesh with the same layout can be written into them in place.
+#[derive(Clone, Debug, PartialEq)]
+struct TextureLayout {
+    precision: Precision,
+    /// `[width, height, depth]` of hair_mesh, uv, w, u, v.
+    sizes: [[u32; 3]; 5],
+    blocks: Vec<hairloom_core::runtime::atlas::BundleBlock>,
+    per_bundle: u32,
+}
+
+impl TextureLayout {
+    fn of(hair: &RuntimeHair, per_bundle: u32) -> Self {
+        let t = &hair.textures;
+        Self {
+            precision: t.precision,
+            sizes: [&t.hair_mesh, &t.uv, &t.w, &t.u, &t.v].map(|x| [x.width, x.height, x.depth]),
+            blocks: t.atlas.blocks.clone(),
+            per_bundle,
+        }
+    }
 }
 
 /// One placement per atlas block with its styling index (never empty: a storage buffer
@@ -533,7 +581,7 @@ impl StrandGenRenderer {
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         Ok(GpuHair {
             position_offset: textures.position_offset.to_array(),
-            _textures: vec![t0, t1, t2, t3, t4],
+            textures: vec![t0, t1, t2, t3, t4],
             hair_mesh,
             uv,
             w,
@@ -546,6 +594,7 @@ impl StrandGenRenderer {
             styling: buffer("strand_gen_styling", styling_bytes),
             bundles: hair.bundle_bounds(),
             per_bundle: per_bundle as u32,
+            layout: TextureLayout::of(hair, per_bundle as u32),
             bytes: a
                 + b
                 + c
@@ -553,6 +602,38 @@ impl StrandGenRenderer {
                 + e
                 + (bundle_bytes.len() + sample_bytes.len() + styling_bytes.len()) as u64,
         })
+    }
+
+    /// Takes a reshaped `hair` (the hair mesh moved — motion, drape, a vertex drag — with the
+    /// same atlas, texture sizes, precision and strand count) into `gpu` by rewriting its five
+    /// textures, placements and bounds in place: no allocation, no sample upload. Returns
+    /// `false`, writing nothing, when the layout differs (then upload afresh).
+    pub fn update_shape(
+        &self,
+        context: &GpuContext,
+        gpu: &mut GpuHair,
+        hair: &RuntimeHair,
+    ) -> bool {
+        if TextureLayout::of(hair, gpu.per_bundle) != gpu.layout {
+            return false;
+        }
+        let textures = &hair.textures;
+        let precision = textures.precision;
+        for (gpu_texture, (texture, channels)) in gpu.textures.iter().zip([
+            (&textures.hair_mesh, 4),
+            (&textures.uv, 2),
+            (&textures.w, 1),
+            (&textures.u, 4),
+            (&textures.v, 4),
+        ]) {
+            let format = TexelFormat::for_precision(precision, channels);
+            let bytes = hairloom_core::io::ktx2::texel_bytes(&texture.texels, format);
+            write_texels(context, gpu_texture, texture, &bytes, channels, format);
+        }
+        gpu.position_offset = textures.position_offset.to_array();
+        gpu.bundles = hair.bundle_bounds();
+        self.update_styling(context, gpu, hair);
+        true
     }
 
     /// Takes `hair`'s styling (parameters and group assignments) into `gpu` without touching

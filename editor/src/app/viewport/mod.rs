@@ -88,6 +88,8 @@ pub struct UploadCounts {
     pub full: u64,
     /// Only the styling buffers rewritten (a styling-only edit).
     pub styling: u64,
+    /// The textures rewritten in place (the hair mesh moved: motion, drape, a drag).
+    pub shape: u64,
 }
 
 /// Key of what was last drawn, to draw again only when something changed.

@@ -47,28 +47,53 @@ impl ViewportGpu {
         }
     }
 
+    /// Takes a new asset: rewritten into the GPU textures in place when only the hair mesh
+    /// moved, uploaded afresh otherwise.
+    fn replace_hair(&mut self, replacement: Replacement, shared: &CallbackShared) {
+        let Replacement {
+            hair,
+            bounds,
+            reshape,
+        } = replacement;
+        if reshape
+            && let Some(uploaded) = self.hair.as_mut()
+            && self
+                .generator
+                .update_shape(&self.context, &mut uploaded.gpu, &hair)
+        {
+            // A head animation moves the body with the hair.
+            if uploaded.hair.body != hair.body {
+                uploaded.body = GpuBody::upload(&self.context, &hair.body);
+            }
+            uploaded.hair = *hair;
+            uploaded.bounds = bounds;
+            return;
+        }
+        let upload = self.generator.upload(&self.context, &hair);
+        let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
+        match upload {
+            Ok(gpu) => {
+                report.upload_error = None;
+                self.hair = Some(GpuSideHair {
+                    gpu,
+                    body: GpuBody::upload(&self.context, &hair.body),
+                    hair: *hair,
+                    bounds,
+                });
+            }
+            Err(error) => {
+                // Above the adapter's limits nothing is uploaded and the viewport says
+                // which limit; the document is untouched (undo the edit, or save it).
+                report.upload_error = Some(format!("cannot draw this hair: {error}"));
+                self.hair = None;
+            }
+        }
+    }
+
     /// Does what the panel asked for, in order: a new asset or a restyle, then a frame.
     fn apply(&mut self, work: PendingWork, shared: &CallbackShared, ctx: &egui::Context) {
-        if let Some((hair, bounds)) = work.full {
-            let upload = self.generator.upload(&self.context, &hair);
-            let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
-            match upload {
-                Ok(gpu) => {
-                    report.upload_error = None;
-                    self.hair = Some(GpuSideHair {
-                        gpu,
-                        body: GpuBody::upload(&self.context, &hair.body),
-                        hair: *hair,
-                        bounds,
-                    });
-                }
-                Err(error) => {
-                    // Above the adapter's limits nothing is uploaded and the viewport says
-                    // which limit; the document is untouched (undo the edit, or save it).
-                    report.upload_error = Some(format!("cannot draw this hair: {error}"));
-                    self.hair = None;
-                }
-            }
+        if let Some(replacement) = work.full {
+            self.replace_hair(replacement, shared);
         }
         if let (Some(styling), Some(uploaded)) = (work.restyle, self.hair.as_mut()) {
             uploaded.hair.set_styling(&styling);
@@ -137,22 +162,38 @@ impl ViewportGpu {
 #[derive(Default)]
 pub(super) struct PendingWork {
     /// A new asset and its hair's box.
-    full: Option<(Box<RuntimeHair>, (Vec3, Vec3))>,
+    full: Option<Replacement>,
     /// New styling for the asset on the GPU.
     restyle: Option<StylingSet>,
     frame: Option<FrameRequest>,
 }
 
+/// A new asset for the GPU.
+struct Replacement {
+    hair: Box<RuntimeHair>,
+    /// The hair's box.
+    bounds: (Vec3, Vec3),
+    /// Only the hair mesh's positions changed since the asset on the GPU: its textures can
+    /// be rewritten in place.
+    reshape: bool,
+}
+
 impl PendingWork {
-    fn upload(&mut self, hair: RuntimeHair, bounds: (Vec3, Vec3)) {
-        self.full = Some((Box::new(hair), bounds));
+    fn upload(&mut self, hair: RuntimeHair, bounds: (Vec3, Vec3), reshape: bool) {
+        // A reshape of an asset that has not reached the GPU yet is still a new asset.
+        let reshape = reshape && self.full.as_ref().is_none_or(|pending| pending.reshape);
+        self.full = Some(Replacement {
+            hair: Box::new(hair),
+            bounds,
+            reshape,
+        });
         self.restyle = None;
     }
 
     fn restyle(&mut self, styling: &StylingSet) {
         match self.full.as_mut() {
             // Not uploaded yet: upload it restyled.
-            Some((hair, _)) => hair.set_styling(styling),
+            Some(pending) => pending.hair.set_styling(styling),
             None => self.restyle = Some(styling.clone()),
         }
     }
@@ -365,6 +406,23 @@ impl Viewport {
             if restyle {
                 self.uploads.styling += 1;
             } else {
+                // Same bundles, columns of the same lengths and settings: only positions
+                // moved (the body too, with a head animation), and the GPU textures are
+                // rewritten in place.
+                let reshape = match (&self.hair_shown, self.uploaded) {
+                    (Some(shown), Some((_, uploaded_settings))) => {
+                        uploaded_settings == settings
+                            && shown.mesh.bundles == document.hair_mesh.bundles
+                            && shown.mesh.columns.len() == document.hair_mesh.columns.len()
+                            && shown
+                                .mesh
+                                .columns
+                                .iter()
+                                .zip(&document.hair_mesh.columns)
+                                .all(|(a, b)| a.positions.len() == b.positions.len())
+                    }
+                    _ => false,
+                };
                 let hair = RuntimeHair::from_document(
                     document,
                     &RuntimeOptions {
@@ -379,9 +437,13 @@ impl Viewport {
                     bounds,
                 });
                 if let Some(shown) = &self.hair_shown {
-                    pending.upload(hair, shown.bounds);
+                    pending.upload(hair, shown.bounds, reshape);
                 }
-                self.uploads.full += 1;
+                if reshape {
+                    self.uploads.shape += 1;
+                } else {
+                    self.uploads.full += 1;
+                }
             }
             self.uploaded = Some(key);
             self.drawn = None;
