@@ -351,6 +351,15 @@ fn reshaping_in_place_generates_what_a_fresh_upload_does() {
         assert_eq!(reshaped, uploaded, "{precision:?}");
         assert_ne!(reshaped, before, "{precision:?}: the motion must show");
         assert_eq!(gpu.bundles, fresh.bundles, "LOD bounds follow the mesh");
+        // Another strand count needs other samples: refused.
+        let denser = RuntimeHair::from_document(
+            &document,
+            &RuntimeOptions {
+                strands_per_bundle: 16,
+                ..options.clone()
+            },
+        );
+        assert!(!renderer.update_shape(&context, &mut gpu, &denser));
 
         // One more layer on a bundle changes the layout: refused, the GPU hair untouched.
         let extruded = hairloom_core::edit::extrude(

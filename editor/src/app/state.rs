@@ -385,6 +385,10 @@ impl EditorState {
         let selected: Vec<u32> = self.selection.iter().copied().collect();
         match edit(&self.project.document.hair_mesh, &selected) {
             Ok(outcome) => {
+                // A merge renumbers columns: selected vertices would name other vertices.
+                if outcome.mesh.columns.len() < self.project.document.hair_mesh.columns.len() {
+                    self.vertex_selection.clear();
+                }
                 self.edit(label).hair_mesh = outcome.mesh;
                 self.commit_edit();
                 self.message = format!(

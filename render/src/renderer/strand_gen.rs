@@ -605,7 +605,7 @@ impl StrandGenRenderer {
     }
 
     /// Takes a reshaped `hair` (the hair mesh moved — motion, drape, a vertex drag — with the
-    /// same atlas, texture sizes, precision and strand count) into `gpu` by rewriting its five
+    /// same atlas, texture sizes, precision and strands per bundle) into `gpu` by rewriting its five
     /// textures, placements and bounds in place: no allocation, no sample upload. Returns
     /// `false`, writing nothing, when the layout differs (then upload afresh).
     pub fn update_shape(
@@ -614,7 +614,10 @@ impl StrandGenRenderer {
         gpu: &mut GpuHair,
         hair: &RuntimeHair,
     ) -> bool {
-        if TextureLayout::of(hair, gpu.per_bundle) != gpu.layout {
+        let per_bundle = (hair.strands_per_bundle as usize)
+            .min(hair.samples.quad.len())
+            .min(hair.samples.triangle.len()) as u32;
+        if TextureLayout::of(hair, per_bundle) != gpu.layout {
             return false;
         }
         let textures = &hair.textures;

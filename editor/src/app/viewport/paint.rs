@@ -486,9 +486,10 @@ impl Viewport {
             }
             self.drawn = Some(drawn);
         }
+        // No hair first: an older upload or frame error is about hair no longer shown.
         self.error = match (&self.hair_shown, &report.upload_error, &report.error) {
-            (_, Some(error), _) | (_, None, Some(error)) => Some(error.clone()),
-            (None, None, None) => Some("no bundle grows hair".into()),
+            (None, _, _) => Some("no bundle grows hair".into()),
+            (Some(_), Some(error), _) | (Some(_), None, Some(error)) => Some(error.clone()),
             (Some(_), None, None) => None,
         };
         ui.painter().add(egui_wgpu::Callback::new_paint_callback(
