@@ -724,6 +724,15 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
         harness.state().state.project.history.undo[0].label(),
         "Paste shape"
     );
+    // Bundle 5 gets its own curl (a styling group), which Mirror carries over.
+    {
+        let state = &mut harness.state_mut().state;
+        let styling = &mut state.edit("New group").styling;
+        let group = styling.new_group("wisp", &[5]);
+        styling.groups[group].params.curl.radius_m = 0.004;
+        styling.groups[group].params.curl.turns_per_m = 30.0;
+        state.commit_edit();
+    }
     harness.get_by_label("Mirror shape").scroll_to_me();
     harness.run();
     harness.get_by_label("Mirror shape").click();
@@ -734,7 +743,25 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
         !selection.contains(&5),
         "the mirror image is another bundle"
     );
-    assert_eq!(harness.state().state.project.history.undo.len(), 2);
+    let mirrored = *selection.iter().next().expect("one");
+    let document = harness.state().state.document();
+    assert_eq!(
+        document.hair_mesh.bundles[mirrored as usize].layers, document.hair_mesh.bundles[5].layers,
+        "the whole shape, layer count included"
+    );
+    let group = document
+        .styling
+        .group_of(mirrored)
+        .expect("the mirror image is styled like its source");
+    assert!(
+        document.styling.groups[group].name.starts_with("wisp"),
+        "{:?}",
+        document.styling.groups[group].name
+    );
+    // Curl turns the same amount, in the mirrored sense where the uv frames say so.
+    let curl = &document.styling.groups[group].params.curl;
+    assert_eq!((curl.radius_m, curl.turns_per_m.abs()), (0.004, 30.0));
+    assert_eq!(harness.state().state.project.history.undo.len(), 3);
     assert!(
         harness
             .state()
@@ -744,7 +771,7 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
             .validate()
             .is_ok()
     );
-    undo(&mut harness, 2);
+    undo(&mut harness, 3);
     assert_eq!(harness.state().state.document(), &original);
 }
 

@@ -152,7 +152,7 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
         assert!(
             matches!(
                 harness.state().viewport.shown_quality,
-                FrameQuality::Interactive { scale } if scale < 1.0
+                FrameQuality::Interactive { scale, detail } if scale < 1.0 && detail <= 1.0
             ),
             "{:?}",
             harness.state().viewport.shown_quality

@@ -33,7 +33,7 @@ pub use topology::{
     subdivide,
 };
 pub use transform::{VertexTransform, falloff_weight, transform_vertices};
-pub use wisps::{bundle_layer_centre, growth_direction, mirror_shape, paste_shape};
+pub use wisps::{bundle_layer_centre, growth_direction, mirror_shape, mirror_styling, paste_shape};
 
 /// Why an edit was refused. The mesh is unchanged.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -123,6 +123,18 @@ pub fn set_locked(
         .map(|(i, _)| i as u32)
         .collect();
     finish(out, affected, Some(&layers))
+}
+
+/// Trims each column to what its tallest bundle needs (a split or a shorter
+/// pasted shape can leave a column with only shorter bundles).
+pub(crate) fn fit_column_lengths(mesh: &mut HairMesh) {
+    let topology = crate::Topology::build(mesh);
+    for c in 0..mesh.columns.len() {
+        let required = mesh.required_column_len(&topology, c);
+        let column = &mut mesh.columns[c];
+        column.positions.truncate(required.max(1));
+        column.w.truncate(required.max(1));
+    }
 }
 
 pub(crate) fn finish(
@@ -255,7 +267,7 @@ mod tests {
     }
 
     #[test]
-    fn pasting_a_shape_copies_the_centre_path_and_keeps_the_width() {
+    fn pasting_a_shape_copies_the_centre_path_and_keeps_the_width_of_a_moved_top() {
         // Bundle 0 of a 4×1 strip bends along +x; paste it onto bundle 3.
         let mesh = grid(4, 1, 2, 0.5);
         let bent = transform_vertices(
@@ -306,6 +318,72 @@ mod tests {
     }
 
     #[test]
+    fn pasting_copies_every_corner_and_the_layer_count() {
+        // Bundle 0 of a 4×1 strip (columns 0, 1, 6, 5) grows a third layer, then its top
+        // tapers: each top corner moves a quarter of the way to the top's centre.
+        let mesh = grid(4, 1, 2, 0.5);
+        let grown = extrude(&mesh, &[0], ExtrudeDirection::AlongNormal { distance: 0.5 })
+            .expect("extrude")
+            .mesh;
+        let mut tapered = grown.clone();
+        let centre = bundle_layer_centre(&grown, &grown.bundles[0], 3).expect("centre");
+        for c in [0usize, 1, 5, 6] {
+            let p = &mut tapered.columns[c].positions[3];
+            *p += (centre - *p) * 0.25;
+        }
+        let tapered = finish(tapered, [0].into(), None).expect("valid").mesh;
+        let out = paste_shape(&tapered, 0, &[3, 0]).expect("paste");
+        out.mesh.validate().expect("valid after paste");
+        let bundle = &out.mesh.bundles[3];
+        assert_eq!(bundle.layers, 3, "the source's layer count");
+        // Every corner moved from its own root exactly as the source's matching corner did
+        // (both frames are the same here: the strip is flat and the bundles alike).
+        for (&s, &t) in tapered.bundles[0].vertices.iter().zip(&bundle.vertices) {
+            let source = &tapered.columns[s as usize].positions;
+            let target = &out.mesh.columns[t as usize].positions;
+            for k in 1..=3 {
+                let (a, b) = (source[k] - source[0], target[k] - target[0]);
+                assert!(a.distance(b) < 1e-9, "column {t} layer {k}: {a} vs {b}");
+            }
+        }
+        // The taper came along: the top is three quarters as wide as the root.
+        let top = |k: usize| out.mesh.columns[bundle.vertices[k] as usize].positions[3];
+        assert!((top(0).distance(top(1)) - 0.75).abs() < 1e-9);
+        // The source itself is not a target, and its neighbours keep their layer counts.
+        assert_eq!(out.mesh.bundles[0], tapered.bundles[0]);
+        assert_eq!(out.mesh.bundles[2].layers, 2);
+
+        // A shorter shape shrinks the target; only its own columns lose their tops. Bundles
+        // 0 and 1 grow a third layer; bundle 3's two-layer shape goes onto bundle 0.
+        let tall = extrude(
+            &mesh,
+            &[0, 1],
+            ExtrudeDirection::AlongNormal { distance: 0.5 },
+        )
+        .expect("extrude")
+        .mesh;
+        let out = paste_shape(&tall, 3, &[0]).expect("paste short");
+        out.mesh.validate().expect("valid after a shorter paste");
+        assert_eq!(out.mesh.bundles[0].layers, 2);
+        assert_eq!(
+            out.mesh.columns[0].positions.len(),
+            3,
+            "bundle 0's own column"
+        );
+        assert_eq!(
+            out.mesh.columns[1].positions.len(),
+            4,
+            "shared with bundle 1"
+        );
+
+        // Pasting a bundle onto itself alone is nothing to do.
+        assert!(matches!(
+            paste_shape(&tapered, 0, &[0]),
+            Err(EditError::EmptySelection)
+        ));
+    }
+
+    #[test]
     fn mirroring_reflects_a_shape_onto_the_other_side() {
         // A 4×1 strip spans x ∈ [0, 4]: bundle 0 mirrors onto bundle 3 across x = 2.
         let mesh = grid(4, 1, 1, 0.5);
@@ -328,8 +406,8 @@ mod tests {
         )
         .expect("lean")
         .mesh;
-        let (out, targets) = mirror_shape(&leaning, &[0], 2.0).expect("mirror");
-        assert_eq!(targets, vec![3]);
+        let (out, pairs) = mirror_shape(&leaning, &[0], 2.0).expect("mirror");
+        assert_eq!(pairs, vec![(0, 3)]);
         let path = |m: &HairMesh, b: u32| centre_path(m, &m.bundles[b as usize]).expect("path");
         let source = path(&leaning, 0)[0];
         let mirrored = path(&out.mesh, 3)[0];
@@ -338,6 +416,85 @@ mod tests {
             mirror_shape(&leaning, &[0], f64::NAN),
             Err(EditError::NotFinite { .. })
         ));
+    }
+
+    #[test]
+    fn mirroring_copies_every_corner_and_the_layer_count() {
+        // Bundle 0 of a 4×1 strip grows a third layer whose top leans and tapers toward
+        // one corner; its mirror image across x = 2 is bundle 3.
+        let mesh = grid(4, 1, 2, 0.5);
+        let mut shaped = extrude(&mesh, &[0], ExtrudeDirection::AlongNormal { distance: 0.5 })
+            .expect("extrude")
+            .mesh;
+        shaped.columns[0].positions[3] += DVec3::new(0.3, 0.2, 0.0);
+        shaped.columns[1].positions[3] += DVec3::new(-0.1, 0.0, 0.1);
+        let shaped = finish(shaped, [0].into(), None).expect("valid").mesh;
+        let (out, pairs) = mirror_shape(&shaped, &[0], 2.0).expect("mirror");
+        assert_eq!(pairs, vec![(0, 3)]);
+        out.mesh.validate().expect("valid after mirror");
+        assert_eq!(out.mesh.bundles[3].layers, 3);
+        // Each source column's path, reflected, is the path of the column at its root's
+        // mirror image (column c at x = i mirrors to x = 4 - i, same row).
+        for (s, t) in [(0usize, 4usize), (1, 3), (5, 9), (6, 8)] {
+            let (source, target) = (&shaped.columns[s].positions, &out.mesh.columns[t].positions);
+            for k in 1..=3 {
+                let d = source[k] - source[0];
+                let reflected = DVec3::new(-d.x, d.y, d.z);
+                let got = target[k] - target[0];
+                assert!(
+                    got.distance(reflected) < 1e-9,
+                    "column {t} layer {k}: {got} vs {reflected}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn mirroring_turns_curl_twist_and_wave_the_other_way() {
+        use crate::model::styling::StylingSet;
+        let mesh = grid(4, 1, 2, 0.5);
+        let mut styling = StylingSet::default();
+        let left = styling.new_group("left", &[0]);
+        let params = &mut styling.groups[left].params;
+        params.curl.radius_m = 0.004;
+        params.curl.turns_per_m = 30.0;
+        params.twist.turns_per_m = 5.0;
+        params.wave.amplitude_m = 0.01;
+        params.wave.direction_rad = 0.3;
+        let source = styling.groups[left].params.clone();
+        // The strip's u runs along +x on both sides: the reflection reverses handedness.
+        let mirrored = mirror_styling(&styling, &mesh, &[(0, 3)]);
+        mirrored.validate().expect("valid styling");
+        let group = mirrored.group_of(3).expect("a group for the mirror image");
+        assert_eq!(mirrored.groups[group].name, "left (mirrored)");
+        let got = mirrored.params_for(3);
+        assert_eq!(got.curl.turns_per_m, -30.0);
+        assert_eq!(got.twist.turns_per_m, -5.0);
+        assert!((got.wave.direction_rad - (std::f64::consts::PI - 0.3)).abs() < 1e-9);
+        assert_eq!(got.curl.radius_m, source.curl.radius_m);
+        assert_eq!(mirrored.params_for(0), &source, "the source keeps its own");
+        // Mirroring again reuses the mirrored group.
+        let again = mirror_styling(&mirrored, &mesh, &[(0, 3)]);
+        assert_eq!(again.groups.len(), mirrored.groups.len());
+        assert_eq!(again.params_for(3), got);
+
+        // A uv layout mirrored on the right side (u runs along -x there): the reflected
+        // frame matches the target's, and the parameters copy as they are.
+        let mut flipped = mesh.clone();
+        for bundle in &mut flipped.bundles[2..] {
+            for uv in &mut bundle.uvs {
+                uv.x = 1.0 - uv.x;
+            }
+        }
+        let same = mirror_styling(&styling, &flipped, &[(0, 3)]);
+        assert_eq!(same.params_for(3), &source);
+        let copied = same.group_of(3).expect("grouped");
+        assert_eq!(copied, left, "nothing turned: the source's own group");
+        // A source on the global parameters sends its target back to them.
+        let mut grouped_target = StylingSet::default();
+        grouped_target.new_group("right", &[3]);
+        let plain = mirror_styling(&grouped_target, &mesh, &[(1, 3)]);
+        assert_eq!(plain.group_of(3), None);
     }
 
     #[test]

@@ -5,7 +5,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use crate::edit::{EditError, EditOutcome, check_bundles, finish};
+use crate::edit::{EditError, EditOutcome, check_bundles, finish, fit_column_lengths};
 use crate::model::mesh::{Column, HairMesh, Topology, VertexRef};
 
 /// Splits `bundles` off the bundles around them: every column the group shares with a
@@ -136,18 +136,6 @@ pub fn merge_bundles(mesh: &HairMesh, bundles: &[u32]) -> Result<EditOutcome, Ed
     remove_unused_columns(&mut out);
     affected.extend(group);
     finish(out, affected, None)
-}
-
-/// Trims each column to what its tallest bundle needs (a split can leave a column with
-/// only shorter bundles).
-fn fit_column_lengths(mesh: &mut HairMesh) {
-    let topology = Topology::build(mesh);
-    for c in 0..mesh.columns.len() {
-        let required = mesh.required_column_len(&topology, c);
-        let column = &mut mesh.columns[c];
-        column.positions.truncate(required.max(1));
-        column.w.truncate(required.max(1));
-    }
 }
 
 /// Drops the columns no bundle uses and renumbers the rest (bundles and locks follow).

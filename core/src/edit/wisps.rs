@@ -1,12 +1,14 @@
 //! Wisps on bundles: a bundle's shape (its centre's path above the root) copied onto
 //! others or mirrored across the body's centre, each target keeping its width.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 
 use glam::DVec3;
 
 use crate::edit::{EditError, EditOutcome, check_bundles, finish};
+use crate::geometry::frames::layer_frames;
 use crate::model::mesh::{Bundle, HairMesh};
+use crate::model::styling::{StylingGroup, StylingSet};
 
 /// The centre of a bundle's corners at `layer`.
 pub fn bundle_layer_centre(mesh: &HairMesh, bundle: &Bundle, layer: usize) -> Option<DVec3> {
@@ -57,39 +59,139 @@ pub(crate) fn centre_path(mesh: &HairMesh, bundle: &Bundle) -> Option<Vec<DVec3>
         .collect()
 }
 
-/// Moves the target bundles' centre paths to `path_of(target)` (layer k's centre offset
-/// from the root centre), keeping each target's own cross-section around its centre. A
-/// column shared by several targets takes the mean of what they ask for.
-fn set_centre_paths(
+/// How each corner of a bundle moves away from its own root, layer by layer
+/// (`[corner][k - 1]` is layer k), in the bundle's root frame.
+fn corner_paths_local(
     mesh: &HairMesh,
+    bundle: &Bundle,
+    frame: [DVec3; 3],
+) -> Option<Vec<Vec<DVec3>>> {
+    let [t, b, n] = frame;
+    bundle
+        .vertices
+        .iter()
+        .map(|&c| {
+            let positions = &mesh.columns.get(c as usize)?.positions;
+            let root = *positions.first()?;
+            (1..=bundle.layers as usize)
+                .map(|k| {
+                    let d = *positions.get(k)? - root;
+                    Some(DVec3::new(d.dot(t), d.dot(b), d.dot(n)))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Wisp copy / paste (the key-strand copy of Zhang & Wünsche's framework, on bundles):
+/// gives every target the whole shape of `source` — its layer count, and each corner's path
+/// away from its root (so the source's spread, taper and twist come along), turned from the
+/// source's root frame into each target's and started from each target's own roots. When a
+/// target has another corner count (a triangle onto a quad), its corners follow the source
+/// centre's path instead. A column shared by several targets takes the mean of what they
+/// ask for; columns grow or shrink with the layer counts.
+pub fn paste_shape(
+    mesh: &HairMesh,
+    source: u32,
     targets: &[u32],
-    path_of: impl Fn(u32, &Bundle) -> Option<Vec<DVec3>>,
 ) -> Result<EditOutcome, EditError> {
+    check_bundles(mesh, &[source])?;
+    check_bundles(mesh, targets)?;
+    let source_bundle = &mesh.bundles[source as usize];
+    let Some(source_frame) = root_frame(mesh, source_bundle) else {
+        return Err(EditError::NotFinite {
+            what: "source root frame (degenerate root face)",
+            value: format!("bundle {source}"),
+        });
+    };
+    let [t0, b0, n0] = source_frame;
+    let to_local = |d: &DVec3| DVec3::new(d.dot(t0), d.dot(b0), d.dot(n0));
+    let out_of_range = EditError::BundleOutOfRange {
+        index: source,
+        count: mesh.bundles.len(),
+    };
+    let centre_local: Vec<DVec3> = centre_path(mesh, source_bundle)
+        .ok_or(out_of_range.clone())?
+        .iter()
+        .map(to_local)
+        .collect();
+    let corners_local =
+        corner_paths_local(mesh, source_bundle, source_frame).ok_or(out_of_range)?;
+    let layers = source_bundle.layers as usize;
+    let mut targets: Vec<u32> = targets.iter().copied().filter(|&t| t != source).collect();
+    targets.sort_unstable();
+    targets.dedup();
+    if targets.is_empty() {
+        return Err(EditError::EmptySelection);
+    }
+    // Each target's corner paths in object space (`None`: a degenerate root face, left alone).
+    let wanted: Vec<(u32, Vec<Vec<DVec3>>)> = targets
+        .iter()
+        .filter_map(|&t| {
+            let bundle = &mesh.bundles[t as usize];
+            let [t1, b1, n1] = root_frame(mesh, bundle)?;
+            let to_object = |l: &DVec3| t1 * l.x + b1 * l.y + n1 * l.z;
+            let same_corners = bundle.vertices.len() == source_bundle.vertices.len();
+            let paths = (0..bundle.vertices.len())
+                .map(|i| {
+                    let local = if same_corners {
+                        &corners_local[i]
+                    } else {
+                        &centre_local
+                    };
+                    local.iter().map(to_object).collect()
+                })
+                .collect();
+            Some((t, paths))
+        })
+        .collect();
+    let wanted: Vec<(u32, usize, Vec<Vec<DVec3>>)> = wanted
+        .into_iter()
+        .map(|(t, paths)| (t, layers, paths))
+        .collect();
+    set_shapes(mesh, &wanted)
+}
+
+/// Gives each `(target, layers, paths)` of `wanted` `layers` layers and puts its corner `i`
+/// at layer `k` at its own root plus `paths[i][k - 1]` (object space). A column shared by
+/// several targets takes the mean of what they ask for; columns grow or shrink with the
+/// layer counts.
+fn set_shapes(
+    mesh: &HairMesh,
+    wanted: &[(u32, usize, Vec<Vec<DVec3>>)],
+) -> Result<EditOutcome, EditError> {
+    let mut out = mesh.clone();
+    for (t, layers, _) in wanted {
+        out.bundles[*t as usize].layers = *layers as u32;
+    }
+    // Columns long enough for the new layer counts (trimmed back below where they shrank).
+    let topology = crate::Topology::build(&out);
+    let old_lengths: Vec<usize> = out.columns.iter().map(|c| c.positions.len()).collect();
+    for (t, _, _) in wanted {
+        for &c in &out.bundles[*t as usize].vertices.clone() {
+            let required = out.required_column_len(&topology, c as usize);
+            let column = &mut out.columns[c as usize];
+            while column.positions.len() < required {
+                let (last, last_w) = (
+                    *column.positions.last().unwrap_or(&DVec3::ZERO),
+                    *column.w.last().unwrap_or(&0.0),
+                );
+                column.positions.push(last);
+                column.w.push(last_w);
+            }
+        }
+    }
     let mut sums: HashMap<(u32, usize), (DVec3, f64)> = HashMap::new();
-    for &t in targets {
-        let bundle = &mesh.bundles[t as usize];
-        let Some(path) = path_of(t, bundle) else {
-            continue;
-        };
-        let Some(root) = bundle_layer_centre(mesh, bundle, 0) else {
-            continue;
-        };
-        let layers = (bundle.layers as usize).min(path.len());
-        for (k, offset) in path.iter().enumerate().take(layers) {
-            let layer = k + 1;
-            let Some(centre) = bundle_layer_centre(mesh, bundle, layer) else {
-                continue;
-            };
-            for &c in &bundle.vertices {
-                let p = mesh.columns[c as usize].positions[layer];
-                let entry = sums.entry((c, layer)).or_insert((DVec3::ZERO, 0.0));
-                entry.0 += root + *offset + (p - centre);
+    for (t, _, paths) in wanted {
+        for (&c, path) in mesh.bundles[*t as usize].vertices.iter().zip(paths) {
+            let root = mesh.columns[c as usize].positions[0];
+            for (k, offset) in path.iter().enumerate() {
+                let entry = sums.entry((c, k + 1)).or_insert((DVec3::ZERO, 0.0));
+                entry.0 += root + *offset;
                 entry.1 += 1.0;
             }
         }
     }
-    let mut out = mesh.clone();
-    let mut layers = BTreeSet::new();
     for ((c, layer), (sum, count)) in sums {
         let p = sum / count;
         if !p.is_finite() {
@@ -99,42 +201,16 @@ fn set_centre_paths(
             });
         }
         out.columns[c as usize].positions[layer] = p;
-        layers.insert(layer);
     }
-    let layers: Vec<usize> = layers.into_iter().collect();
-    finish(out, targets.iter().copied().collect(), Some(&layers))
-}
-
-/// Wisp copy / paste (the key-strand copy of Zhang & Wünsche's framework, on bundles):
-/// gives every target the shape of `source` — its centre's path above the root, turned
-/// from the source's root frame into each target's — keeping each target's own width.
-/// Layers beyond the shorter of the two bundles are left alone.
-pub fn paste_shape(
-    mesh: &HairMesh,
-    source: u32,
-    targets: &[u32],
-) -> Result<EditOutcome, EditError> {
-    check_bundles(mesh, &[source])?;
-    check_bundles(mesh, targets)?;
-    let source_bundle = &mesh.bundles[source as usize];
-    let path = centre_path(mesh, source_bundle).ok_or(EditError::BundleOutOfRange {
-        index: source,
-        count: mesh.bundles.len(),
-    })?;
-    let Some([t0, b0, n0]) = root_frame(mesh, source_bundle) else {
-        return Err(EditError::NotFinite {
-            what: "source root frame (degenerate root face)",
-            value: format!("bundle {source}"),
-        });
-    };
-    let local: Vec<DVec3> = path
-        .iter()
-        .map(|d| DVec3::new(d.dot(t0), d.dot(b0), d.dot(n0)))
-        .collect();
-    set_centre_paths(mesh, targets, |_, bundle| {
-        let [t, b, n] = root_frame(mesh, bundle)?;
-        Some(local.iter().map(|l| t * l.x + b * l.y + n * l.z).collect())
-    })
+    // New vertices' w continues their column by path length (kept as is in manual w mode
+    // afterwards, recomputed otherwise).
+    for (column, &old) in out.columns.iter_mut().zip(&old_lengths) {
+        for k in old.max(1)..column.positions.len() {
+            column.w[k] = column.w[k - 1] + column.positions[k].distance(column.positions[k - 1]);
+        }
+    }
+    crate::edit::fit_column_lengths(&mut out);
+    finish(out, wanted.iter().map(|(t, _, _)| *t).collect(), None)
 }
 
 /// The bundle whose root centre is nearest to `point` (visible bundles only).
@@ -148,14 +224,16 @@ fn nearest_bundle(mesh: &HairMesh, point: DVec3) -> Option<u32> {
         .map(|(i, _)| i)
 }
 
-/// Wisp mirror: each source bundle's shape, reflected across the plane `x = plane_x`,
-/// onto the bundle whose root lies nearest the source root's mirror image. Returns the
-/// outcome and the mirrored bundles, in source order.
+/// Wisp mirror: each source bundle's whole shape (layer count and every corner's path),
+/// reflected across the plane `x = plane_x`, onto the bundle whose root lies nearest the
+/// source root's mirror image; each target corner follows the source corner whose reflected
+/// root is nearest (the centre's path when the corners do not pair up). Returns the outcome
+/// and the `(source, target)` pairs, in source order.
 pub fn mirror_shape(
     mesh: &HairMesh,
     sources: &[u32],
     plane_x: f64,
-) -> Result<(EditOutcome, Vec<u32>), EditError> {
+) -> Result<(EditOutcome, Vec<(u32, u32)>), EditError> {
     check_bundles(mesh, sources)?;
     if !plane_x.is_finite() {
         return Err(EditError::NotFinite {
@@ -164,27 +242,155 @@ pub fn mirror_shape(
         });
     }
     let reflect = |p: DVec3| DVec3::new(2.0 * plane_x - p.x, p.y, p.z);
+    // A direction reflects without the plane's offset.
+    let reflect_direction = |d: DVec3| DVec3::new(-d.x, d.y, d.z);
+    let root_of = |c: u32| mesh.columns[c as usize].positions[0];
     let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let mut wanted: Vec<(u32, usize, Vec<Vec<DVec3>>)> = Vec::new();
     for &s in sources {
         let bundle = &mesh.bundles[s as usize];
         let Some(root) = bundle_layer_centre(mesh, bundle, 0) else {
             continue;
         };
-        if let Some(t) = nearest_bundle(mesh, reflect(root))
-            && !pairs.iter().any(|&(_, existing)| existing == t)
-        {
-            pairs.push((s, t));
+        let Some(t) = nearest_bundle(mesh, reflect(root)) else {
+            continue;
+        };
+        if pairs.iter().any(|&(_, existing)| existing == t) {
+            continue;
         }
+        let target = &mesh.bundles[t as usize];
+        let Some(centre) = centre_path(mesh, bundle) else {
+            continue;
+        };
+        // Target corner j ← the source corner whose reflected root is nearest.
+        let partner: Vec<usize> = target
+            .vertices
+            .iter()
+            .map(|&tc| {
+                (0..bundle.vertices.len())
+                    .min_by(|&a, &b| {
+                        let distance =
+                            |i: usize| reflect(root_of(bundle.vertices[i])).distance(root_of(tc));
+                        distance(a).total_cmp(&distance(b))
+                    })
+                    .unwrap_or(0)
+            })
+            .collect();
+        let paired = target.vertices.len() == bundle.vertices.len()
+            && (0..partner.len()).all(|j| !partner[..j].contains(&partner[j]));
+        let paths = partner
+            .iter()
+            .map(|&i| {
+                let column = &mesh.columns[bundle.vertices[i] as usize].positions;
+                (1..=bundle.layers as usize)
+                    .map(|k| {
+                        let d = if paired {
+                            column[k] - column[0]
+                        } else {
+                            centre[k - 1]
+                        };
+                        reflect_direction(d)
+                    })
+                    .collect()
+            })
+            .collect();
+        pairs.push((s, t));
+        wanted.push((t, bundle.layers as usize, paths));
     }
-    let targets: Vec<u32> = pairs.iter().map(|&(_, t)| t).collect();
-    if targets.is_empty() {
+    if wanted.is_empty() {
         return Err(EditError::EmptySelection);
     }
-    let outcome = set_centre_paths(mesh, &targets, |t, _| {
-        let &(s, _) = pairs.iter().find(|&&(_, target)| target == t)?;
-        let path = centre_path(mesh, &mesh.bundles[s as usize])?;
-        // A direction reflects without the plane's offset.
-        Some(path.iter().map(|d| DVec3::new(-d.x, d.y, d.z)).collect())
-    })?;
-    Ok((outcome, targets))
+    Ok((set_shapes(mesh, &wanted)?, pairs))
+}
+
+/// Mirror copies group styling too: each target takes its source's styling group, turned
+/// so the mirrored bundle is the mirror image of its source, not only in shape. A source on
+/// the global parameters sends its target back to them (the artist grouped nothing). A
+/// grouped source's parameters are turned through how the target's styling frame (û, v̂ at
+/// the root) sits against the reflected source frame: the 2×2 map `M` from the source's
+/// (û, v̂) coordinates to the target's decides. When `det M < 0` the reflection reverses
+/// handedness, so a curl and a twist that are on turn the other way; an active wave's
+/// direction is mapped through `M`. Noise, frizz and clump are random or isotropic in
+/// (û, v̂) and copy as they are. The target joins a group `"<source group> (mirrored)"`
+/// holding exactly those parameters (reused when one exists: mirroring twice makes no new
+/// group), or the source's own group when nothing turned.
+pub fn mirror_styling(styling: &StylingSet, mesh: &HairMesh, pairs: &[(u32, u32)]) -> StylingSet {
+    let frames = layer_frames(mesh, 0);
+    // A bundle's root frame: its corners' û and v̂ averaged.
+    let root_axes = |b: u32| -> Option<(DVec3, DVec3)> {
+        let bundle = mesh.bundles.get(b as usize)?;
+        let (mut u, mut v) = (DVec3::ZERO, DVec3::ZERO);
+        for &c in &bundle.vertices {
+            let frame = frames.get(c as usize).copied().flatten()?;
+            u += frame.u;
+            v += frame.v;
+        }
+        Some((u.try_normalize()?, v.try_normalize()?))
+    };
+    let reflect_direction = |d: DVec3| DVec3::new(-d.x, d.y, d.z);
+    let mut out = styling.clone();
+    for &(s, t) in pairs {
+        if s == t {
+            continue;
+        }
+        let Some(source_group) = styling.group_of(s) else {
+            let _ = out.assign(&[t], None);
+            continue;
+        };
+        let (Some((su, sv)), Some((tu, tv))) = (root_axes(s), root_axes(t)) else {
+            continue;
+        };
+        let (su, sv) = (reflect_direction(su), reflect_direction(sv));
+        // The target's (û, v̂) coordinates of the reflected source axes. û and v̂ need not be
+        // orthogonal: solve for them through the target's dual basis.
+        let (uu, uv, vv) = (tu.dot(tu), tu.dot(tv), tv.dot(tv));
+        let det_t = uu * vv - uv * uv;
+        if det_t.abs() < 1e-12 {
+            continue;
+        }
+        let coords = |d: DVec3| {
+            let (du, dv) = (d.dot(tu), d.dot(tv));
+            ((vv * du - uv * dv) / det_t, (uu * dv - uv * du) / det_t)
+        };
+        let (m00, m10) = coords(su);
+        let (m01, m11) = coords(sv);
+        let flips = m00 * m11 - m01 * m10 < 0.0;
+        let source = &styling.groups[source_group];
+        let mut params = source.params.clone();
+        if flips && params.curl.radius_m > 0.0 {
+            params.curl.turns_per_m = -params.curl.turns_per_m;
+        }
+        if flips && params.twist.turns_per_m != 0.0 {
+            params.twist.turns_per_m = -params.twist.turns_per_m;
+        }
+        let alpha = params.wave.direction_rad;
+        let mapped = (
+            m00 * alpha.cos() + m01 * alpha.sin(),
+            m10 * alpha.cos() + m11 * alpha.sin(),
+        );
+        if params.wave.amplitude_m > 0.0 && mapped.0.hypot(mapped.1) > 1e-9 {
+            // Rounded so that mirroring back gives the same group, not a new near-twin.
+            params.wave.direction_rad = (mapped.1.atan2(mapped.0) * 1e9).round() / 1e9;
+        }
+        let group = if params == source.params {
+            source_group
+        } else {
+            let name = format!("{} (mirrored)", source.name);
+            out.groups
+                .iter()
+                .position(|g| g.name == name && g.params == params)
+                .unwrap_or_else(|| {
+                    out.groups.push(StylingGroup {
+                        name,
+                        bundles: Vec::new(),
+                        params,
+                    });
+                    out.groups.len() - 1
+                })
+        };
+        let group = Some(group);
+        // The group exists (just found or made): assigning cannot fail.
+        let _ = out.assign(&[t], group);
+    }
+    out
 }

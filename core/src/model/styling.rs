@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 #[serde(default)]
 pub struct Curl {
     pub radius_m: f64,
+    /// Turns per metre along w; negative turns the other way (a left-handed helix).
     pub turns_per_m: f64,
     /// Length over which the curl grows from nothing at the root to full radius.
     pub ramp_in_m: f64,
@@ -304,7 +305,8 @@ impl StylingSet {
 /// variation cells per uv start at 1, fractions stay in [0, 1].
 pub const HARD_RANGES: &[(&str, f64, f64)] = &[
     ("curl.radius_m", 0.0, 0.5),
-    ("curl.turns_per_m", 0.0, 1000.0),
+    // Negative turns: a left-handed helix (what a mirrored bundle needs).
+    ("curl.turns_per_m", -1000.0, 1000.0),
     ("curl.ramp_in_m", 0.0, 10.0),
     ("curl.radius_jitter", 0.0, 1.0),
     ("twist.turns_per_m", -1000.0, 1000.0),

@@ -57,6 +57,26 @@ impl Default for LodSettings {
     }
 }
 
+impl LodSettings {
+    /// These settings with LOD on and both α scaled by `detail ∈ (0, 1]`: a bias toward
+    /// fewer strands (thickened to keep coverage, eq. 8) and fewer vertices, for frames that
+    /// must cost less than the full picture (the editor's interactive frames). A
+    /// non-finite or non-positive detail is taken as 1.
+    pub fn with_detail(self, detail: f64) -> Self {
+        let detail = if detail.is_finite() && detail > 0.0 {
+            detail.min(1.0)
+        } else {
+            1.0
+        };
+        Self {
+            enabled: true,
+            alpha_strands: self.alpha_strands * detail,
+            alpha_vertices: self.alpha_vertices * detail,
+            ..self
+        }
+    }
+}
+
 /// The camera as LOD sees it.
 #[derive(Clone, Copy, Debug)]
 pub struct LodCamera {
@@ -259,6 +279,48 @@ mod tests {
             }
         }
         roots
+    }
+
+    #[test]
+    fn less_detail_draws_fewer_strands_and_vertices_thicker() {
+        let camera = camera(2.0, false);
+        let plan_at =
+            |settings: &LodSettings| plan_frame(&bundles(), 64, 5, &camera, settings, 1 << 20);
+        // LOD off by the artist: the detail bias turns it on.
+        let off = LodSettings {
+            enabled: false,
+            ..LodSettings::default()
+        };
+        let full = plan_at(&off.with_detail(1.0));
+        assert!(off.with_detail(0.5).enabled);
+        let mut previous = full.clone();
+        for detail in [0.5, 0.25, 0.1, 0.02] {
+            let plan = plan_at(&off.with_detail(detail));
+            check_runs(&plan, 1 << 20);
+            assert!(
+                plan.strands < previous.strands,
+                "detail {detail}: {} strands",
+                plan.strands
+            );
+            assert!(plan.vertices < previous.vertices);
+            // Thinned bundles draw thicker strands; every bundle keeps at least one.
+            let thickest = plan
+                .batches
+                .iter()
+                .flatten()
+                .map(|r| r.thickness)
+                .fold(1.0, f32::max);
+            assert!(thickest > 1.0, "detail {detail}");
+            assert!(plan.strands >= 40);
+            previous = plan;
+        }
+        // Nonsense detail means none of the bias.
+        for detail in [f64::NAN, 0.0, -1.0, f64::INFINITY, 7.0] {
+            assert_eq!(
+                plan_at(&LodSettings::default().with_detail(detail)),
+                plan_at(&LodSettings::default())
+            );
+        }
     }
 
     #[test]

@@ -808,11 +808,14 @@ impl HairloomApp {
                     "GPU generate + draw {ms:.1} ms ({fps:.digits$} fps)"
                 ));
             }
-            if let viewport::FrameQuality::Interactive { scale } = self.viewport.shown_quality {
+            if let viewport::FrameQuality::Interactive { scale, detail } =
+                self.viewport.shown_quality
+            {
                 ui.separator();
                 ui.label(format!(
-                    "interactive: {:.0}% size, no effects (budget {} ms)",
+                    "interactive: {:.0}% size, {:.0}% LOD detail, no effects (budget {} ms)",
                     scale * 100.0,
+                    detail * 100.0,
                     viewport::FRAME_BUDGET_MS
                 ))
                 .on_hover_text("the full picture follows when input is still");

@@ -267,7 +267,10 @@ impl ToolsPanel {
             if let Some(source) = self.copied_shape
                 && ui
                     .button("Paste shape")
-                    .on_hover_text("Onto the selected bundles, turned into each one's frame")
+                    .on_hover_text(
+                        "The whole shape (layer count, every corner's path) onto the selected \
+                         bundles, turned into each one's frame",
+                    )
                     .clicked()
             {
                 state.edit_mesh("Paste shape", |mesh, bundles| {
@@ -276,7 +279,10 @@ impl ToolsPanel {
             }
             if ui
                 .button("Mirror shape")
-                .on_hover_text("The selected bundles' shapes onto their mirror images across the model's centre (x)")
+                .on_hover_text(
+                    "The selected bundles' whole shapes and styling groups onto their mirror \
+                     images across the model's centre (x)",
+                )
                 .clicked()
             {
                 // The body's centre (a head is symmetric; its hair need not be yet).
@@ -289,13 +295,28 @@ impl ToolsPanel {
                         .bounds()
                         .map_or(0.0, |(lo, hi)| 0.5 * (lo.x + hi.x)),
                 };
+                // Shape and styling groups in one undo step.
+                state.commit_edit();
+                state.stop_playback_for_editing();
+                let sources: Vec<u32> = state.selection.iter().copied().collect();
+                let document = state.document();
                 let mut mirrored = Vec::new();
-                state.edit_mesh("Mirror shape", |mesh, bundles| {
-                    edit::mirror_shape(mesh, bundles, plane_x).map(|(outcome, targets)| {
-                        mirrored = targets;
-                        outcome
-                    })
-                });
+                match edit::mirror_shape(&document.hair_mesh, &sources, plane_x) {
+                    Ok((outcome, pairs)) => {
+                        let styling =
+                            edit::mirror_styling(&document.styling, &outcome.mesh, &pairs);
+                        let edited = state.edit("Mirror shape");
+                        edited.hair_mesh = outcome.mesh;
+                        edited.styling = styling;
+                        state.commit_edit();
+                        state.message = format!(
+                            "Mirror shape: {} bundle(s) mirrored with their styling",
+                            pairs.len()
+                        );
+                        mirrored = pairs.into_iter().map(|(_, t)| t).collect();
+                    }
+                    Err(error) => state.message = format!("Mirror shape: {error}"),
+                }
                 if !mirrored.is_empty() {
                     state.selection = mirrored.into_iter().collect();
                 }

@@ -8,6 +8,7 @@ use glam::DVec3;
 use hairloom_core::edit::{ExtrudeDirection, VertexTransform, extrude, transform_vertices};
 use hairloom_core::geometry::interior::place_interior;
 use hairloom_core::{HairMesh, Topology, VertexRef};
+use hairloom_editor::app::viewport::{FrameQuality, InteractiveEffort};
 
 #[derive(Subcommand)]
 pub enum Which {
@@ -73,6 +74,10 @@ pub enum Which {
         size: String,
         #[arg(long, default_value_t = 9)]
         runs: usize,
+        /// Folder for the full picture and the budget-adapted interactive frame (PNG), to
+        /// look at what interaction shows.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
     },
     /// Styled strand vertices per second on all cores at 10K and 100K strands.
     Cpu {
@@ -235,7 +240,8 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             project,
             size,
             runs,
-        } => edit_latency(project, &size, runs.max(1)),
+            out,
+        } => edit_latency(project, &size, runs.max(1), out.as_deref()),
         Which::Gpu {
             project,
             vertices_log2,
@@ -635,6 +641,7 @@ fn edit_latency(
     project: Option<std::path::PathBuf>,
     size: &str,
     runs: usize,
+    out: Option<&std::path::Path>,
 ) -> anyhow::Result<()> {
     use hairloom_core::runtime::frame_plan::LodSettings;
     use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
@@ -674,15 +681,16 @@ fn edit_latency(
     let frame_of = |gpu: &GpuHair,
                     body: &GpuBody,
                     lighting: &hairloom_core::model::scene::Scene,
-                    [width, height]: [u32; 2]|
-     -> anyhow::Result<()> {
+                    quality: FrameQuality|
+     -> anyhow::Result<Vec<u8>> {
+        let [width, height] = quality.size([width, height]);
         let scene = hairloom_render::preview::default_scene(
             body,
             HairSource::Generated {
                 generator: &generator,
                 hair: gpu,
                 filtering: Filtering::Exact,
-                lod: LodSettings::default(),
+                lod: quality.lod(LodSettings::default()),
             },
             vertex_count,
             bounds,
@@ -690,11 +698,12 @@ fn edit_latency(
             lighting,
         );
         let plan = preview.plan(&scene, width, height);
-        preview.render(&context, &scene, &plan, width, height)?;
-        Ok(())
+        Ok(preview.render(&context, &scene, &plan, width, height)?)
     };
     let full_scene = document.scene.clone();
-    let frame = |gpu: &GpuHair, body: &GpuBody| frame_of(gpu, body, &full_scene, [width, height]);
+    let frame = |gpu: &GpuHair, body: &GpuBody| {
+        frame_of(gpu, body, &full_scene, FrameQuality::Full).map(|_| ())
+    };
     // The body is uploaded once per document, as the viewport does.
     let body = GpuBody::upload(&context, &hair.body);
     frame(&gpu, &body)?; // warm-up: pipelines, first allocations
@@ -806,7 +815,7 @@ fn edit_latency(
     row("frame alone (no edit)", [0.0, frame_only], false);
 
     // While the artist drags the slider the viewport draws interactive frames (see
-    // `FRAME_BUDGET_MS`): no optional effect, a fraction of the pixels.
+    // `FRAME_BUDGET_MS`): no optional effect, a fraction of the pixels, a LOD detail bias.
     let interactive_scene = hairloom_core::model::scene::Scene {
         effects: full_scene.effects.none(),
         ..full_scene.clone()
@@ -819,35 +828,93 @@ fn edit_latency(
         "{:<46} {:>12} {:>8}",
         "slider tick, frame", "to pixels ms", "ratio"
     );
-    for (name, scale, lighting) in [
+    let interactive = |scale, detail| FrameQuality::Interactive { scale, detail };
+    let mut tick = 0;
+    let mut slider_tick = |quality: FrameQuality, lighting| {
+        tick += 1;
+        document.styling.global.curl.radius_m = curl(tick);
+        hair.set_styling(&document.styling);
+        generator.update_styling(&context, &mut gpu, &hair);
+        frame_of(&gpu, &body, lighting, quality)
+    };
+    let mut full_ms = 0.0;
+    for (name, quality, lighting) in [
         (
             "full picture (every tick, before the budget)",
-            1.0,
+            FrameQuality::Full,
             &full_scene,
         ),
         (
             "interactive, no effects, 100% size",
-            1.0,
+            interactive(1.0, 1.0),
             &interactive_scene,
         ),
-        ("interactive, no effects, 50% size", 0.5, &interactive_scene),
+        (
+            "interactive, no effects, 50% size",
+            interactive(0.5, 1.0),
+            &interactive_scene,
+        ),
         (
             "interactive, no effects, 25% size",
-            0.25,
+            interactive(0.25, 1.0),
+            &interactive_scene,
+        ),
+        (
+            "interactive, 25% size, 25% LOD detail",
+            interactive(0.25, 0.25),
+            &interactive_scene,
+        ),
+        (
+            "interactive, 25% size, 5% LOD detail",
+            interactive(0.25, 0.05),
             &interactive_scene,
         ),
     ] {
-        let size = [width, height].map(|side| ((side as f32 * scale).round() as u32).max(1));
-        let ms = timed(Box::new(|run| {
-            document.styling.global.curl.radius_m = curl(run);
-            hair.set_styling(&document.styling);
-            generator.update_styling(&context, &mut gpu, &hair);
-            frame_of(&gpu, &body, lighting, size)
-        }))?;
+        let ms = timed(Box::new(|_| slider_tick(quality, lighting).map(|_| ())))?;
+        if quality == FrameQuality::Full {
+            full_ms = ms;
+            if let Some(out) = out {
+                std::fs::create_dir_all(out)?;
+                let pixels = slider_tick(quality, lighting)?;
+                super::render::write_png(&out.join("edit_full.png"), &pixels, width, height)?;
+            }
+        }
         println!(
             "{name:<46} {ms:>12.2} {:>8}",
             format!("{:.3}×", ms / in_place[1])
         );
     }
+    // What the viewport does: the effort starts at the budget's share of the full frame and
+    // learns from each interactive frame; after it settles, the frames it draws.
+    let mut effort = InteractiveEffort::from_full_frame(full_ms);
+    let mut settled = Vec::new();
+    for step in 0..12 {
+        let start = Instant::now();
+        slider_tick(effort.quality(), &interactive_scene)?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        effort.learn(ms);
+        if step >= 8 {
+            settled.push(ms);
+        }
+    }
+    let FrameQuality::Interactive { scale, detail } = effort.quality() else {
+        unreachable!("interactive efforts give interactive frames")
+    };
+    let ms = median(settled);
+    if let Some(out) = out {
+        let quality = effort.quality();
+        let pixels = slider_tick(quality, &interactive_scene)?;
+        let [w, h] = quality.size([width, height]);
+        super::render::write_png(&out.join("edit_interactive.png"), &pixels, w, h)?;
+    }
+    println!(
+        "{:<46} {ms:>12.2} {:>8}",
+        format!(
+            "budget-adapted ({:.0}% size, {:.0}% LOD detail)",
+            scale * 100.0,
+            detail * 100.0
+        ),
+        format!("{:.3}×", ms / in_place[1])
+    );
     Ok(())
 }

@@ -16,6 +16,8 @@
 //! or Enter confirms (one undo step), Esc or a right-click cancels. Interior vertices follow
 //! live.
 
+mod budget;
+pub use budget::{FRAME_BUDGET_MS, FrameQuality, InteractiveEffort, SETTLE};
 mod camera;
 mod effect_costs;
 pub use effect_costs::EffectCostResult;
@@ -111,24 +113,6 @@ struct BodyDepthKey {
     bounds: Option<(Vec3, Vec3)>,
 }
 
-/// How much of the picture a frame draws (see [`FRAME_BUDGET_MS`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FrameQuality {
-    /// The scene's effects at the viewport's full size.
-    Full,
-    /// While the artist interacts and the full frame is over budget: no optional effect,
-    /// drawn at `scale` of the viewport's size (then stretched).
-    Interactive { scale: f32 },
-}
-
-/// The viewport's frame budget while the artist interacts (navigating, dragging a vertex or
-/// a slider, a modal tool): when the full picture costs more, interactive frames drop the
-/// optional effects and draw fewer pixels, the scale adapting to what the last interactive
-/// frame cost; the full picture follows once input has been still for [`SETTLE`].
-pub const FRAME_BUDGET_MS: f64 = 120.0;
-/// How long input must be still before the full picture is drawn again.
-pub const SETTLE: std::time::Duration = std::time::Duration::from_millis(400);
-
 /// What an accuracy measurement gives: every switch's row, or why it failed.
 type AccuracyResult = Result<Vec<AccuracyRow>, String>;
 
@@ -162,8 +146,8 @@ pub struct Viewport {
     full_frame_ms: Option<f64>,
     /// When what the viewport shows last changed (an edit, the camera, the size).
     last_change: Option<std::time::Instant>,
-    /// The resolution scale of interactive frames, adapted to the budget.
-    interactive_scale: f32,
+    /// How much interactive frames draw, adapted to the budget; `None` until the first.
+    effort: Option<InteractiveEffort>,
     /// The quality of the picture shown now (the status bar says when it is reduced).
     pub shown_quality: FrameQuality,
     pub adapter: String,
@@ -280,7 +264,7 @@ impl Viewport {
             drawn: None,
             full_frame_ms: None,
             last_change: None,
-            interactive_scale: 0.5,
+            effort: None,
             shown_quality: FrameQuality::Full,
             error: None,
             keyboard_blocked: false,

@@ -300,10 +300,10 @@ impl Viewport {
         if let (Some(quality), Some(ms)) = (timed, self.frame_ms()) {
             match quality {
                 FrameQuality::Full => self.full_frame_ms = Some(ms),
-                FrameQuality::Interactive { scale } => {
-                    // Pixels go as the square of the scale; move halfway toward the budget.
-                    let ideal = scale * (FRAME_BUDGET_MS / ms.max(1e-3)).sqrt() as f32;
-                    self.interactive_scale = (0.5 * (scale + ideal)).clamp(0.2, 1.0);
+                FrameQuality::Interactive { .. } => {
+                    if let Some(effort) = self.effort.as_mut() {
+                        effort.learn(ms);
+                    }
                 }
             }
         }
@@ -321,13 +321,15 @@ impl Viewport {
             || self
                 .last_change
                 .is_some_and(|t| now.duration_since(t) < SETTLE);
-        let over_budget = self.full_frame_ms.is_some_and(|ms| ms > FRAME_BUDGET_MS);
-        if interacting && over_budget {
+        if let (true, Some(full_ms)) = (
+            interacting,
+            self.full_frame_ms.filter(|&ms| ms > FRAME_BUDGET_MS),
+        ) {
             // Come back for the full picture once input is still.
             ui.ctx().request_repaint_after(SETTLE);
-            FrameQuality::Interactive {
-                scale: self.interactive_scale,
-            }
+            self.effort
+                .get_or_insert_with(|| InteractiveEffort::from_full_frame(full_ms))
+                .quality()
         } else {
             FrameQuality::Full
         }
@@ -376,12 +378,7 @@ impl Viewport {
             ((rect.height() * pixels_per_point).round() as u32).clamp(1, 8192),
         ];
         let quality = self.frame_quality(ui, state, full_size, settings);
-        let size = match quality {
-            FrameQuality::Full => full_size,
-            FrameQuality::Interactive { scale } => {
-                full_size.map(|side| ((side as f32 * scale).round() as u32).max(1))
-            }
-        };
+        let size = quality.size(full_size);
         let key = (state.shown_revision(), settings);
         if self.uploaded != Some(key) {
             let document = state.shown_document();
@@ -480,7 +477,7 @@ impl Viewport {
                     size,
                     quality,
                     filtering: self.settings.filtering,
-                    lod: self.settings.lod,
+                    lod: quality.lod(self.settings.lod),
                 });
                 self.shown_quality = quality;
             }
