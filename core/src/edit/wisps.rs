@@ -59,6 +59,16 @@ pub(crate) fn centre_path(mesh: &HairMesh, bundle: &Bundle) -> Option<Vec<DVec3>
         .collect()
 }
 
+/// `d`'s coordinates in `frame` (tangent, bitangent, normal).
+fn to_frame([t, b, n]: [DVec3; 3], d: DVec3) -> DVec3 {
+    DVec3::new(d.dot(t), d.dot(b), d.dot(n))
+}
+
+/// A direction reflected across a plane `x = const` (no offset: directions have none).
+fn reflect_direction(d: DVec3) -> DVec3 {
+    DVec3::new(-d.x, d.y, d.z)
+}
+
 /// How each corner of a bundle moves away from its own root, layer by layer
 /// (`[corner][k - 1]` is layer k), in the bundle's root frame.
 fn corner_paths_local(
@@ -66,7 +76,6 @@ fn corner_paths_local(
     bundle: &Bundle,
     frame: [DVec3; 3],
 ) -> Option<Vec<Vec<DVec3>>> {
-    let [t, b, n] = frame;
     bundle
         .vertices
         .iter()
@@ -74,10 +83,7 @@ fn corner_paths_local(
             let positions = &mesh.columns.get(c as usize)?.positions;
             let root = *positions.first()?;
             (1..=bundle.layers as usize)
-                .map(|k| {
-                    let d = *positions.get(k)? - root;
-                    Some(DVec3::new(d.dot(t), d.dot(b), d.dot(n)))
-                })
+                .map(|k| Some(to_frame(frame, *positions.get(k)? - root)))
                 .collect()
         })
         .collect()
@@ -104,8 +110,6 @@ pub fn paste_shape(
             value: format!("bundle {source}"),
         });
     };
-    let [t0, b0, n0] = source_frame;
-    let to_local = |d: &DVec3| DVec3::new(d.dot(t0), d.dot(b0), d.dot(n0));
     let out_of_range = EditError::BundleOutOfRange {
         index: source,
         count: mesh.bundles.len(),
@@ -113,7 +117,7 @@ pub fn paste_shape(
     let centre_local: Vec<DVec3> = centre_path(mesh, source_bundle)
         .ok_or(out_of_range.clone())?
         .iter()
-        .map(to_local)
+        .map(|&d| to_frame(source_frame, d))
         .collect();
     let corners_local =
         corner_paths_local(mesh, source_bundle, source_frame).ok_or(out_of_range)?;
@@ -125,7 +129,7 @@ pub fn paste_shape(
         return Err(EditError::EmptySelection);
     }
     // Each target's corner paths in object space (`None`: a degenerate root face, left alone).
-    let wanted: Vec<(u32, Vec<Vec<DVec3>>)> = targets
+    let wanted: Vec<(u32, usize, Vec<Vec<DVec3>>)> = targets
         .iter()
         .filter_map(|&t| {
             let bundle = &mesh.bundles[t as usize];
@@ -142,12 +146,8 @@ pub fn paste_shape(
                     local.iter().map(to_object).collect()
                 })
                 .collect();
-            Some((t, paths))
+            Some((t, layers, paths))
         })
-        .collect();
-    let wanted: Vec<(u32, usize, Vec<Vec<DVec3>>)> = wanted
-        .into_iter()
-        .map(|(t, paths)| (t, layers, paths))
         .collect();
     set_shapes(mesh, &wanted)
 }
@@ -242,8 +242,6 @@ pub fn mirror_shape(
         });
     }
     let reflect = |p: DVec3| DVec3::new(2.0 * plane_x - p.x, p.y, p.z);
-    // A direction reflects without the plane's offset.
-    let reflect_direction = |d: DVec3| DVec3::new(-d.x, d.y, d.z);
     let root_of = |c: u32| mesh.columns[c as usize].positions[0];
     let mut pairs: Vec<(u32, u32)> = Vec::new();
     let mut wanted: Vec<(u32, usize, Vec<Vec<DVec3>>)> = Vec::new();
@@ -327,7 +325,6 @@ pub fn mirror_styling(styling: &StylingSet, mesh: &HairMesh, pairs: &[(u32, u32)
         }
         Some((u.try_normalize()?, v.try_normalize()?))
     };
-    let reflect_direction = |d: DVec3| DVec3::new(-d.x, d.y, d.z);
     let mut out = styling.clone();
     for &(s, t) in pairs {
         if s == t {
