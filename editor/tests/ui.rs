@@ -1550,3 +1550,47 @@ fn split_and_merge_are_one_undo_step_each() {
     undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original);
 }
+
+#[test]
+fn the_panel_layout_comes_back_in_the_next_session_and_a_hostile_one_is_named() {
+    use hairloom_editor::app::panel_memory::SavedTile;
+    let recovery_dir = fresh_recovery_dir();
+    let mut harness = harness_with_recovery(&recovery_dir);
+    let default = SavedTile::of(&harness.state().layout).expect("layout");
+    // Widen the left column, as dragging its divider does, and let go.
+    {
+        let layout = &mut harness.state_mut().layout;
+        let root = layout.root.expect("root");
+        let Some(egui_tiles::Tile::Container(egui_tiles::Container::Linear(linear))) =
+            layout.tiles.get_mut(root)
+        else {
+            panic!("the root is a split");
+        };
+        let left = linear.children[0];
+        linear.shares.set_share(left, 1.75);
+    }
+    harness.run();
+    let arranged = SavedTile::of(&harness.state().layout).expect("layout");
+    assert_ne!(arranged, default);
+    // Rearranging panes is not an edit.
+    assert!(!harness.state().state.is_dirty());
+    drop(harness);
+
+    let next = harness_with_recovery(&recovery_dir);
+    assert_eq!(SavedTile::of(&next.state().layout), Some(arranged));
+    drop(next);
+
+    // A layout without the viewport is refused by name; the default layout is used.
+    std::fs::write(
+        recovery_dir.join("panels.json"),
+        r#"{"kind":"tabs","active":0,"children":[{"kind":"pane","pane":"Tools"}]}"#,
+    )
+    .expect("write");
+    let hostile = harness_with_recovery(&recovery_dir);
+    assert_eq!(SavedTile::of(&hostile.state().layout), Some(default));
+    let message = &hostile.state().state.message;
+    assert!(
+        message.contains("panels.json") && message.contains("the Viewport pane is missing"),
+        "{message}"
+    );
+}

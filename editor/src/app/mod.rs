@@ -7,6 +7,7 @@ pub mod gizmo;
 pub mod history_panel;
 pub mod layout_panel;
 pub mod outliner_panel;
+pub mod panel_memory;
 pub mod playback;
 pub mod recovery;
 pub mod scene_panel;
@@ -61,7 +62,7 @@ pub enum AfterConfirm {
 }
 
 /// The dockable panes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Pane {
     Viewport,
     Tools,
@@ -74,6 +75,18 @@ pub enum Pane {
 }
 
 impl Pane {
+    /// Every pane; a layout shows each exactly once.
+    pub const ALL: [Self; 8] = [
+        Self::Viewport,
+        Self::Tools,
+        Self::Outliner,
+        Self::History,
+        Self::Styling,
+        Self::Scene,
+        Self::Strands,
+        Self::Layout,
+    ];
+
     pub fn title(self) -> &'static str {
         match self {
             Self::Viewport => "Viewport",
@@ -140,6 +153,8 @@ pub struct HairloomApp {
     pub recent: RecentFiles,
     /// How each project was last viewed (per user; not part of any document).
     pub views: view_memory::ViewMemory,
+    /// How the panes are arranged (per user; not part of any document).
+    pub panels: panel_memory::PanelMemory,
     /// The typed-path prompt, where no native dialog exists.
     pub prompt: Option<PathPrompt>,
     pub export: Option<ExportJob>,
@@ -167,8 +182,11 @@ impl HairloomApp {
         state: EditorState,
         recovery: Recovery,
     ) -> Self {
+        let (panels, stored_layout, layout_problem) =
+            panel_memory::PanelMemory::load(recovery.dir().join("panels.json"));
         let mut app = Self {
             viewport: Viewport::new(cc.wgpu_render_state.as_ref()),
+            panels,
             offer: recovery.pending(),
             autosaved: (0.0, state.revision),
             recent: RecentFiles::load(recovery.dir().join("recent.txt")),
@@ -181,7 +199,7 @@ impl HairloomApp {
             tools: ToolsPanel::default(),
             outliner: OutlinerPanel::default(),
             layout_panel: LayoutPanel::default(),
-            layout: default_layout(),
+            layout: stored_layout.unwrap_or_else(default_layout),
             dialogs: Box::new(NativeDialogs),
             prompt: None,
             export: None,
@@ -192,6 +210,9 @@ impl HairloomApp {
             title: String::new(),
         };
         app.recall_view();
+        if let Some(problem) = layout_problem {
+            app.state.message = problem;
+        }
         app
     }
 
@@ -938,6 +959,10 @@ impl eframe::App for HairloomApp {
             };
             self.layout.ui(&mut panes, ui);
         });
+        // A divider or tab is stored once it is let go, not at every step of its drag.
+        if !ui.input(|i| i.pointer.any_down()) {
+            self.panels.remember(&self.layout);
+        }
     }
 }
 
