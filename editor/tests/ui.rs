@@ -1594,3 +1594,227 @@ fn the_panel_layout_comes_back_in_the_next_session_and_a_hostile_one_is_named() 
         "{message}"
     );
 }
+
+/// Presses at `from`, moves to `to` in steps, and (unless `escape_first`) releases there;
+/// with `escape_first`, Esc is pressed before the button is let go.
+fn drag_with(
+    harness: &mut Harness<'static, HairloomApp>,
+    from: egui::Pos2,
+    to: egui::Pos2,
+    escape_first: bool,
+) {
+    harness.hover_at(from);
+    harness.run();
+    harness.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run();
+    for step in 1..=8 {
+        harness.hover_at(from + (to - from) * (step as f32 / 8.0));
+        harness.run();
+    }
+    if escape_first {
+        harness.key_press(egui::Key::Escape);
+        harness.run();
+    }
+    harness.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run();
+}
+
+/// Issue "The editor as artists use it": the styling-direction gizmo (seed 004) points the
+/// wave, twists and mirrors the curl of the selected bundles' group, live, each drag one
+/// undo step, Esc cancelling; a selection mixing groups is refused.
+#[test]
+fn the_styling_direction_gizmo_points_the_wave_twists_and_mirrors_the_curl() {
+    use hairloom_editor::app::viewport::StylingGizmoHandles;
+    let mut harness = harness();
+    harness.get_by_label("View").click();
+    harness.run();
+    harness
+        .get_by_label("Styling-direction gizmo (wave, twist, curl)")
+        .click();
+    harness.run();
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert!(harness.state().viewport.settings.styling_gizmo);
+    // A curl to mirror (the sample's global parameters), as its own undo step.
+    {
+        let state = &mut harness.state_mut().state;
+        let global = &mut state.edit("set up a curl").styling.global;
+        global.curl.radius_m = 0.004;
+        global.curl.turns_per_m = 25.0;
+        global.wave.amplitude_m = 0.01;
+        state.commit_edit();
+    }
+    let original = harness.state().state.document().clone();
+    let steps = harness.state().state.project.history.undo.len();
+
+    // A bundle whose gizmo stands well inside the viewport.
+    let inner = viewport_rect(&harness).shrink(120.0);
+    let bundles = harness.state().state.document().hair_mesh.bundles.len() as u32;
+    let mut handles = None;
+    for b in 0..bundles {
+        harness.state_mut().state.selection = [b].into();
+        harness.run();
+        let shown: Option<StylingGizmoHandles> = harness.state().viewport.styling_handles;
+        if let Some(h) = shown
+            && [h.centre, h.wave, h.twist]
+                .iter()
+                .all(|p| inner.contains(*p))
+            && h.curl.is_some_and(|c| inner.contains(c))
+            && h.wave.distance(h.centre) > 30.0
+        {
+            handles = Some(h);
+            break;
+        }
+    }
+    let handles = handles.expect("a bundle's gizmo inside the viewport");
+    assert!(
+        harness.state().viewport.gizmo_centre.is_none(),
+        "the move gizmo gives way"
+    );
+
+    // Wave: drag the tip a quarter turn round; the arrow follows the pointer.
+    let arm = handles.wave - handles.centre;
+    let target = handles.centre + egui::vec2(-arm.y, arm.x);
+    drag_with(&mut harness, handles.wave, target, false);
+    let document = harness.state().state.document().clone();
+    assert_ne!(
+        document.styling.global.wave.direction_rad,
+        original.styling.global.wave.direction_rad,
+        "{}",
+        harness.state().state.message
+    );
+    let now = harness.state().viewport.styling_handles.expect("handles");
+    let (drawn, aimed) = (now.wave - now.centre, target - now.centre);
+    let angle = (drawn.x * aimed.y - drawn.y * aimed.x).atan2(drawn.dot(aimed));
+    assert!(
+        angle.abs() < 0.05,
+        "the drawn arrow points {angle} rad off the pointer"
+    );
+    assert_eq!(harness.state().state.project.history.undo.len(), steps + 1);
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .project
+            .history
+            .undo
+            .last()
+            .expect("step")
+            .label(),
+        "Wave direction"
+    );
+
+    // Twist: drag the ring's handle; the bundle twists, one step.
+    let now = harness.state().viewport.styling_handles.expect("handles");
+    drag_with(
+        &mut harness,
+        now.twist,
+        now.twist + egui::vec2(25.0, 30.0),
+        false,
+    );
+    let twisted = harness
+        .state()
+        .state
+        .document()
+        .styling
+        .global
+        .twist
+        .turns_per_m;
+    assert_ne!(twisted, original.styling.global.twist.turns_per_m);
+    assert!(harness.state().state.document().styling.validate().is_ok());
+    assert_eq!(harness.state().state.project.history.undo.len(), steps + 2);
+
+    // Esc in the middle of a drag cancels it: nothing changes, no step.
+    let before_cancel = harness.state().state.document().clone();
+    let now = harness.state().viewport.styling_handles.expect("handles");
+    drag_with(
+        &mut harness,
+        now.twist,
+        now.twist + egui::vec2(-30.0, 20.0),
+        true,
+    );
+    assert_eq!(harness.state().state.document(), &before_cancel);
+    assert_eq!(harness.state().state.project.history.undo.len(), steps + 2);
+    assert!(harness.state().viewport.modal_tool().is_none());
+
+    // Curl: a sweep one way or the other mirrors the helix (a sweep the way it already
+    // winds changes nothing and is no step).
+    let turns = || 25.0f64;
+    for direction in [1.0f32, -1.0] {
+        let now = harness.state().viewport.styling_handles.expect("handles");
+        let curl = now.curl.expect("curl handle");
+        drag_with(
+            &mut harness,
+            curl,
+            curl + tangent(now.curl_ring, curl) * direction,
+            false,
+        );
+        if harness
+            .state()
+            .state
+            .document()
+            .styling
+            .global
+            .curl
+            .turns_per_m
+            < 0.0
+        {
+            break;
+        }
+    }
+    assert_eq!(
+        harness
+            .state()
+            .state
+            .document()
+            .styling
+            .global
+            .curl
+            .turns_per_m,
+        -turns(),
+        "the curl was mirrored, its rate kept"
+    );
+    assert_eq!(harness.state().state.project.history.undo.len(), steps + 3);
+
+    // Every drag undoes as one step.
+    undo(&mut harness, 3);
+    assert_eq!(harness.state().state.document(), &original);
+
+    // Bundles of different groups: the gizmo does not stand (one drag edits one set).
+    let grouped = handles_bundle(&harness);
+    {
+        let state = &mut harness.state_mut().state;
+        state.edit("group").styling.new_group("fringe", &[grouped]);
+        state.commit_edit();
+        state.selection = [grouped, (grouped + 1) % bundles].into();
+    }
+    harness.run();
+    assert!(harness.state().viewport.styling_handles.is_none());
+}
+
+/// 30 points along a ring's tangent at `handle` (the ring centred at `ring` on screen).
+fn tangent(ring: egui::Pos2, handle: egui::Pos2) -> egui::Vec2 {
+    let radial = (handle - ring).normalized();
+    egui::vec2(-radial.y, radial.x) * 30.0
+}
+
+/// The one selected bundle.
+fn handles_bundle(harness: &Harness<'static, HairloomApp>) -> u32 {
+    *harness
+        .state()
+        .state
+        .selection
+        .iter()
+        .next()
+        .expect("a selected bundle")
+}

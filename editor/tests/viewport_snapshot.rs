@@ -379,3 +379,67 @@ fn motion_is_simulated_and_uploaded_only_when_the_scene_has_it() {
         modelled.hair_mesh
     );
 }
+
+#[test]
+fn the_styling_direction_gizmo_is_drawn_at_the_selected_roots() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    harness.state_mut().viewport.settings.styling_gizmo = true;
+    {
+        let state = &mut harness.state_mut().state;
+        let global = &mut state.edit("curl").styling.global;
+        global.curl.radius_m = 0.004;
+        global.curl.turns_per_m = 25.0;
+        global.twist.turns_per_m = 4.0;
+        state.commit_edit();
+    }
+    // A bundle near the middle of the picture.
+    let middle = harness.state().viewport.rect.expect("viewport").center();
+    let bundles = harness.state().state.document().hair_mesh.bundles.len() as u32;
+    let mut best = (f32::INFINITY, 0);
+    for b in 0..bundles {
+        harness.state_mut().state.selection = [b].into();
+        harness.step();
+        if let Some(h) = harness.state().viewport.styling_handles {
+            let d = h.centre.distance(middle);
+            if d < best.0 {
+                best = (d, b);
+            }
+        }
+    }
+    harness.state_mut().state.selection.clear();
+    let before = viewport_image(&mut harness);
+    harness.state_mut().state.selection = [best.1].into();
+    let after = viewport_image(&mut harness);
+    after
+        .save(root().join("target/editor-styling-gizmo.png"))
+        .expect("write picture");
+    let handles = harness
+        .state()
+        .viewport
+        .styling_handles
+        .expect("the gizmo stands at the selected roots");
+    let rect = harness.state().viewport.rect.expect("viewport");
+    let scale = harness.ctx.pixels_per_point();
+    // The wave arrow and both rings are drawn: pixels changed around each handle.
+    for (name, at) in [
+        ("wave", handles.wave),
+        ("twist", handles.twist),
+        ("curl", handles.curl.expect("curl handle")),
+    ] {
+        let (cx, cy) = ((at.x - rect.left()) * scale, (at.y - rect.top()) * scale);
+        let changed = before
+            .enumerate_pixels()
+            .zip(after.pixels())
+            .filter(|((x, y, a), b)| {
+                (*x as f32 - cx).hypot(*y as f32 - cy) < 6.0 * scale
+                    && a.0.iter().zip(b.0).any(|(p, q)| p.abs_diff(q) > 40)
+            })
+            .count();
+        assert!(
+            changed > 20,
+            "only {changed} pixels changed at the {name} handle"
+        );
+    }
+}

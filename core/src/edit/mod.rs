@@ -16,6 +16,7 @@ pub mod coordinates;
 pub mod pick;
 pub mod select;
 pub mod split_merge;
+pub mod styling_direction;
 pub mod topology;
 pub mod transform;
 pub mod wisps;

@@ -689,6 +689,15 @@ impl HairloomApp {
                 ui.checkbox(&mut settings.wireframe, "Hair-mesh wireframe");
                 ui.checkbox(&mut settings.gizmo, "Transform gizmo");
                 ui.checkbox(
+                    &mut settings.styling_gizmo,
+                    "Styling-direction gizmo (wave, twist, curl)",
+                )
+                .on_hover_text(
+                    "At the selected bundles' roots, instead of the transform gizmo: drag the \
+                     yellow tip to point the wave, the cyan ring to twist, the magenta ring to \
+                     mirror the curl",
+                );
+                ui.checkbox(
                     &mut settings.frame_glyphs,
                     "Styling frames (u red, v green, w blue)",
                 );

@@ -24,6 +24,9 @@ pub struct SavedView {
     pub wireframe: bool,
     pub frame_glyphs: bool,
     pub gizmo: bool,
+    /// Views stored before the styling-direction gizmo existed read as off.
+    #[serde(default)]
+    pub styling_gizmo: bool,
     pub strands_per_bundle: u32,
     pub precision: Precision,
     pub filtering: Filtering,
@@ -41,6 +44,7 @@ impl SavedView {
             wireframe: settings.wireframe,
             frame_glyphs: settings.frame_glyphs,
             gizmo: settings.gizmo,
+            styling_gizmo: settings.styling_gizmo,
             strands_per_bundle: settings.strands_per_bundle,
             precision: settings.precision,
             filtering: settings.filtering,
@@ -59,6 +63,7 @@ impl SavedView {
         settings.wireframe = self.wireframe;
         settings.frame_glyphs = self.frame_glyphs;
         settings.gizmo = self.gizmo;
+        settings.styling_gizmo = self.styling_gizmo;
         settings.strands_per_bundle = self.strands_per_bundle;
         settings.precision = self.precision;
         settings.filtering = self.filtering;

@@ -11,6 +11,9 @@
 //! selects with the box, lasso or paint brush (shift adds, ctrl removes). A selects all,
 //! alt+A none, ctrl +/- grows / shrinks, Tab switches bundles / vertices.
 //!
+//! Styling directions (View ▸ Styling-direction gizmo, `styling_gizmo.rs`): at the selected
+//! bundles' roots, drag the wave arrow, the twist ring or the curl ring; one undo step each.
+//!
 //! Transform (modal, like Blender): G moves, R rotates, S scales the selection following
 //! the pointer, E extrudes the selected bundles with the pointer setting the distance; X / Y / Z lock an axis, the wheel changes the soft-selection radius; a click
 //! or Enter confirms (one undo step), Esc or a right-click cancels. Interior vertices follow
@@ -25,6 +28,8 @@ mod input;
 mod overlay;
 mod paint;
 mod settings;
+mod styling_gizmo;
+pub use styling_gizmo::{StylingGizmoHandles, StylingHandle};
 mod transform_tools;
 
 use std::sync::Arc;
@@ -63,6 +68,9 @@ pub struct ViewSettings {
     pub frame_glyphs: bool,
     /// Show the move / rotate / scale gizmo at the selection.
     pub gizmo: bool,
+    /// Show the styling-direction gizmo (wave, twist, curl) at the selected bundles'
+    /// roots instead of the move gizmo.
+    pub styling_gizmo: bool,
     pub strands_per_bundle: u32,
     pub precision: Precision,
     pub filtering: Filtering,
@@ -75,6 +83,7 @@ impl Default for ViewSettings {
             wireframe: false,
             frame_glyphs: false,
             gizmo: true,
+            styling_gizmo: false,
             strands_per_bundle: 32,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -165,6 +174,10 @@ pub struct Viewport {
     gizmo_shown: bool,
     /// Where the gizmo's centre was drawn last (tests drag it).
     pub gizmo_centre: Option<egui::Pos2>,
+    /// A drag on a styling-direction gizmo handle (a modal tool while it runs).
+    styling_drag: Option<styling_gizmo::StylingDrag>,
+    /// Where the styling-direction gizmo's handles were drawn last (tests drag them).
+    pub styling_handles: Option<StylingGizmoHandles>,
     /// The vertices a running gizmo drag moves and its pivot (fixed when it began).
     gizmo_drag: Option<(Vec<VertexRef>, Option<DVec3>)>,
     /// What the selection transforms and its centre, for the selection key it was computed
@@ -273,6 +286,8 @@ impl Viewport {
             gizmo: GizmoAdapter::default(),
             gizmo_shown: false,
             gizmo_drag: None,
+            styling_drag: None,
+            styling_handles: None,
             targets_cache: None,
             gizmo_centre: None,
             accuracy: None,
@@ -312,9 +327,20 @@ impl Viewport {
         if let Some(projector) = self.projector(state, rect) {
             if self.transform.is_some() {
                 self.drive_transform(ui, state, &response, projector);
+            } else if self.styling_drag.is_some() {
+                // A modal drag: the pointer and Esc are the gizmo's until it is let go.
+                self.drive_styling_gizmo(ui, state, &response, projector);
             } else {
                 self.navigate(ui, &response);
-                if !self.drive_gizmo(ui, state, &response, projector) {
+                let grabbed = if self.settings.styling_gizmo {
+                    self.gizmo_shown = false;
+                    self.gizmo_centre = None;
+                    self.drive_styling_gizmo(ui, state, &response, projector)
+                } else {
+                    self.styling_handles = None;
+                    self.drive_gizmo(ui, state, &response, projector)
+                };
+                if !grabbed {
                     self.select(ui, state, &response, projector);
                 }
                 self.keys(ui, state, &response);

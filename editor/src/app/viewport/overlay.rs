@@ -180,6 +180,12 @@ impl Viewport {
         if self.gizmo_shown && self.transform.is_none() {
             self.gizmo.paint(&painter);
         }
+        if self.settings.styling_gizmo
+            && self.transform.is_none()
+            && let Some(projector) = self.projector(state, rect)
+        {
+            self.paint_styling_gizmo(&painter, state, &projector);
+        }
         let orange = egui::Color32::from_rgb(255, 150, 40);
         for v in &state.vertex_selection {
             if let Some(at) = mesh.position(*v).and_then(project) {

@@ -252,7 +252,10 @@ pub(super) fn describe_transform(
 impl Viewport {
     /// The modal tool running (G / R / S / E), which owns the keyboard until it ends.
     pub fn modal_tool(&self) -> Option<&'static str> {
-        self.transform.as_ref().map(|t| t.kind.label())
+        self.transform
+            .as_ref()
+            .map(|t| t.kind.label())
+            .or_else(|| self.styling_drag().map(|h| h.label()))
     }
 
     pub(super) fn begin_transform(
