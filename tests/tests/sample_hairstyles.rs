@@ -165,3 +165,192 @@ fn strand_density_falls_off_over_the_hairline() {
         assert_eq!(densest, 32, "{name}: full bundles grow every strand");
     }
 }
+
+/// An orthographic view for the coverage measurement: pixel `(i, j)` of `size` × `size`
+/// pixels of `pixel_m` around `centre`, depth growing toward the camera.
+struct OrthoView {
+    right: DVec3,
+    up: DVec3,
+    toward_camera: DVec3,
+    centre: DVec3,
+    pixel_m: f64,
+    size: usize,
+}
+
+impl OrthoView {
+    /// Continuous pixel coordinates and depth of `p`.
+    fn project(&self, p: DVec3) -> (f64, f64, f64) {
+        let d = p - self.centre;
+        (
+            d.dot(self.right) / self.pixel_m + self.size as f64 / 2.0,
+            -d.dot(self.up) / self.pixel_m + self.size as f64 / 2.0,
+            d.dot(self.toward_camera),
+        )
+    }
+
+    /// Rasterises triangle `t`, keeping the nearest depth per pixel in `depth`.
+    fn triangle(&self, t: [DVec3; 3], depth: &mut [f64]) {
+        let [a, b, c] = t.map(|p| self.project(p));
+        let area = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
+        if area.abs() < 1e-12 {
+            return;
+        }
+        let n = self.size as f64;
+        let (x0, x1) = (a.0.min(b.0).min(c.0).max(0.0), a.0.max(b.0).max(c.0).min(n - 1.0));
+        let (y0, y1) = (a.1.min(b.1).min(c.1).max(0.0), a.1.max(b.1).max(c.1).min(n - 1.0));
+        for y in y0.floor() as usize..=y1.ceil().min(n - 1.0) as usize {
+            for x in x0.floor() as usize..=x1.ceil().min(n - 1.0) as usize {
+                let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+                let w0 = ((b.0 - px) * (c.1 - py) - (b.1 - py) * (c.0 - px)) / area;
+                let w1 = ((c.0 - px) * (a.1 - py) - (c.1 - py) * (a.0 - px)) / area;
+                let w2 = 1.0 - w0 - w1;
+                if w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0 {
+                    let z = w0 * a.2 + w1 * b.2 + w2 * c.2;
+                    let slot = &mut depth[y * self.size + x];
+                    *slot = slot.max(z);
+                }
+            }
+        }
+    }
+}
+
+/// From the front, the side and the back, no bald patch shows where hair grows: of the
+/// scalp the camera sees (root faces of growing bundles, not hidden by the face or ears),
+/// at least 97% lies under a strand that is in front of it, and the largest bare region is
+/// under 0.5 cm² (a bald patch a viewer would notice is several cm²). 2 mm pixels, 32
+/// strands per bundle. The rim bundles' thinning (a third of the strands) is what the
+/// remaining bare pixels mostly are.
+#[test]
+fn hair_covers_the_scalp_seen_from_front_side_and_back() {
+    const PIXEL_M: f64 = 0.002;
+    const MIN_COVERED: f64 = 0.97;
+    const MAX_BARE_CM2: f64 = 0.5;
+    for (name, document) in head_samples() {
+        let options = StrandOptions {
+            strands_per_bundle: 32,
+            vertices_log2: 4,
+            ..StrandOptions::default()
+        };
+        let strands = generate(&document, &options);
+        let mesh = &document.hair_mesh;
+        let (lo, hi) = mesh.bounds().expect("hair bounds");
+        let centre = (lo + hi) / 2.0;
+        let size = ((hi - lo).max_element() * 1.3 / PIXEL_M).ceil() as usize;
+        let body: Vec<DVec3> = document
+            .body
+            .positions
+            .iter()
+            .map(|p| glam::Vec3::from_array(*p).as_dvec3())
+            .collect();
+        for (view_name, toward_camera) in [
+            ("front", DVec3::Z),
+            ("side", DVec3::X),
+            ("back", DVec3::NEG_Z),
+        ] {
+            let right = DVec3::Y.cross(toward_camera);
+            let view = OrthoView {
+                right,
+                up: DVec3::Y,
+                toward_camera,
+                centre,
+                pixel_m: PIXEL_M,
+                size,
+            };
+            let mut body_depth = vec![f64::NEG_INFINITY; size * size];
+            for t in &document.body.triangles {
+                view.triangle(t.map(|i| body[i as usize]), &mut body_depth);
+            }
+            let mut scalp_depth = vec![f64::NEG_INFINITY; size * size];
+            for bundle in mesh.bundles.iter().filter(|b| !b.removed && b.density > 0.0) {
+                let root: Vec<DVec3> = bundle
+                    .vertices
+                    .iter()
+                    .map(|&c| mesh.columns[c as usize].positions[0])
+                    .collect();
+                for k in 1..root.len() - 1 {
+                    view.triangle([root[0], root[k], root[k + 1]], &mut scalp_depth);
+                }
+            }
+            // Visible scalp: the root faces where they are the body's front surface.
+            let visible: Vec<bool> = scalp_depth
+                .iter()
+                .zip(&body_depth)
+                .map(|(s, b)| s.is_finite() && *s >= b - 0.003)
+                .collect();
+            let mut covered = vec![false; size * size];
+            for strand in &strands {
+                for segment in strand.points.windows(2) {
+                    let (a, b) = (view.project(segment[0]), view.project(segment[1]));
+                    let steps = ((b.0 - a.0).hypot(b.1 - a.1) * 2.0).ceil().max(1.0) as usize;
+                    for s in 0..=steps {
+                        let f = s as f64 / steps as f64;
+                        let (x, y, z) = (
+                            a.0 + (b.0 - a.0) * f,
+                            a.1 + (b.1 - a.1) * f,
+                            a.2 + (b.2 - a.2) * f,
+                        );
+                        if x < 0.0 || y < 0.0 || x >= size as f64 || y >= size as f64 {
+                            continue;
+                        }
+                        let i = y as usize * size + x as usize;
+                        // Hair in front of the surface seen there (not behind the head).
+                        if z >= body_depth[i] - 0.002 {
+                            covered[i] = true;
+                        }
+                    }
+                }
+            }
+            let scalp_pixels = visible.iter().filter(|v| **v).count();
+            let bare: Vec<bool> = (0..size * size).map(|i| visible[i] && !covered[i]).collect();
+            let fraction = 1.0 - bare.iter().filter(|b| **b).count() as f64 / scalp_pixels as f64;
+            // The largest 4-connected bare region.
+            let mut seen = vec![false; size * size];
+            let mut largest = 0usize;
+            for start in 0..size * size {
+                if !bare[start] || seen[start] {
+                    continue;
+                }
+                let (mut stack, mut count) = (vec![start], 0usize);
+                seen[start] = true;
+                while let Some(i) = stack.pop() {
+                    count += 1;
+                    let (x, y) = (i % size, i / size);
+                    let mut visit = |j: usize| {
+                        if bare[j] && !seen[j] {
+                            seen[j] = true;
+                            stack.push(j);
+                        }
+                    };
+                    if x > 0 {
+                        visit(i - 1);
+                    }
+                    if x + 1 < size {
+                        visit(i + 1);
+                    }
+                    if y > 0 {
+                        visit(i - size);
+                    }
+                    if y + 1 < size {
+                        visit(i + size);
+                    }
+                }
+                largest = largest.max(count);
+            }
+            let largest_cm2 = largest as f64 * PIXEL_M * PIXEL_M * 1e4;
+            eprintln!(
+                "{name} {view_name}: {scalp_pixels} scalp pixels, {:.2}% covered, largest bare region {largest_cm2:.2} cm²",
+                fraction * 100.0
+            );
+            assert!(scalp_pixels > 500, "{name} {view_name}: {scalp_pixels} scalp pixels seen");
+            assert!(
+                fraction >= MIN_COVERED,
+                "{name} {view_name}: only {:.2}% of the visible scalp is under hair",
+                fraction * 100.0
+            );
+            assert!(
+                largest_cm2 < MAX_BARE_CM2,
+                "{name} {view_name}: a bare patch of {largest_cm2:.2} cm²"
+            );
+        }
+    }
+}

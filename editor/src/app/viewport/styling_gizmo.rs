@@ -395,8 +395,8 @@ impl Viewport {
         });
         let curl = match axes.curl_sense(params.curl.turns_per_m) {
             s if params.curl.radius_m <= 0.0 || s == 0.0 => "no curl".to_string(),
-            s if s > 0.0 => "curl ↺ about w".to_string(),
-            _ => "curl ↻ about w".to_string(),
+            s if s > 0.0 => "curl counter-clockwise about w".to_string(),
+            _ => "curl clockwise about w".to_string(),
         };
         painter.text(
             projector.rect.left_bottom() + egui::vec2(10.0, -10.0),
