@@ -196,8 +196,14 @@ impl OrthoView {
             return;
         }
         let n = self.size as f64;
-        let (x0, x1) = (a.0.min(b.0).min(c.0).max(0.0), a.0.max(b.0).max(c.0).min(n - 1.0));
-        let (y0, y1) = (a.1.min(b.1).min(c.1).max(0.0), a.1.max(b.1).max(c.1).min(n - 1.0));
+        let (x0, x1) = (
+            a.0.min(b.0).min(c.0).max(0.0),
+            a.0.max(b.0).max(c.0).min(n - 1.0),
+        );
+        let (y0, y1) = (
+            a.1.min(b.1).min(c.1).max(0.0),
+            a.1.max(b.1).max(c.1).min(n - 1.0),
+        );
         for y in y0.floor() as usize..=y1.ceil().min(n - 1.0) as usize {
             for x in x0.floor() as usize..=x1.ceil().min(n - 1.0) as usize {
                 let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
@@ -214,134 +220,159 @@ impl OrthoView {
     }
 }
 
+/// How much of the scalp seen from `toward_camera` lies under hair: the visible scalp's
+/// pixel count, the fraction of it covered by a strand in front of it, and the largest
+/// 4-connected bare region (cm²). 2 mm pixels, orthographic.
+fn scalp_coverage(
+    document: &Document,
+    strands: &[hairloom_core::strands::reference::Strand],
+    toward_camera: DVec3,
+) -> (usize, f64, f64) {
+    const PIXEL_M: f64 = 0.002;
+    let mesh = &document.hair_mesh;
+    let (lo, hi) = mesh.bounds().expect("hair bounds");
+    let centre = (lo + hi) / 2.0;
+    let size = ((hi - lo).max_element() * 1.3 / PIXEL_M).ceil() as usize;
+    let body: Vec<DVec3> = document
+        .body
+        .positions
+        .iter()
+        .map(|p| glam::Vec3::from_array(*p).as_dvec3())
+        .collect();
+    let view = OrthoView {
+        right: DVec3::Y.cross(toward_camera),
+        up: DVec3::Y,
+        toward_camera,
+        centre,
+        pixel_m: PIXEL_M,
+        size,
+    };
+    let mut body_depth = vec![f64::NEG_INFINITY; size * size];
+    for t in &document.body.triangles {
+        view.triangle(t.map(|i| body[i as usize]), &mut body_depth);
+    }
+    let mut scalp_depth = vec![f64::NEG_INFINITY; size * size];
+    for bundle in mesh
+        .bundles
+        .iter()
+        .filter(|b| !b.removed && b.density > 0.0)
+    {
+        let root: Vec<DVec3> = bundle
+            .vertices
+            .iter()
+            .map(|&c| mesh.columns[c as usize].positions[0])
+            .collect();
+        for k in 1..root.len() - 1 {
+            view.triangle([root[0], root[k], root[k + 1]], &mut scalp_depth);
+        }
+    }
+    // Visible scalp: the root faces where they are the body's front surface.
+    let visible: Vec<bool> = scalp_depth
+        .iter()
+        .zip(&body_depth)
+        .map(|(s, b)| s.is_finite() && *s >= b - 0.003)
+        .collect();
+    let mut covered = vec![false; size * size];
+    for strand in strands {
+        for segment in strand.points.windows(2) {
+            let (a, b) = (view.project(segment[0]), view.project(segment[1]));
+            let steps = ((b.0 - a.0).hypot(b.1 - a.1) * 2.0).ceil().max(1.0) as usize;
+            for s in 0..=steps {
+                let f = s as f64 / steps as f64;
+                let (x, y, z) = (
+                    a.0 + (b.0 - a.0) * f,
+                    a.1 + (b.1 - a.1) * f,
+                    a.2 + (b.2 - a.2) * f,
+                );
+                if x < 0.0 || y < 0.0 || x >= size as f64 || y >= size as f64 {
+                    continue;
+                }
+                let i = y as usize * size + x as usize;
+                // Hair in front of the surface seen there (not behind the head).
+                if z >= body_depth[i] - 0.002 {
+                    covered[i] = true;
+                }
+            }
+        }
+    }
+    let scalp_pixels = visible.iter().filter(|v| **v).count();
+    let bare: Vec<bool> = (0..size * size)
+        .map(|i| visible[i] && !covered[i])
+        .collect();
+    let fraction = 1.0 - bare.iter().filter(|b| **b).count() as f64 / scalp_pixels.max(1) as f64;
+    let mut seen = vec![false; size * size];
+    let mut largest = 0usize;
+    for start in 0..size * size {
+        if !bare[start] || seen[start] {
+            continue;
+        }
+        let (mut stack, mut count) = (vec![start], 0usize);
+        seen[start] = true;
+        while let Some(i) = stack.pop() {
+            count += 1;
+            let (x, y) = (i % size, i / size);
+            let mut visit = |j: usize| {
+                if bare[j] && !seen[j] {
+                    seen[j] = true;
+                    stack.push(j);
+                }
+            };
+            if x > 0 {
+                visit(i - 1);
+            }
+            if x + 1 < size {
+                visit(i + 1);
+            }
+            if y > 0 {
+                visit(i - size);
+            }
+            if y + 1 < size {
+                visit(i + size);
+            }
+        }
+        largest = largest.max(count);
+    }
+    (
+        scalp_pixels,
+        fraction,
+        largest as f64 * PIXEL_M * PIXEL_M * 1e4,
+    )
+}
+
 /// From the front, the side and the back, no bald patch shows where hair grows: of the
 /// scalp the camera sees (root faces of growing bundles, not hidden by the face or ears),
-/// at least 97% lies under a strand that is in front of it, and the largest bare region is
-/// under 0.5 cm² (a bald patch a viewer would notice is several cm²). 2 mm pixels, 32
-/// strands per bundle. The rim bundles' thinning (a third of the strands) is what the
-/// remaining bare pixels mostly are.
+/// at least 97% lies under a strand in front of it, and the largest bare region is under
+/// 0.5 cm² (a bald patch a viewer notices is several cm²). 32 strands per bundle. Measured
+/// (2026-12-04): 97.8-100% covered, largest bare region 0.32 cm² (short straight, side);
+/// the rim bundles' thinning is most of what stays bare. A control proves the measurement
+/// sees a bald patch: without the strands of the short cut's bundles rooted within 4 cm of
+/// the scalp point nearest the side camera, the side view shows one.
 #[test]
 fn hair_covers_the_scalp_seen_from_front_side_and_back() {
-    const PIXEL_M: f64 = 0.002;
     const MIN_COVERED: f64 = 0.97;
     const MAX_BARE_CM2: f64 = 0.5;
+    let options = StrandOptions {
+        strands_per_bundle: 32,
+        vertices_log2: 4,
+        ..StrandOptions::default()
+    };
     for (name, document) in head_samples() {
-        let options = StrandOptions {
-            strands_per_bundle: 32,
-            vertices_log2: 4,
-            ..StrandOptions::default()
-        };
         let strands = generate(&document, &options);
-        let mesh = &document.hair_mesh;
-        let (lo, hi) = mesh.bounds().expect("hair bounds");
-        let centre = (lo + hi) / 2.0;
-        let size = ((hi - lo).max_element() * 1.3 / PIXEL_M).ceil() as usize;
-        let body: Vec<DVec3> = document
-            .body
-            .positions
-            .iter()
-            .map(|p| glam::Vec3::from_array(*p).as_dvec3())
-            .collect();
         for (view_name, toward_camera) in [
             ("front", DVec3::Z),
             ("side", DVec3::X),
             ("back", DVec3::NEG_Z),
         ] {
-            let right = DVec3::Y.cross(toward_camera);
-            let view = OrthoView {
-                right,
-                up: DVec3::Y,
-                toward_camera,
-                centre,
-                pixel_m: PIXEL_M,
-                size,
-            };
-            let mut body_depth = vec![f64::NEG_INFINITY; size * size];
-            for t in &document.body.triangles {
-                view.triangle(t.map(|i| body[i as usize]), &mut body_depth);
-            }
-            let mut scalp_depth = vec![f64::NEG_INFINITY; size * size];
-            for bundle in mesh.bundles.iter().filter(|b| !b.removed && b.density > 0.0) {
-                let root: Vec<DVec3> = bundle
-                    .vertices
-                    .iter()
-                    .map(|&c| mesh.columns[c as usize].positions[0])
-                    .collect();
-                for k in 1..root.len() - 1 {
-                    view.triangle([root[0], root[k], root[k + 1]], &mut scalp_depth);
-                }
-            }
-            // Visible scalp: the root faces where they are the body's front surface.
-            let visible: Vec<bool> = scalp_depth
-                .iter()
-                .zip(&body_depth)
-                .map(|(s, b)| s.is_finite() && *s >= b - 0.003)
-                .collect();
-            let mut covered = vec![false; size * size];
-            for strand in &strands {
-                for segment in strand.points.windows(2) {
-                    let (a, b) = (view.project(segment[0]), view.project(segment[1]));
-                    let steps = ((b.0 - a.0).hypot(b.1 - a.1) * 2.0).ceil().max(1.0) as usize;
-                    for s in 0..=steps {
-                        let f = s as f64 / steps as f64;
-                        let (x, y, z) = (
-                            a.0 + (b.0 - a.0) * f,
-                            a.1 + (b.1 - a.1) * f,
-                            a.2 + (b.2 - a.2) * f,
-                        );
-                        if x < 0.0 || y < 0.0 || x >= size as f64 || y >= size as f64 {
-                            continue;
-                        }
-                        let i = y as usize * size + x as usize;
-                        // Hair in front of the surface seen there (not behind the head).
-                        if z >= body_depth[i] - 0.002 {
-                            covered[i] = true;
-                        }
-                    }
-                }
-            }
-            let scalp_pixels = visible.iter().filter(|v| **v).count();
-            let bare: Vec<bool> = (0..size * size).map(|i| visible[i] && !covered[i]).collect();
-            let fraction = 1.0 - bare.iter().filter(|b| **b).count() as f64 / scalp_pixels as f64;
-            // The largest 4-connected bare region.
-            let mut seen = vec![false; size * size];
-            let mut largest = 0usize;
-            for start in 0..size * size {
-                if !bare[start] || seen[start] {
-                    continue;
-                }
-                let (mut stack, mut count) = (vec![start], 0usize);
-                seen[start] = true;
-                while let Some(i) = stack.pop() {
-                    count += 1;
-                    let (x, y) = (i % size, i / size);
-                    let mut visit = |j: usize| {
-                        if bare[j] && !seen[j] {
-                            seen[j] = true;
-                            stack.push(j);
-                        }
-                    };
-                    if x > 0 {
-                        visit(i - 1);
-                    }
-                    if x + 1 < size {
-                        visit(i + 1);
-                    }
-                    if y > 0 {
-                        visit(i - size);
-                    }
-                    if y + 1 < size {
-                        visit(i + size);
-                    }
-                }
-                largest = largest.max(count);
-            }
-            let largest_cm2 = largest as f64 * PIXEL_M * PIXEL_M * 1e4;
+            let (scalp_pixels, fraction, largest_cm2) =
+                scalp_coverage(&document, &strands, toward_camera);
             eprintln!(
                 "{name} {view_name}: {scalp_pixels} scalp pixels, {:.2}% covered, largest bare region {largest_cm2:.2} cm²",
                 fraction * 100.0
             );
-            assert!(scalp_pixels > 500, "{name} {view_name}: {scalp_pixels} scalp pixels seen");
+            assert!(
+                scalp_pixels > 500,
+                "{name} {view_name}: {scalp_pixels} scalp pixels seen"
+            );
             assert!(
                 fraction >= MIN_COVERED,
                 "{name} {view_name}: only {:.2}% of the visible scalp is under hair",
@@ -352,5 +383,33 @@ fn hair_covers_the_scalp_seen_from_front_side_and_back() {
                 "{name} {view_name}: a bare patch of {largest_cm2:.2} cm²"
             );
         }
+        // The control: a shaved patch over the ear is seen on the short cut (on longer hair,
+        // hair from above lies over it, as it would on a head).
+        if name != "head_short_straight" {
+            continue;
+        }
+        let mesh = &document.hair_mesh;
+        let root_centre = |b: u32| {
+            hairloom_core::edit::bundle_layer_centre(mesh, &mesh.bundles[b as usize], 0)
+                .expect("root centre")
+        };
+        let side_most = (0..mesh.bundles.len() as u32)
+            .map(root_centre)
+            .max_by(|a, b| a.x.total_cmp(&b.x))
+            .expect("a bundle");
+        let shaved: Vec<_> = strands
+            .iter()
+            .filter(|s| root_centre(s.bundle).distance(side_most) > 0.04)
+            .cloned()
+            .collect();
+        let (_, fraction, largest_cm2) = scalp_coverage(&document, &shaved, DVec3::X);
+        eprintln!(
+            "{name} side, shaved 4 cm around {side_most}: {:.2}% covered, largest bare region {largest_cm2:.2} cm²",
+            fraction * 100.0
+        );
+        assert!(
+            largest_cm2 > MAX_BARE_CM2,
+            "{name}: the shaved patch went unseen ({largest_cm2:.2} cm²)"
+        );
     }
 }
