@@ -486,8 +486,9 @@ fn root_normals(mesh: &HairMesh) -> Vec<DVec3> {
         .collect()
 }
 
-/// The head hairstyles: a short crop, wavy shoulder-length hair and curls.
-pub const HEAD_STYLES: [(&str, Growth); 3] = [
+/// The head hairstyles: a short crop, wavy shoulder-length hair, curls and long straight
+/// hair (the last draped: see [`DRAPED_STYLES`]).
+pub const HEAD_STYLES: [(&str, Growth); 4] = [
     (
         "head_short_straight",
         Growth {
@@ -521,7 +522,25 @@ pub const HEAD_STYLES: [(&str, Growth); 3] = [
             cut: None,
         },
     ),
+    (
+        "head_long_straight",
+        Growth {
+            layers: 7,
+            step_m: 0.05,
+            gravity: 1.0,
+            volume: 0.03,
+            cut: Some(Cut {
+                back_y_m: -0.26,
+                front_y_m: -0.2,
+            }),
+        },
+    ),
 ];
+
+/// The styles whose combed mesh is then draped (`simulate::drape`): the hair falls under
+/// gravity onto the head and shoulders and settles, so long hair rests where it lands
+/// instead of where the comb put it.
+pub const DRAPED_STYLES: [&str; 1] = ["head_long_straight"];
 
 /// The styling of each head sample.
 pub(crate) fn head_style(name: &str) -> StylingParams {
@@ -541,6 +560,22 @@ pub(crate) fn head_style(name: &str) -> StylingParams {
         ..StylingParams::default()
     };
     match name {
+        // Straight and sleek: less noise, tighter clumps.
+        "head_long_straight" => StylingParams {
+            noise: Noise {
+                amplitude_m: 0.001,
+                frequency_per_m: 8.0,
+                octaves: 2,
+            },
+            clump: Clump {
+                strength: 0.45,
+                clumps_per_uv: 70.0,
+                radius_m: 0.005,
+                tightening: 2.0,
+            },
+            length: LengthVariation { fraction: 0.08 },
+            ..base
+        },
         "head_long_wavy" => StylingParams {
             wave: Wave {
                 amplitude_m: 0.008,
@@ -588,6 +623,15 @@ pub(crate) fn head_material(name: &str) -> HairMaterial {
             },
             ..base
         },
+        // Light brown.
+        "head_long_straight" => HairMaterial {
+            pigment: Pigment::Melanin {
+                eumelanin: 0.55,
+                pheomelanin: 0.35,
+            },
+            longitudinal_roughness: 0.2,
+            ..base
+        },
         // Near black, a little smoother.
         "head_short_straight" => HairMaterial {
             pigment: Pigment::Melanin {
@@ -610,6 +654,18 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
         .map(|(name, growth)| {
             let shaped = grow(&scalp, *growth, radii_m);
             let mut mesh = keep_out_of_body(&shaped, &body);
+            if DRAPED_STYLES.contains(name) {
+                // A drape that cannot run (it only refuses an empty or invalid mesh, which
+                // the comb never makes) leaves the combed mesh: still a valid sample.
+                if let Ok((outcome, _)) = crate::simulate::drape(&mesh, &body, &[], &[]) {
+                    mesh = outcome.mesh;
+                    // The drape keeps the vertices out; the curves between them are lifted
+                    // clear as for every sample.
+                    let sdf = crate::simulate::body_sdf::BodySdf::for_hair(&body, &mesh);
+                    lift_curves_out_of_body(&mut mesh, &sdf, CURVE_CLEARANCE_M);
+                    mesh.update_w();
+                }
+            }
             thin_hairline(&mut mesh, &HAIRLINE_DENSITY);
             let mut document = Document::new(*name, mesh);
             document.styling.global = head_style(name);
