@@ -561,7 +561,7 @@ pub(crate) fn head_style(name: &str) -> StylingParams {
     };
     match name {
         // Straight and sleek: less noise, tighter clumps.
-        "head_long_straight" => StylingParams {
+        "head_long_straight" | "head_ponytail" => StylingParams {
             noise: Noise {
                 amplitude_m: 0.001,
                 frequency_per_m: 8.0,
@@ -632,6 +632,15 @@ pub(crate) fn head_material(name: &str) -> HairMaterial {
             longitudinal_roughness: 0.2,
             ..base
         },
+        // Dark brown.
+        "head_ponytail" => HairMaterial {
+            pigment: Pigment::Melanin {
+                eumelanin: 1.4,
+                pheomelanin: 0.3,
+            },
+            longitudinal_roughness: 0.22,
+            ..base
+        },
         // Near black, a little smoother.
         "head_short_straight" => HairMaterial {
             pigment: Pigment::Melanin {
@@ -645,29 +654,163 @@ pub(crate) fn head_material(name: &str) -> HairMaterial {
     }
 }
 
+/// A ponytail: all hair gathered over the scalp to a tie at the back of the head, then a
+/// tail hanging from it.
+#[derive(Clone, Copy, Debug)]
+pub struct Ponytail {
+    /// Layers from the scalp to the tie (the hair lying on the scalp).
+    pub gather_layers: u32,
+    /// Layers of the tail below the tie.
+    pub tail_layers: u32,
+    pub tail_step_m: f64,
+    /// Where the tie sits: a direction from the cranium's centre in the cranium ellipsoid's
+    /// unit-sphere space (x right, y up, z front).
+    pub tie_direction: DVec3,
+    /// The tie's radius as an angle on that unit sphere.
+    pub tie_radius_rad: f64,
+}
+
+/// The ponytail sample: gathered a little above the occipital bone, a 30 cm tail.
+pub const HEAD_PONYTAIL: (&str, Ponytail) = (
+    "head_ponytail",
+    Ponytail {
+        gather_layers: 6,
+        tail_layers: 6,
+        tail_step_m: 0.05,
+        tie_direction: DVec3::new(0.0, 0.0, -1.0),
+        tie_radius_rad: 0.3,
+    },
+);
+
+/// Gathers `scalp` into a ponytail: each column runs over the cranium ellipsoid (`radii_m`)
+/// along the great circle from its root to its own place in the tie — an azimuthal
+/// equidistant map of the scalp around the tie, so neighbouring roots stay neighbours and no
+/// bundle folds over — lifted a little more the farther it came (front hair lies over back
+/// hair at the tie), then hangs from the tie as a tapering tail. Every vertex is placed, so
+/// interior vertices are locked where they were put, as for cut hair.
+pub fn gather_ponytail(scalp: &HairMesh, tail: Ponytail, radii_m: DVec3) -> HairMesh {
+    let all: Vec<u32> = (0..scalp.bundles.len() as u32).collect();
+    let mut mesh = scalp.clone();
+    for _ in 0..tail.gather_layers + tail.tail_layers {
+        match extrude(
+            &mesh,
+            &all,
+            ExtrudeDirection::AlongNormal { distance: 0.01 },
+        ) {
+            Ok(outcome) => mesh = outcome.mesh,
+            Err(_) => return mesh,
+        }
+    }
+    let tie = tail.tie_direction.normalize();
+    let e1 = DVec3::X.reject_from_normalized(tie).normalize();
+    let e2 = tie.cross(e1);
+    // Each root's angle from the tie and its azimuth about it.
+    let polar = |root: DVec3| {
+        let s = (root / radii_m).normalize_or(tie);
+        let angle = s.dot(tie).clamp(-1.0, 1.0).acos();
+        (angle, s.dot(e2).atan2(s.dot(e1)))
+    };
+    let farthest = mesh
+        .columns
+        .iter()
+        .map(|c| polar(c.positions[0]).0)
+        .fold(1e-6, f64::max);
+    let on_sphere = |angle: f64, azimuth: f64| {
+        tie * angle.cos() + (e1 * azimuth.cos() + e2 * azimuth.sin()) * angle.sin()
+    };
+    let gather = tail.gather_layers as usize;
+    let tie_centre = tie * radii_m * 1.06;
+    for column in &mut mesh.columns {
+        let root = column.positions[0];
+        let (angle, azimuth) = polar(root);
+        let reach = angle / farthest;
+        let start = (root / radii_m).normalize_or(tie);
+        let end = on_sphere(tail.tie_radius_rad * reach.sqrt(), azimuth);
+        let mut positions = vec![root];
+        for k in 1..=gather {
+            let f = k as f64 / gather as f64;
+            let direction = slerp(start, end, f);
+            // Lifted off the ellipsoid a little, more the farther the hair has come.
+            let lift = 1.0 + 0.04 * reach * f;
+            positions.push(direction * radii_m * lift);
+        }
+        // The tail: out from the tie, turning down, tapering.
+        let offset = positions[gather] - tie_centre;
+        let mut centre = tie_centre;
+        for j in 1..=tail.tail_layers as usize {
+            let turn = (j as f64 / 2.0).min(1.0);
+            let direction = (tie * (1.0 - turn) - DVec3::Y * (0.3 + turn)).normalize();
+            centre += direction * tail.tail_step_m;
+            let taper = 1.0 - 0.3 * j as f64 / tail.tail_layers as f64;
+            // The tie's cross-section turns with the tail, so the tail stays round
+            // instead of flattening into a ribbon as it turns down.
+            let turned = glam::DQuat::from_rotation_arc(tie, direction) * offset;
+            positions.push(centre + turned * taper);
+        }
+        column.positions = positions;
+    }
+    let topology = crate::model::mesh::Topology::build(&mesh);
+    let interior: Vec<VertexRef> = crate::edit::select::bundle_vertices_above_root(&mesh, &all)
+        .into_iter()
+        .filter(|v| mesh.is_interior(&topology, v.column as usize, v.layer as usize))
+        .collect();
+    mesh.set_locked(&interior, true);
+    mesh.update_w();
+    mesh
+}
+
+/// Spherical interpolation between unit vectors (linear where they nearly coincide).
+fn slerp(a: DVec3, b: DVec3, t: f64) -> DVec3 {
+    let angle = a.dot(b).clamp(-1.0, 1.0).acos();
+    if angle < 1e-6 {
+        return a.lerp(b, t).normalize_or(a);
+    }
+    (a * ((1.0 - t) * angle).sin() + b * (t * angle).sin()) / angle.sin()
+}
+
 /// Builds the head sample projects from the scan's GLB bytes.
 pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> {
     let (scalp, body) = head_scalp(glb)?;
     let radii_m = HEAD_CRANIUM_RADII * HEAD_SCALE;
-    Ok(HEAD_STYLES
+    // Lets the hair fall and settle, keeping `held` where it is, then lifts the curves
+    // between vertices clear of the body as for every sample. A drape that cannot run (it
+    // only refuses an empty or invalid mesh, which the builders never make) leaves the mesh
+    // as it was: still a valid sample.
+    let drape = |mesh: &mut HairMesh, held: &[VertexRef]| {
+        if let Ok((outcome, _)) = crate::simulate::drape(mesh, &body, &[], held) {
+            *mesh = outcome.mesh;
+            let sdf = crate::simulate::body_sdf::BodySdf::for_hair(&body, mesh);
+            lift_curves_out_of_body(mesh, &sdf, CURVE_CLEARANCE_M);
+            mesh.update_w();
+        }
+    };
+    let mut meshes: Vec<(&str, HairMesh)> = HEAD_STYLES
         .iter()
         .map(|(name, growth)| {
             let shaped = grow(&scalp, *growth, radii_m);
             let mut mesh = keep_out_of_body(&shaped, &body);
             if DRAPED_STYLES.contains(name) {
-                // A drape that cannot run (it only refuses an empty or invalid mesh, which
-                // the comb never makes) leaves the combed mesh: still a valid sample.
-                if let Ok((outcome, _)) = crate::simulate::drape(&mesh, &body, &[], &[]) {
-                    mesh = outcome.mesh;
-                    // The drape keeps the vertices out; the curves between them are lifted
-                    // clear as for every sample.
-                    let sdf = crate::simulate::body_sdf::BodySdf::for_hair(&body, &mesh);
-                    lift_curves_out_of_body(&mut mesh, &sdf, CURVE_CLEARANCE_M);
-                    mesh.update_w();
-                }
+                drape(&mut mesh, &[]);
             }
+            (*name, mesh)
+        })
+        .collect();
+    // The ponytail: gathered, kept out of the head, and the tail draped from the tie (the
+    // gathered layers held, like vertices an artist locked).
+    let (name, ponytail) = HEAD_PONYTAIL;
+    let mut mesh = keep_out_of_body(&gather_ponytail(&scalp, ponytail, radii_m), &body);
+    let held: Vec<VertexRef> = (0..mesh.columns.len() as u32)
+        .flat_map(|column| {
+            (0..=ponytail.gather_layers).map(move |layer| VertexRef { column, layer })
+        })
+        .collect();
+    drape(&mut mesh, &held);
+    meshes.push((name, mesh));
+    Ok(meshes
+        .into_iter()
+        .map(|(name, mut mesh)| {
             thin_hairline(&mut mesh, &HAIRLINE_DENSITY);
-            let mut document = Document::new(*name, mesh);
+            let mut document = Document::new(name, mesh);
             document.styling.global = head_style(name);
             document.scene.material = head_material(name);
             document.source = HEAD_CREDIT.to_string();
