@@ -408,9 +408,13 @@ fn the_styling_direction_gizmo_is_drawn_at_the_selected_roots() {
             }
         }
     }
-    harness.state_mut().state.selection.clear();
-    let before = viewport_image(&mut harness);
+    // The same selection with the gizmo off and on: only the gizmo differs.
     harness.state_mut().state.selection = [best.1].into();
+    harness.state_mut().viewport.settings.styling_gizmo = false;
+    // The outliner scrolls to the picked bundle over a few frames.
+    harness.run_steps(30);
+    let before = viewport_image(&mut harness);
+    harness.state_mut().viewport.settings.styling_gizmo = true;
     let after = viewport_image(&mut harness);
     after
         .save(root().join("target/editor-styling-gizmo.png"))

@@ -131,6 +131,33 @@ pub fn tip_twist_rad(turns_per_m: f64, length_m: f64) -> f64 {
 }
 
 impl StylingAxes {
+    /// +1 when û × v̂ points along ŵ, −1 when against it (a mirrored uv layout). Generation
+    /// twists about û × v̂, so a twist seen about ŵ turns by this sign.
+    pub fn uv_sense(&self) -> f64 {
+        if self.u.cross(self.v).dot(self.w) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
+    /// How far a twist of `turns_per_m` turns the bundle's tips about ŵ (right-hand rule).
+    pub fn tip_twist_about_w_rad(&self, turns_per_m: f64) -> f64 {
+        self.uv_sense() * tip_twist_rad(turns_per_m, self.length_m)
+    }
+
+    /// The twist rate after a drag swept `swept_rad` about ŵ from a start of
+    /// `start_turns_per_m`: unchanged for no sweep (exactly: a click is no edit), held in the
+    /// valid range; `None` for a bare bundle.
+    pub fn twist_after_sweep(&self, start_turns_per_m: f64, swept_rad: f64) -> Option<f64> {
+        if swept_rad == 0.0 || !swept_rad.is_finite() {
+            return Some(start_turns_per_m);
+        }
+        let change = twist_turns_per_m(self.uv_sense() * swept_rad, self.length_m)?;
+        let (lo, hi) = hard_range("twist.turns_per_m");
+        Some((start_turns_per_m + change).clamp(lo, hi))
+    }
+
     /// Which way a curl of `turns_per_m` winds about ŵ: +1 counter-clockwise seen looking
     /// down ŵ toward the root (the right-hand rule), −1 clockwise, 0 for no curl. The helix
     /// turns from û toward v̂ as w grows, so the sense is the sign of the rate times that of
@@ -139,7 +166,7 @@ impl StylingAxes {
         if turns_per_m == 0.0 || !turns_per_m.is_finite() {
             return 0.0;
         }
-        turns_per_m.signum() * self.u.cross(self.v).dot(self.w).signum()
+        turns_per_m.signum() * self.uv_sense()
     }
 
     /// `turns_per_m` made to wind the way a drag about ŵ swept (its rate kept). A sweep
@@ -340,6 +367,60 @@ mod tests {
         assert_eq!(axes.curl_turns_for_sweep(20.0, 0.5 * sense, 0.1), 20.0);
         assert_eq!(axes.curl_turns_for_sweep(20.0, -0.05 * sense, 0.1), 20.0);
         assert_eq!(axes.curl_turns_for_sweep(20.0, f64::NAN, 0.1), 20.0);
+    }
+
+    #[test]
+    fn the_twist_drawn_about_w_is_the_way_generated_strands_turn_even_with_mirrored_uvs() {
+        for mirrored in [false, true] {
+            let mut mesh = hair_sized(3);
+            if mirrored {
+                // Swap u for its mirror: û × v̂ then points against the hair.
+                for bundle in &mut mesh.bundles {
+                    for uv in &mut bundle.uvs {
+                        uv.x = 1.0 - uv.x;
+                    }
+                }
+            }
+            let mut document = Document::new("grid", mesh);
+            let axes = styling_axes(&document.hair_mesh, &[0]).expect("axes");
+            assert_eq!(axes.uv_sense() < 0.0, mirrored, "{axes:?}");
+            let options = StrandOptions {
+                strands_per_bundle: 8,
+                ..StrandOptions::default()
+            };
+            let plain = generate(&document, &options);
+            // A quarter turn of the tips about ŵ, as the ring would set it.
+            let turns = axes.twist_after_sweep(0.0, FRAC_PI_2).expect("twist");
+            assert!((axes.tip_twist_about_w_rad(turns) - FRAC_PI_2).abs() < 1e-9);
+            document.styling.global.twist.turns_per_m = turns;
+            let twisted = generate(&document, &options);
+            let centre = axes.origin + axes.w * axes.length_m;
+            let (p, t) = plain
+                .iter()
+                .zip(&twisted)
+                .filter(|(s, _)| s.bundle == 0)
+                .max_by(|a, b| {
+                    let d = |s: &crate::strands::reference::Strand| {
+                        s.points.last().map_or(0.0, |p| p.distance(centre))
+                    };
+                    d(a.0).total_cmp(&d(b.0))
+                })
+                .expect("strands of bundle 0");
+            let (from, to) = (
+                *p.points.last().expect("tip") - centre,
+                *t.points.last().expect("tip") - centre,
+            );
+            let turned = swept_about(axes.w, from, to);
+            assert!(
+                (turned - FRAC_PI_2).abs() < 0.15,
+                "mirrored {mirrored}: the tips turned {turned} rad about w, drawn {FRAC_PI_2}"
+            );
+        }
+        // No sweep, no change (bit for bit); a bare bundle cannot twist.
+        let axes = styling_axes(&hair_sized(3), &[0]).expect("axes");
+        assert_eq!(axes.twist_after_sweep(3.0, 0.0), Some(3.0));
+        let bare = styling_axes(&hair_sized(0), &[0]).expect("bare");
+        assert_eq!(bare.twist_after_sweep(3.0, 0.5), None);
     }
 
     #[test]

@@ -119,7 +119,11 @@ pub fn default_layout() -> egui_tiles::Tree<Pane> {
         linear.shares.set_share(left_middle, 1.2);
         linear.shares.set_share(left_bottom, 0.9);
     }
-    let viewport = tiles.insert_pane(Pane::Viewport);
+    // In a tab group of its own, as egui_tiles would put it on the first frame (every pane
+    // must have tabs): the default is then exactly what the dock shows, and a layout nobody
+    // rearranged is never written to `panels.json`.
+    let viewport_pane = tiles.insert_pane(Pane::Viewport);
+    let viewport = tiles.insert_tab_tile(vec![viewport_pane]);
     let styling = tiles.insert_pane(Pane::Styling);
     let scene = tiles.insert_pane(Pane::Scene);
     let strands = tiles.insert_pane(Pane::Strands);
@@ -917,6 +921,7 @@ impl egui_tiles::Behavior<Pane> for PaneUi<'_> {
 impl eframe::App for HairloomApp {
     fn on_exit(&mut self) {
         self.remember_view();
+        self.panels.remember(&self.layout);
         if let Some(job) = &self.export {
             // Let the export finish writing (each file is atomic either way).
             let _ = job.wait();

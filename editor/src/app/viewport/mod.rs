@@ -176,6 +176,9 @@ pub struct Viewport {
     pub gizmo_centre: Option<egui::Pos2>,
     /// A drag on a styling-direction gizmo handle (a modal tool while it runs).
     styling_drag: Option<styling_gizmo::StylingDrag>,
+    /// A cancelled styling drag waits for the button to be let go (the press stays the
+    /// gizmo's).
+    styling_hold: bool,
     /// Where the styling-direction gizmo's handles were drawn last (tests drag them).
     pub styling_handles: Option<StylingGizmoHandles>,
     /// The vertices a running gizmo drag moves and its pivot (fixed when it began).
@@ -287,6 +290,7 @@ impl Viewport {
             gizmo_shown: false,
             gizmo_drag: None,
             styling_drag: None,
+            styling_hold: false,
             styling_handles: None,
             targets_cache: None,
             gizmo_centre: None,
@@ -327,7 +331,7 @@ impl Viewport {
         if let Some(projector) = self.projector(state, rect) {
             if self.transform.is_some() {
                 self.drive_transform(ui, state, &response, projector);
-            } else if self.styling_drag.is_some() {
+            } else if self.styling_drag.is_some() || self.styling_hold {
                 // A modal drag: the pointer and Esc are the gizmo's until it is let go.
                 self.drive_styling_gizmo(ui, state, &response, projector);
             } else {

@@ -18,8 +18,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 use hairloom_core::edit::styling_direction::{
-    StylingAxes, shared_group, solve_in_basis, styling_axes, tip_twist_rad, twist_turns_per_m,
-    wave_direction_rad,
+    StylingAxes, shared_group, solve_in_basis, styling_axes, wave_direction_rad,
 };
 use hairloom_core::model::styling::StylingParams;
 
@@ -70,7 +69,8 @@ pub(super) struct Placed {
 pub(super) struct StylingDrag {
     handle: StylingHandle,
     placed: Placed,
-    /// The pointer's angle about the ring at the last frame (twist and curl).
+    /// The pointer's angle about the ring at the last frame (twist and curl), or its wave
+    /// direction where the handle was grabbed (so grabbing beside the tip does not snap).
     last: Option<f64>,
     /// The angle swept about ŵ since the drag began.
     swept_rad: f64,
@@ -122,7 +122,7 @@ impl Placed {
         projector: &Projector,
     ) -> Option<StylingGizmoHandles> {
         let axes = &self.axes;
-        let tip_rad = tip_twist_rad(params.twist.turns_per_m, axes.length_m);
+        let tip_rad = axes.tip_twist_about_w_rad(params.twist.turns_per_m);
         Some(StylingGizmoHandles {
             centre: projector.project(axes.origin)?,
             wave: projector.project(
@@ -164,11 +164,22 @@ impl Placed {
     }
 }
 
-fn params_of(state: &EditorState, group: Option<usize>) -> &StylingParams {
+/// The parameters a gizmo on `group` edits; `None` when the group no longer exists (the
+/// document changed under a drag).
+fn params_of(state: &EditorState, group: Option<usize>) -> Option<&StylingParams> {
     let styling = &state.document().styling;
-    group
-        .and_then(|g| styling.groups.get(g))
-        .map_or(&styling.global, |g| &g.params)
+    match group {
+        None => Some(&styling.global),
+        Some(g) => styling.groups.get(g).map(|g| &g.params),
+    }
+}
+
+/// The name of whose parameters a gizmo edits.
+fn whose(state: &EditorState, group: Option<usize>) -> String {
+    match group.and_then(|g| state.document().styling.groups.get(g)) {
+        Some(g) => format!("group {}", g.name),
+        None => "all bundles (global)".into(),
+    }
 }
 
 impl Viewport {
@@ -214,20 +225,34 @@ impl Viewport {
         projector: Projector,
     ) -> bool {
         self.styling_handles = None;
+        // A cancelled drag keeps the pointer until the button is let go: the rest of the
+        // press is not a box selection.
+        if self.styling_hold {
+            self.styling_hold = ui.input(|i| i.pointer.primary_down());
+            return true;
+        }
         if let Some(mut drag) = self.styling_drag.take() {
             let cancel = ui.input(|i| i.key_pressed(egui::Key::Escape))
                 || response.clicked_by(egui::PointerButton::Secondary);
-            if cancel {
+            let gone = params_of(state, drag.placed.group).is_none();
+            if cancel || gone {
                 state.cancel_edit();
-                state.message = format!("{} cancelled", drag.handle.label());
+                state.message = if gone {
+                    format!(
+                        "{}: the styling group is gone; cancelled",
+                        drag.handle.label()
+                    )
+                } else {
+                    format!("{} cancelled", drag.handle.label())
+                };
+                self.styling_hold = ui.input(|i| i.pointer.primary_down());
                 return true;
             }
             if let Some(at) = ui.input(|i| i.pointer.hover_pos()) {
                 apply_drag(&mut drag, state, &projector, at);
             }
-            self.styling_handles = drag
-                .placed
-                .handles(params_of(state, drag.placed.group), &projector);
+            self.styling_handles = params_of(state, drag.placed.group)
+                .and_then(|params| drag.placed.handles(params, &projector));
             if ui.input(|i| i.pointer.primary_down()) {
                 self.styling_drag = Some(drag);
             } else {
@@ -235,11 +260,17 @@ impl Viewport {
             }
             return true;
         }
+        // Alt+drag orbits (a trackpad's middle button), never grabs a handle.
+        if ui.input(|i| i.modifiers.alt) {
+            return false;
+        }
         let placed = match self.place_styling_gizmo(state, &projector) {
             Ok(placed) => placed,
             Err(_) => return false,
         };
-        let params = params_of(state, placed.group).clone();
+        let Some(params) = params_of(state, placed.group).cloned() else {
+            return false;
+        };
         let Some(handles) = placed.handles(&params, &projector) else {
             return false;
         };
@@ -261,6 +292,7 @@ impl Viewport {
         {
             state.commit_edit();
             state.stop_playback_for_editing();
+            self.drag_path.clear();
             let mut drag = StylingDrag {
                 handle,
                 placed,
@@ -268,18 +300,17 @@ impl Viewport {
                 swept_rad: 0.0,
                 start: params,
             };
+            // Measured from where the press began, so the handle does not jump to it.
+            if let Some(origin) = ui.input(|i| i.pointer.press_origin()) {
+                apply_drag(&mut drag, state, &projector, origin);
+            }
             if let Some(at) = ui.input(|i| i.pointer.hover_pos()) {
                 apply_drag(&mut drag, state, &projector, at);
             }
             state.message = format!(
                 "{} of {}: drag around; release to keep, Esc cancels",
                 handle.label(),
-                placed
-                    .group
-                    .map_or("all bundles (global)".into(), |g| format!(
-                        "group {}",
-                        state.document().styling.groups[g].name
-                    ))
+                whose(state, placed.group)
             );
             self.styling_drag = Some(drag);
             return true;
@@ -316,7 +347,9 @@ impl Viewport {
                 }
             },
         };
-        let params = params_of(state, placed.group);
+        let Some(params) = params_of(state, placed.group) else {
+            return;
+        };
         let project = |p: DVec3| projector.project(p);
         let axes = &placed.axes;
         let Some(centre) = project(axes.origin) else {
@@ -387,12 +420,10 @@ impl Viewport {
                 .collect();
             line(arc, colour, 2.5);
         };
-        let twist_rad = tip_twist_rad(params.twist.turns_per_m, axes.length_m);
+        let twist_rad = axes.tip_twist_about_w_rad(params.twist.turns_per_m);
         ring(TWIST_RING, cyan, twist_rad);
         // What the handles hold, in words, where the artist reads (bottom left).
-        let whose = placed.group.map_or("all bundles (global)".into(), |g| {
-            format!("group {}", state.document().styling.groups[g].name)
-        });
+        let whose = whose(state, placed.group);
         let curl = match axes.curl_sense(params.curl.turns_per_m) {
             s if params.curl.radius_m <= 0.0 || s == 0.0 => "no curl".to_string(),
             s if s > 0.0 => "curl counter-clockwise about w".to_string(),
@@ -438,7 +469,8 @@ impl Viewport {
     }
 }
 
-/// Moves the dragged handle to the pointer at `at`, editing the group's parameters.
+/// Moves the dragged handle with the pointer at `at`, editing the group's parameters. The
+/// first call of a drag (at the press) only records where it began.
 fn apply_drag(
     drag: &mut StylingDrag,
     state: &mut EditorState,
@@ -465,8 +497,14 @@ fn apply_drag(
             .and_then(|(a, b)| wave_direction_rad(a, b)) else {
                 return;
             };
+            let Some(grabbed) = drag.last else {
+                drag.last = Some(alpha);
+                return;
+            };
+            let turned = (alpha - grabbed + PI).rem_euclid(TAU) - PI;
+            let direction = (drag.start.wave.direction_rad + turned + PI).rem_euclid(TAU) - PI;
             // Rounded to a micro-radian: a stored value that reads back as typed.
-            params.wave.direction_rad = (alpha * 1e6).round() / 1e6;
+            params.wave.direction_rad = (direction * 1e6).round() / 1e6;
         }
         StylingHandle::Twist | StylingHandle::Curl => {
             let spec = if drag.handle == StylingHandle::Twist {
@@ -483,8 +521,10 @@ fn apply_drag(
             }
             drag.last = Some(now);
             if drag.handle == StylingHandle::Twist {
-                let start = tip_twist_rad(drag.start.twist.turns_per_m, placed.axes.length_m);
-                match twist_turns_per_m(start + drag.swept_rad, placed.axes.length_m) {
+                match placed
+                    .axes
+                    .twist_after_sweep(drag.start.twist.turns_per_m, drag.swept_rad)
+                {
                     Some(turns) => params.twist.turns_per_m = turns,
                     None => {
                         state.message =
@@ -501,8 +541,9 @@ fn apply_drag(
             }
         }
     }
-    if *params_of(state, placed.group) == params {
-        return;
+    match params_of(state, placed.group) {
+        Some(current) if *current != params => {}
+        _ => return,
     }
     let document = state.edit(drag.handle.label());
     match placed.group {
