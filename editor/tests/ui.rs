@@ -490,26 +490,7 @@ fn without_a_native_dialog_a_typed_path_is_asked_for() {
 
 /// A left-button drag from `from` to `to` in steps (a region selection in the viewport).
 fn drag(harness: &mut Harness<'static, HairloomApp>, from: egui::Pos2, to: egui::Pos2) {
-    harness.hover_at(from);
-    harness.run();
-    harness.event(egui::Event::PointerButton {
-        pos: from,
-        button: egui::PointerButton::Primary,
-        pressed: true,
-        modifiers: egui::Modifiers::NONE,
-    });
-    harness.run();
-    for step in 1..=8 {
-        harness.hover_at(from + (to - from) * (step as f32 / 8.0));
-        harness.run();
-    }
-    harness.event(egui::Event::PointerButton {
-        pos: to,
-        button: egui::PointerButton::Primary,
-        pressed: false,
-        modifiers: egui::Modifiers::NONE,
-    });
-    harness.run();
+    drag_with(harness, from, to, false);
 }
 
 fn viewport_rect(harness: &Harness<'static, HairloomApp>) -> egui::Rect {

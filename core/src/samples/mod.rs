@@ -225,12 +225,7 @@ pub fn grow(scalp: &HairMesh, growth: Growth, radii_m: DVec3) -> HairMesh {
         // their combed places (locked). A layer's interior placed from its rim (the
         // hairline) would not follow columns of different lengths: crown hair is longer
         // than nape hair, so rim-placed crown columns would cut across the head.
-        let topology = crate::model::mesh::Topology::build(&mesh);
-        let interior: Vec<VertexRef> = crate::edit::select::bundle_vertices_above_root(&mesh, &all)
-            .into_iter()
-            .filter(|v| mesh.is_interior(&topology, v.column as usize, v.layer as usize))
-            .collect();
-        mesh.set_locked(&interior, true);
+        lock_interior(&mut mesh, &all);
     }
     mesh.update_w();
     mesh
@@ -749,14 +744,20 @@ pub fn gather_ponytail(scalp: &HairMesh, tail: Ponytail, radii_m: DVec3) -> Hair
         }
         column.positions = positions;
     }
-    let topology = crate::model::mesh::Topology::build(&mesh);
-    let interior: Vec<VertexRef> = crate::edit::select::bundle_vertices_above_root(&mesh, &all)
+    lock_interior(&mut mesh, &all);
+    mesh.update_w();
+    mesh
+}
+
+/// Locks the interior vertices of `bundles` where a builder placed them (automatic
+/// placement from each layer's rim would not follow a comb that placed every column).
+fn lock_interior(mesh: &mut HairMesh, bundles: &[u32]) {
+    let topology = crate::model::mesh::Topology::build(mesh);
+    let interior: Vec<VertexRef> = crate::edit::select::bundle_vertices_above_root(mesh, bundles)
         .into_iter()
         .filter(|v| mesh.is_interior(&topology, v.column as usize, v.layer as usize))
         .collect();
     mesh.set_locked(&interior, true);
-    mesh.update_w();
-    mesh
 }
 
 /// Spherical interpolation between unit vectors (linear where they nearly coincide).
