@@ -50,6 +50,20 @@ pub fn scalp_document(
     let mut document = Document::new(name, hair_mesh);
     document.source = format!("imported from {}", scalp.display());
     document.body = imported.to_body();
+    // The file's body animation becomes the scene's head animation: the scene then has
+    // motion, and the hair is simulated following the body.
+    let animation = if imported.body_animation.is_empty() {
+        String::new()
+    } else {
+        let keys = imported.body_animation.clone();
+        let seconds = keys.last().map_or(0.0, |k| k.time_s);
+        let count = keys.len();
+        document.scene.motion = Some(hairloom_core::model::motion::Motion {
+            head_animation: keys,
+            ..Default::default()
+        });
+        format!("; body animation: {count} keys over {seconds:.2} s, in the Scene panel's Motion")
+    };
     document
         .validate()
         .with_context(|| format!("{} produced an invalid document", scalp.display()))?;
@@ -64,8 +78,8 @@ pub fn scalp_document(
             ""
         } else {
             "; uv generated (the file has no TEXCOORD_0)"
-        }
-    );
+        },
+    ) + &animation;
     Ok((document, summary))
 }
 

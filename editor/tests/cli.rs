@@ -156,6 +156,26 @@ fn import_writes_a_valid_project() {
     assert!(stderr.contains("missing.glb"), "{stderr}");
 }
 
+/// A glTF whose body is animated imports with that animation as the scene's head animation
+/// (so the scene has motion), and says so.
+#[test]
+fn import_takes_the_body_animation_into_the_scene() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = dir.path().join("turning.glb");
+    std::fs::write(&glb, hairloom_tests::animated_quad_glb(|_| {})).expect("write");
+    let out = dir.path().join("turning.hairloom");
+    let (code, stdout, stderr) = run(hairloom().arg("import").arg(&glb).arg("--out").arg(&out));
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("body animation: 2 keys over 1.00 s"),
+        "{stdout}"
+    );
+    let project = hairloom_core::io::project::load(&out).expect("project");
+    let motion = project.document.scene.motion.expect("the scene has motion");
+    assert_eq!(motion.head_animation.len(), 2);
+    assert!((motion.head_animation[1].yaw_deg - 90.0).abs() < 1e-3);
+}
+
 /// Runs a validator; `None` when it is not installed (allowed outside `make test`).
 fn validator(program: &Path, args: &[&Path], cwd: &Path) -> Option<(i32, String)> {
     if !program.exists() && program.components().count() > 1 {

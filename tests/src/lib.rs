@@ -126,6 +126,32 @@ impl GltfBuilder {
     }
 }
 
+/// A quad mesh whose node (translated by (0, 1, 0) and scaled 2×) is turned 90° about Y over
+/// one second and lifted 0.5 along Y, with LINEAR keys; `edit` changes the JSON first.
+pub fn animated_quad_glb(edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {
+    let mut builder = GltfBuilder::default();
+    builder.add_quad_mesh("body");
+    let times = builder.add_f32(&[0.0, 1.0], "SCALAR", 2);
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    let turns = builder.add_f32(&[0.0, 0.0, 0.0, 1.0, 0.0, half, 0.0, half], "VEC4", 2);
+    let lifts = builder.add_f32(&[0.0, 1.0, 0.0, 0.0, 1.5, 0.0], "VEC3", 2);
+    let mut json = builder.json();
+    json["nodes"][0]["translation"] = serde_json::json!([0.0, 1.0, 0.0]);
+    json["nodes"][0]["scale"] = serde_json::json!([2.0, 2.0, 2.0]);
+    json["animations"] = serde_json::json!([{
+        "channels": [
+            {"sampler": 0, "target": {"node": 0, "path": "rotation"}},
+            {"sampler": 1, "target": {"node": 0, "path": "translation"}}
+        ],
+        "samplers": [
+            {"input": times, "output": turns, "interpolation": "LINEAR"},
+            {"input": times, "output": lifts, "interpolation": "LINEAR"}
+        ]
+    }]);
+    edit(&mut json);
+    builder.glb(&json)
+}
+
 /// A small document whose runtime bundle differs per `variant` in geometry only (same
 /// sizes and formats): the case where a mixed bundle would render silently wrong.
 pub fn bundle_variant(variant: u32) -> hairloom_core::Document {

@@ -398,3 +398,96 @@ fn ten_thousand_primitives_sharing_an_accessor_hit_a_named_cap() {
         "{message}"
     );
 }
+
+/// Issue "Scenes and effects on demand, part 2": a body animation in the glTF becomes the
+/// head animation, moving the imported body exactly as the file moves the mesh.
+#[test]
+fn a_body_animation_in_the_file_becomes_the_head_animation() {
+    use glam::DVec3;
+    use hairloom_core::model::motion::Motion;
+    let imported = import(
+        &hairloom_tests::animated_quad_glb(|_| {}),
+        &ImportOptions::default(),
+    )
+    .expect("imports");
+    let keys = &imported.body_animation;
+    assert_eq!(keys.len(), 2, "{keys:?}");
+    assert_eq!((keys[0].time_s, keys[1].time_s), (0.0, 1.0));
+    assert!(
+        keys[0].yaw_deg.abs() < 1e-4 && (keys[1].yaw_deg - 90.0).abs() < 1e-3,
+        "{keys:?}"
+    );
+    let motion = Motion {
+        head_animation: keys.clone(),
+        ..Motion::default()
+    };
+    motion.validate().expect("valid keys");
+    // Each imported vertex goes where the file's animation puts it: at t, the node's
+    // transform T(t) applied to the local vertex; imported, the rest pose T(0).
+    let local = [
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+    ];
+    for t in [0.0f64, 0.25, 0.5, 1.0, 2.0] {
+        let f = t.min(1.0);
+        let rotation = glam::DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2 * f);
+        let translation = DVec3::new(0.0, 1.0 + 0.5 * f, 0.0);
+        let pose = motion.head_pose(t);
+        for p in local {
+            let rest = DVec3::new(0.0, 1.0, 0.0) + p * 2.0;
+            let expected = translation + rotation * (p * 2.0);
+            let moved = pose.apply(rest);
+            assert!(
+                moved.distance(expected) < 1e-4,
+                "t {t}: {p} went to {moved}, the file puts it at {expected}"
+            );
+        }
+    }
+    // No animation, no keys.
+    let mut still = GltfBuilder::default();
+    still.add_quad_mesh("body");
+    let bytes = still.glb(&still.json());
+    assert!(
+        import(&bytes, &ImportOptions::default())
+            .expect("imports")
+            .body_animation
+            .is_empty()
+    );
+}
+
+#[test]
+fn malformed_animations_are_refused_by_name() {
+    let cases: Vec<(Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+        (
+            Box::new(|j| j["animations"][0]["channels"][0]["sampler"] = 7.into()),
+            "uses sampler 7",
+        ),
+        (
+            Box::new(|j| j["animations"][0]["samplers"][0]["output"] = 99.into()),
+            "accessor 99 does not exist",
+        ),
+        (
+            // Times as the rotation's output: one component where four are needed.
+            Box::new(|j| j["animations"][0]["samplers"][0]["output"] = 0.into()),
+            "expected 4 components",
+        ),
+        (
+            // The translation values (2 keys of VEC3) read as cubic-spline: 3 per key needed.
+            Box::new(|j| j["animations"][0]["samplers"][1]["interpolation"] = "CUBICSPLINE".into()),
+            "cubic-spline translation values",
+        ),
+    ];
+    // Accessor indices: the quad uses 0-2, times 3, rotations 4, translations 5.
+    for (edit, expected) in cases {
+        let bytes = hairloom_tests::animated_quad_glb(|j| {
+            edit(j);
+            if j["animations"][0]["samplers"][0]["output"] == 0 {
+                j["animations"][0]["samplers"][0]["output"] = 3.into();
+            }
+        });
+        let text = error_text(&bytes);
+        assert!(text.contains(expected), "expected {expected:?} in {text:?}");
+        assert!(text.contains("crafted.glb"), "{text}");
+    }
+}

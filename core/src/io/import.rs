@@ -123,6 +123,10 @@ pub struct ImportedMesh {
     pub source_triangles: usize,
     /// Triangles dropped because welding collapsed them.
     pub degenerate_triangles: usize,
+    /// The body's motion from the file's first animation that moves the mesh's node
+    /// (translation and rotation; see [`body_animation`]), as head-animation keys in model
+    /// space; empty when nothing animates it.
+    pub body_animation: Vec<crate::model::motion::HeadKey>,
 }
 
 impl ImportedMesh {
@@ -263,8 +267,10 @@ pub fn import_slice(
             "",
         ));
     }
-    let transform =
-        node_transform(&root, mesh_index) * DMat4::from_scale(DVec3::splat(options.scale));
+    let placement = mesh_node(&root, mesh_index);
+    let transform = placement.map_or(DMat4::IDENTITY, |(node, parent)| {
+        parent * local_transform(&root.nodes[node])
+    }) * DMat4::from_scale(DVec3::splat(options.scale));
     let normal_transform = transform.inverse().transpose();
     let buffers = Buffers::load(&root, blob, folder, file, limits.max_file_bytes)?;
     let mut reader = AccessorReader {
@@ -449,6 +455,10 @@ pub fn import_slice(
             corner_uvs.iter().map(|u| u.to_vec()).collect(),
         )
     };
+    let body_animation = match placement {
+        Some((node, parent)) => body_animation(&root, node, parent, &mut reader)?,
+        None => Vec::new(),
+    };
     Ok(ImportedMesh {
         mesh_name,
         positions,
@@ -457,7 +467,228 @@ pub fn import_slice(
         has_uv,
         source_triangles,
         degenerate_triangles: degenerate,
+        body_animation,
     })
+}
+
+/// The first animation (in file order) with a translation or rotation channel on `node`,
+/// sampled at every key time of those channels into rigid head-animation keys:
+/// `p ↦ P · L(t) · L(0)⁻¹ · P⁻¹ · p`, where `P` is the node's parent transform and `L` its
+/// local one (the mesh's rest pose is `L` as the file stores it), so the keys move the
+/// imported body exactly as the file's animation moves the mesh. Scale channels, morph
+/// weights and the animation of ancestor nodes are not read (a head animation is rigid).
+/// LINEAR keys interpolate (quaternions by slerp), STEP keys hold, CUBICSPLINE keys keep
+/// their values (the tangents are dropped: the head animation interpolates linearly between
+/// keys). Euler angles are unwrapped from key to key, so a full turn stays a full turn.
+fn body_animation(
+    root: &json::Root,
+    node: usize,
+    parent: DMat4,
+    reader: &mut AccessorReader,
+) -> Result<Vec<crate::model::motion::HeadKey>, ImportError> {
+    use crate::model::motion::{HeadKey, MAX_HEAD_KEYS, MAX_KEY_TIME_S};
+    use json::animation::{Interpolation, Property};
+    struct Track {
+        times: Vec<f64>,
+        values: Vec<f64>,
+        width: usize,
+        step: bool,
+    }
+    let fail = |animation: usize, message: String| ImportError::Gltf {
+        file: reader.file.to_string(),
+        message: format!("animation {animation}: {message}"),
+    };
+    for (a, animation) in root.animations.iter().enumerate() {
+        let (mut translation, mut rotation) = (None, None);
+        for (c, channel) in animation.channels.iter().enumerate() {
+            if channel.target.node.value() != node {
+                continue;
+            }
+            let (slot, width, name) = match channel.target.path {
+                Checked::Valid(Property::Translation) => (&mut translation, 3, "translation"),
+                Checked::Valid(Property::Rotation) => (&mut rotation, 4, "rotation"),
+                _ => continue,
+            };
+            let s = channel.sampler.value();
+            let Some(sampler) = animation.samplers.get(s) else {
+                return Err(fail(
+                    a,
+                    format!(
+                        "channel {c} uses sampler {s}; the animation has {}",
+                        animation.samplers.len()
+                    ),
+                ));
+            };
+            let what = format!("animation {a} {name} times");
+            let times = reader.read(sampler.input.value(), &what, 1)?.to_vec();
+            if times.len() > MAX_HEAD_KEYS {
+                return Err(fail(
+                    a,
+                    format!(
+                        "{} {name} keys, more than the {MAX_HEAD_KEYS} a head animation may hold",
+                        times.len()
+                    ),
+                ));
+            }
+            if let Some(w) = times.windows(2).find(|w| w[1] < w[0]) {
+                return Err(fail(
+                    a,
+                    format!(
+                        "{name} key time {} comes after {}: keys go in time order",
+                        w[0], w[1]
+                    ),
+                ));
+            }
+            if times.iter().any(|t| !(0.0..=MAX_KEY_TIME_S).contains(t)) {
+                return Err(fail(
+                    a,
+                    format!("{name} key times must lie in [0, {MAX_KEY_TIME_S}] s"),
+                ));
+            }
+            let what = format!("animation {a} {name} values");
+            let raw = reader.read(sampler.output.value(), &what, width)?;
+            let (values, step) = match sampler.interpolation {
+                Checked::Valid(Interpolation::CubicSpline) => {
+                    // (in-tangent, value, out-tangent) per key: keep the values.
+                    if raw.len() != times.len() * 3 * width {
+                        return Err(fail(
+                            a,
+                            format!(
+                                "{} cubic-spline {name} values for {} keys (3 per key)",
+                                raw.len() / width,
+                                times.len()
+                            ),
+                        ));
+                    }
+                    let values = raw
+                        .chunks(3 * width)
+                        .flat_map(|k| k[width..2 * width].to_vec())
+                        .collect();
+                    (values, false)
+                }
+                Checked::Valid(interpolation) => {
+                    if raw.len() != times.len() * width {
+                        return Err(fail(
+                            a,
+                            format!(
+                                "{} {name} values for {} keys",
+                                raw.len() / width,
+                                times.len()
+                            ),
+                        ));
+                    }
+                    (raw.to_vec(), interpolation == Interpolation::Step)
+                }
+                Checked::Invalid => {
+                    return Err(fail(a, format!("unknown {name} interpolation")));
+                }
+            };
+            if !times.is_empty() {
+                *slot = Some(Track {
+                    times,
+                    values,
+                    width,
+                    step,
+                });
+            }
+        }
+        if translation.is_none() && rotation.is_none() {
+            continue;
+        }
+        // A track's value at `t`: held before the first key and after the last.
+        let sample = |track: &Track, t: f64| -> Vec<f64> {
+            let w = track.width;
+            let at = |k: usize| track.values[k * w..(k + 1) * w].to_vec();
+            let next = track.times.partition_point(|&k| k <= t);
+            if next == 0 {
+                return at(0);
+            }
+            if next >= track.times.len() || track.step {
+                return at(next - 1);
+            }
+            let (t0, t1) = (track.times[next - 1], track.times[next]);
+            let f = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+            if w == 4 {
+                let q = |v: Vec<f64>| DQuat::from_array([v[0], v[1], v[2], v[3]]).normalize();
+                let (a, b) = (q(at(next - 1)), q(at(next)));
+                return a.slerp(b, f).to_array().to_vec();
+            }
+            at(next - 1)
+                .iter()
+                .zip(at(next))
+                .map(|(a, b)| a + (b - a) * f)
+                .collect()
+        };
+        let mut times: Vec<f64> = translation
+            .iter()
+            .chain(rotation.iter())
+            .flat_map(|t| t.times.iter().copied())
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        if times.len() > MAX_HEAD_KEYS {
+            return Err(fail(
+                a,
+                format!(
+                    "{} distinct key times, more than the {MAX_HEAD_KEYS} a head animation may hold",
+                    times.len()
+                ),
+            ));
+        }
+        let rest = &root.nodes[node];
+        let rest_local = local_transform(rest);
+        let (rest_scale, rest_rotation, rest_translation) =
+            rest_local.to_scale_rotation_translation();
+        let to_rest = parent * rest_local;
+        if !to_rest.is_finite() || to_rest.determinant().abs() < 1e-12 {
+            return Err(fail(
+                a,
+                "the animated node's rest transform is degenerate".into(),
+            ));
+        }
+        let from_rest = to_rest.inverse();
+        let mut keys: Vec<HeadKey> = Vec::with_capacity(times.len());
+        for t in times {
+            let moved_translation = translation.as_ref().map_or(rest_translation, |track| {
+                DVec3::from_slice(&sample(track, t))
+            });
+            let moved_rotation = rotation.as_ref().map_or(rest_rotation, |track| {
+                let v = sample(track, t);
+                DQuat::from_array([v[0], v[1], v[2], v[3]]).normalize()
+            });
+            let local = DMat4::from_scale_rotation_translation(
+                rest_scale,
+                moved_rotation,
+                moved_translation,
+            );
+            let motion = parent * local * from_rest;
+            let (_, turn, shift) = motion.to_scale_rotation_translation();
+            if !(turn.is_finite() && shift.is_finite()) {
+                return Err(fail(a, format!("the pose at {t} s is not a rigid motion")));
+            }
+            let (yaw, pitch, roll) = turn.normalize().to_euler(glam::EulerRot::YXZ);
+            let mut key = HeadKey {
+                time_s: t,
+                translation_m: shift.to_array(),
+                yaw_deg: yaw.to_degrees(),
+                pitch_deg: pitch.to_degrees(),
+                roll_deg: roll.to_degrees(),
+            };
+            // Unwrapped: the angle nearest the previous key's, so interpolating between
+            // keys never turns the long way round.
+            if let Some(previous) = keys.last() {
+                let near = |angle: f64, previous: f64| {
+                    angle + 360.0 * ((previous - angle) / 360.0).round()
+                };
+                key.yaw_deg = near(key.yaw_deg, previous.yaw_deg);
+                key.pitch_deg = near(key.pitch_deg, previous.pitch_deg);
+                key.roll_deg = near(key.roll_deg, previous.roll_deg);
+            }
+            keys.push(key);
+        }
+        return Ok(keys);
+    }
+    Ok(Vec::new())
 }
 
 /// The JSON chunk and the optional BIN chunk of a GLB, or the whole input as JSON. The
@@ -541,26 +772,27 @@ fn mesh_names(root: &json::Root) -> String {
     names.join(", ")
 }
 
-/// World transform of the first node (in scene order, depth first) that instances `mesh`;
-/// identity when no node does. Indices are looked up checked, and the walk is bounded in
-/// depth and in nodes visited (a hostile file may make the node graph cyclic or shared).
-fn node_transform(root: &json::Root, mesh: usize) -> DMat4 {
+/// The first node (in scene order, depth first) that instances `mesh`, with its parent's
+/// world transform; `None` when no node does. Indices are looked up checked, and the walk is
+/// bounded in depth and in nodes visited (a hostile file may make the node graph cyclic or
+/// shared).
+fn mesh_node(root: &json::Root, mesh: usize) -> Option<(usize, DMat4)> {
     struct Walk<'a> {
         root: &'a json::Root,
         mesh: usize,
         visited: usize,
     }
     impl Walk<'_> {
-        fn visit(&mut self, node: usize, parent: DMat4, depth: usize) -> Option<DMat4> {
+        fn visit(&mut self, index: usize, parent: DMat4, depth: usize) -> Option<(usize, DMat4)> {
             self.visited += 1;
             if depth > 64 || self.visited > 100_000 {
                 return None;
             }
-            let node = self.root.nodes.get(node)?;
-            let world = parent * local_transform(node);
+            let node = self.root.nodes.get(index)?;
             if node.mesh.is_some_and(|m| m.value() == self.mesh) {
-                return Some(world);
+                return Some((index, parent));
             }
+            let world = parent * local_transform(node);
             node.children
                 .iter()
                 .flatten()
@@ -585,8 +817,7 @@ fn node_transform(root: &json::Root, mesh: usize) -> DMat4 {
                 .iter()
                 .find_map(|node| walk.visit(node.value(), DMat4::IDENTITY, 0))
         })
-        .filter(|m| m.is_finite())
-        .unwrap_or(DMat4::IDENTITY)
+        .filter(|(node, parent)| (*parent * local_transform(&root.nodes[*node])).is_finite())
 }
 
 fn local_transform(node: &json::scene::Node) -> DMat4 {
