@@ -458,7 +458,8 @@ fn a_body_animation_in_the_file_becomes_the_head_animation() {
 
 #[test]
 fn malformed_animations_are_refused_by_name() {
-    let cases: Vec<(Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+    type JsonEdit = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(JsonEdit, &str)> = vec![
         (
             Box::new(|j| j["animations"][0]["channels"][0]["sampler"] = 7.into()),
             "uses sampler 7",
