@@ -71,8 +71,8 @@ fn generated_strands_stay_out_of_the_body() {
 /// 1.7 cm apart, so either vertex measure sees the sampling more than the hair. A strand
 /// rising straight off the scalp never counts for the points around its own root (its
 /// first centimetre is skipped), so a helmet fails here. Measured (2026-12-04): short crop
-/// 9.3 mm at worst (a 2.4 cm crop stands a little), curly 7.4, long straight 6.1, long wavy
-/// 5.1, ponytail 3.4. The earlier measure (vertices, skipping two: about 2 mm of a short
+/// 7.8 mm at worst (combed down fully since; it stood at 9.3), curly 7.4, long straight 6.1,
+/// long wavy 5.1, ponytail 3.1. The earlier measure (vertices, skipping two: about 2 mm of a short
 /// strand, so a strand's own hair counted next to its root) allowed 8 mm. Before the builder laid the first layer down, the
 /// long wavy sample's worst gap was 29 mm (vertex measure).
 #[test]

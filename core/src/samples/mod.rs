@@ -489,7 +489,7 @@ pub const HEAD_STYLES: [(&str, Growth); 4] = [
         Growth {
             layers: 2,
             step_m: 0.012,
-            gravity: 0.45,
+            gravity: 1.0,
             volume: 0.09,
             cut: None,
         },
