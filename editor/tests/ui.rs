@@ -1796,3 +1796,50 @@ fn handles_bundle(harness: &Harness<'static, HairloomApp>) -> u32 {
         .next()
         .expect("a selected bundle")
 }
+
+/// Ctrl+Tab cycles the hovered tab group, but not while a modal tool owns the keyboard.
+#[test]
+fn ctrl_tab_cycles_tabs_except_during_a_modal_tool() {
+    use hairloom_editor::app::panel_memory::SavedTile;
+    fn right_active(harness: &Harness<'static, HairloomApp>) -> usize {
+        match SavedTile::of(&harness.state().layout) {
+            Some(SavedTile::Linear { children, .. }) => match children.last() {
+                Some(SavedTile::Tabs { active, .. }) => *active,
+                other => panic!("right column: {other:?}"),
+            },
+            other => panic!("layout: {other:?}"),
+        }
+    }
+    let mut harness = harness();
+    let over_right = egui::pos2(1300.0, 450.0);
+    let before = right_active(&harness);
+    // During G (started over the viewport), Ctrl+Tab over the right group does nothing.
+    click_bundle_in_outliner(&mut harness, 0);
+    harness.hover_at(viewport_rect(&harness).center());
+    harness.run();
+    harness.key_press(egui::Key::G);
+    harness.run();
+    assert_eq!(harness.state().viewport.modal_tool(), Some("Move"));
+    harness.hover_at(over_right);
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::CTRL, egui::Key::Tab);
+    harness.run();
+    assert_eq!(
+        right_active(&harness),
+        before,
+        "no tab switched under the move"
+    );
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert_eq!(harness.state().viewport.modal_tool(), None);
+    // Without one, it cycles.
+    harness.hover_at(over_right);
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::CTRL, egui::Key::Tab);
+    harness.run();
+    assert_ne!(
+        right_active(&harness),
+        before,
+        "Ctrl+Tab cycles the hovered group"
+    );
+}

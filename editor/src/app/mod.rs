@@ -877,6 +877,13 @@ impl egui_tiles::Behavior<Pane> for PaneUi<'_> {
         pane.title().into()
     }
 
+    /// Ctrl+Tab cycles the hovered tab group, except while a modal tool or a dialog owns the
+    /// keyboard: switching the viewport's tab away would leave a running drag or G / R / S
+    /// with nothing to confirm or cancel it.
+    fn cycle_tabs_with_keyboard(&self) -> bool {
+        !self.viewport.keyboard_blocked && self.viewport.modal_tool().is_none()
+    }
+
     fn pane_ui(
         &mut self,
         ui: &mut egui::Ui,
