@@ -534,7 +534,8 @@ pub const HEAD_STYLES: [(&str, Growth); 4] = [
 
 /// The styles whose combed mesh is then draped (`simulate::drape`): the hair falls under
 /// gravity onto the head and shoulders and settles, so long hair rests where it lands
-/// instead of where the comb put it.
+/// instead of where the comb put it. (The curls are draped too, with their front held: see
+/// `head_projects`.)
 pub const DRAPED_STYLES: [&str; 1] = ["head_long_straight"];
 
 /// The styling of each head sample.
@@ -792,6 +793,23 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
             let mut mesh = keep_out_of_body(&shaped, &body);
             if DRAPED_STYLES.contains(name) {
                 drape(&mut mesh, &[]);
+            }
+            if *name == "head_curly" {
+                // The front's hair keeps its sweep back off the face (held, like vertices an
+                // artist locked); the rest falls and settles instead of standing out as a bowl.
+                let held: Vec<VertexRef> = mesh
+                    .columns
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| c.positions[0].z > 0.35 * radii_m.z)
+                    .flat_map(|(c, column)| {
+                        (0..column.positions.len() as u32).map(move |layer| VertexRef {
+                            column: c as u32,
+                            layer,
+                        })
+                    })
+                    .collect();
+                drape(&mut mesh, &held);
             }
             (*name, mesh)
         })
