@@ -113,6 +113,19 @@ struct DrawnKey {
     quality: FrameQuality,
 }
 
+/// The styling gizmo's frame and shared group for a (document revision, selection), or why
+/// it cannot stand there.
+type StylingFrameCache = (
+    (u64, Vec<u32>),
+    Result<
+        (
+            hairloom_core::edit::styling_direction::StylingAxes,
+            Option<usize>,
+        ),
+        String,
+    >,
+);
+
 /// What the overlay's body depth was rasterised for.
 #[derive(Clone, Copy, PartialEq)]
 struct BodyDepthKey {
@@ -176,6 +189,9 @@ pub struct Viewport {
     pub gizmo_centre: Option<egui::Pos2>,
     /// A drag on a styling-direction gizmo handle (a modal tool while it runs).
     styling_drag: Option<styling_gizmo::StylingDrag>,
+    /// The selected bundles' styling frame and shared group (or why there is none), for the
+    /// document revision and selection they were found at.
+    styling_frame: Option<StylingFrameCache>,
     /// A cancelled styling drag waits for the button to be let go (the press stays the
     /// gizmo's).
     styling_hold: bool,
@@ -291,6 +307,7 @@ impl Viewport {
             gizmo_drag: None,
             styling_drag: None,
             styling_hold: false,
+            styling_frame: None,
             styling_handles: None,
             targets_cache: None,
             gizmo_centre: None,

@@ -184,16 +184,32 @@ fn whose(state: &EditorState, group: Option<usize>) -> String {
 
 impl Viewport {
     /// Places the gizmo on the selected bundles, or says why it cannot stand there.
+    /// The frame and group are found once per document revision and selection (the frame
+    /// needs the whole root layer's frames), not every frame the gizmo is driven and drawn.
     fn place_styling_gizmo(
-        &self,
+        &mut self,
         state: &EditorState,
         projector: &Projector,
     ) -> Result<Placed, String> {
         let bundles: Vec<u32> = state.selection.iter().copied().collect();
-        let document = state.document();
-        let group = shared_group(&document.styling, &bundles)?;
-        let axes = styling_axes(&document.hair_mesh, &bundles)
-            .ok_or("the selected bundles have no styling frame (collapsed roots)")?;
+        let key = (state.revision, bundles);
+        let found = match &self.styling_frame {
+            Some((cached, found)) if *cached == key => found.clone(),
+            _ => {
+                let document = state.document();
+                let found = shared_group(&document.styling, &key.1).and_then(|group| {
+                    styling_axes(&document.hair_mesh, &key.1)
+                        .map(|axes| (axes, group))
+                        .ok_or_else(|| {
+                            "the selected bundles have no styling frame (collapsed roots)"
+                                .to_string()
+                        })
+                });
+                self.styling_frame = Some((key, found.clone()));
+                found
+            }
+        };
+        let (axes, group) = found?;
         // Pixels per metre at the roots, along the camera's right.
         let right = projector.view.row(0).truncate().as_dvec3();
         let probe_m = 1e-3;
@@ -325,7 +341,7 @@ impl Viewport {
 
     /// Draws the gizmo over the picture.
     pub(super) fn paint_styling_gizmo(
-        &self,
+        &mut self,
         painter: &egui::Painter,
         state: &EditorState,
         projector: &Projector,
