@@ -24,7 +24,7 @@ USD_CORE := usd-core==26.11
 # The Alembic C++ library's Python bindings, to read .abc grooms back.
 ALEMBIC3D := alembic3d==1.8.12.1
 
-.PHONY: run test deps gpu-deps toolchain lint samples bench fuzz
+.PHONY: run test deps gpu-deps mesh-deps toolchain lint samples bench fuzz
 
 toolchain:
 	@command -v $(CARGO) >/dev/null || { \
@@ -45,6 +45,13 @@ gpu-deps:
 	    echo "warning: missing$$missing (install them as root for the software GPU adapter)"; \
 	  fi; \
 	fi
+
+# Mesa 25's lavapipe from bookworm-backports, unpacked under target/ and never installed: it
+# has VK_EXT_mesh_shader (bookworm's Mesa 22.3 has not), so `make test` checks the
+# mesh-shader generation path on the CPU too.
+MESA_BACKPORT := $(CURDIR)/target/mesa-backport
+mesh-deps:
+	@[ -f $(MESA_BACKPORT)/lvp_icd.json ] || tools/mesa-backport.sh $(MESA_BACKPORT)
 
 # gpu-deps plus the export validators.
 deps: gpu-deps
@@ -79,10 +86,14 @@ run: toolchain gpu-deps
 
 # `cargo test --all-targets` builds examples as test harnesses, so the game example that
 # render/tests/game_window.rs opens in a window is built as a program first.
-test: toolchain deps
+# The mesh-shader tests run again on Mesa 25's lavapipe, where they must not skip.
+test: toolchain deps mesh-deps
 	$(CARGO) build -p hairloom-render --example game
 	$(CARGO) test --workspace --all-targets
 	$(CARGO) test --workspace --doc
+	VK_ICD_FILENAMES=$(MESA_BACKPORT)/lvp_icd.json \
+	  LD_LIBRARY_PATH=$(MESA_BACKPORT)/root/usr/lib/x86_64-linux-gnu \
+	  HAIRLOOM_REQUIRE_MESH_SHADERS=1 $(CARGO) test -p hairloom-render --test strand_mesh
 
 lint: toolchain
 	$(CARGO) fmt --all -- --check

@@ -15,7 +15,13 @@ fn vs_main(
     @builtin(vertex_index) vertex_index: u32,
     @builtin(instance_index) instance_index: u32,
 ) -> ShadowVertex {
-    let ribbon = ribbon_vertex(vertex_index, instance_index);
+    return pass_vertex(ribbon_vertex(vertex_index, instance_index));
+}
+
+// What the shadow passes take from a ribbon vertex (see preview_hair.wgsl `PassVertex`).
+alias PassVertex = ShadowVertex;
+
+fn pass_vertex(ribbon: RibbonVertex) -> ShadowVertex {
     var out: ShadowVertex;
     out.clip = ribbon.clip;
     out.coverage = ribbon.coverage;

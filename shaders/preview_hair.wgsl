@@ -26,7 +26,14 @@ fn vs_main(
     @builtin(vertex_index) vertex_index: u32,
     @builtin(instance_index) instance_index: u32,
 ) -> VertexOutput {
-    let ribbon = ribbon_vertex(vertex_index, instance_index);
+    return pass_vertex(ribbon_vertex(vertex_index, instance_index));
+}
+
+// What this pass's rasteriser takes from a ribbon vertex (the vertex shader above, and the
+// mesh shader of shaders/strand_mesh.wgsl, through `PassVertex`).
+alias PassVertex = VertexOutput;
+
+fn pass_vertex(ribbon: RibbonVertex) -> VertexOutput {
     var out: VertexOutput;
     out.clip = ribbon.clip;
     out.world = ribbon.world;

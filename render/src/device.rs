@@ -143,12 +143,13 @@ impl GpuContext {
         let optional = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::FLOAT32_FILTERABLE
             | wgpu::Features::SHADER_F16;
-        let descriptor = wgpu::DeviceDescriptor {
+        let mut descriptor = wgpu::DeviceDescriptor {
             label: Some("hairloom"),
             required_features: adapter.features() & optional,
             required_limits: adapter.limits(),
             ..Default::default()
         };
+        request_mesh_shaders(&adapter, &mut descriptor);
         let (device, queue) =
             pollster::block_on(adapter.request_device(&descriptor)).map_err(|source| {
                 DeviceError::RequestDevice {
@@ -164,6 +165,57 @@ impl GpuContext {
             resources: Default::default(),
         })
     }
+}
+
+/// Environment variable that keeps mesh shaders off (`0`, `off` or `false`) on an adapter
+/// that has them: wgpu marks them experimental, so a driver that misbehaves can be avoided
+/// without a rebuild.
+pub const MESH_SHADERS_ENV: &str = "HAIRLOOM_MESH_SHADERS";
+
+/// Whether [`MESH_SHADERS_ENV`] (its value, if set) lets the device use mesh shaders.
+pub fn mesh_shaders_wanted(value: Option<&str>) -> bool {
+    !matches!(
+        value.map(|v| v.trim().to_ascii_lowercase()).as_deref(),
+        Some("0" | "off" | "false" | "no")
+    )
+}
+
+/// Adds mesh shaders to `descriptor` where `adapter` has them and [`MESH_SHADERS_ENV`] does
+/// not turn them off: the feature, wgpu's opt-in to experimental features, and the adapter's
+/// own mesh-shader limits (the generation path `strand_mesh.wgsl` needs them). Used by the
+/// headless device and the editor's window.
+#[expect(
+    unsafe_code,
+    reason = "wgpu gates EXPERIMENTAL_MESH_SHADER behind an unsafe opt-in token"
+)]
+pub fn request_mesh_shaders(adapter: &wgpu::Adapter, descriptor: &mut wgpu::DeviceDescriptor) {
+    let wanted = mesh_shaders_wanted(std::env::var(MESH_SHADERS_ENV).ok().as_deref());
+    if !wanted
+        || !adapter
+            .features()
+            .contains(wgpu::Features::EXPERIMENTAL_MESH_SHADER)
+    {
+        return;
+    }
+    let available = adapter.limits();
+    let limits = &mut descriptor.required_limits;
+    limits.max_task_workgroup_total_count = available.max_task_workgroup_total_count;
+    limits.max_task_workgroups_per_dimension = available.max_task_workgroups_per_dimension;
+    limits.max_mesh_workgroup_total_count = available.max_mesh_workgroup_total_count;
+    limits.max_mesh_workgroups_per_dimension = available.max_mesh_workgroups_per_dimension;
+    limits.max_task_invocations_per_workgroup = available.max_task_invocations_per_workgroup;
+    limits.max_task_invocations_per_dimension = available.max_task_invocations_per_dimension;
+    limits.max_mesh_invocations_per_workgroup = available.max_mesh_invocations_per_workgroup;
+    limits.max_mesh_invocations_per_dimension = available.max_mesh_invocations_per_dimension;
+    limits.max_task_payload_size = available.max_task_payload_size;
+    limits.max_mesh_output_vertices = available.max_mesh_output_vertices;
+    limits.max_mesh_output_primitives = available.max_mesh_output_primitives;
+    limits.max_mesh_output_layers = available.max_mesh_output_layers;
+    descriptor.required_features |= wgpu::Features::EXPERIMENTAL_MESH_SHADER;
+    // SAFETY: the opt-in only allows requesting `EXPERIMENTAL_*` features; the only one
+    // requested is `EXPERIMENTAL_MESH_SHADER`, which the adapter reports, used by
+    // `strand_mesh.wgsl`'s pipelines within the limits the device reports.
+    descriptor.experimental_features = unsafe { wgpu::ExperimentalFeatures::enabled() };
 }
 
 /// Maps a `MAP_READ` buffer after the queue's work, and returns its bytes.
@@ -347,6 +399,16 @@ mod tests {
             subgroup_max_size: 64,
             transient_saves_memory: None,
             limit_bucket: None,
+        }
+    }
+
+    #[test]
+    fn mesh_shaders_are_kept_off_only_when_asked() {
+        for off in ["0", "off", "OFF", " false ", "no"] {
+            assert!(!mesh_shaders_wanted(Some(off)), "{off:?}");
+        }
+        for on in [None, Some(""), Some("1"), Some("on"), Some("yes")] {
+            assert!(mesh_shaders_wanted(on), "{on:?}");
         }
     }
 

@@ -30,9 +30,7 @@ use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody};
 use crate::renderer::preview_hair::{HairRenderer, HairUniforms, RibbonInput};
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
-use crate::renderer::strand_gen::{
-    GenerationPath, GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit,
-};
+use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
 use crate::view::View;
 
 /// A perspective camera looking at `target`.
@@ -370,10 +368,10 @@ impl PreviewRenderer {
         // Ribbons read their vertices from a buffer unless the generator makes them in the
         // vertex shader.
         let input = match &scene.hair {
-            HairSource::Generated { generator, .. }
-                if generator.path() == GenerationPath::VertexShader =>
-            {
-                RibbonInput::Generated
+            HairSource::Generated { generator, .. } => {
+                StrandGenRenderer::check_path(context, generator.path())
+                    .map_err(PreviewError::Generation)?;
+                generator.path().ribbon_input()
             }
             _ => RibbonInput::Buffer,
         };
@@ -467,7 +465,7 @@ impl PreviewRenderer {
             }
             HairSource::Stored { buffer, .. } => (buffer, 0),
             // No scratch: the ribbons bind the textures instead.
-            HairSource::Generated { .. } if input == RibbonInput::Generated => {
+            HairSource::Generated { .. } if input != RibbonInput::Buffer => {
                 owned = storage("preview_no_strands", &[0; 16]);
                 (&owned, 0)
             }
@@ -504,7 +502,7 @@ impl PreviewRenderer {
             &shadow_views,
         );
         let prepared_hair = match generator {
-            Some((generator, gpu_hair, filtering)) if input == RibbonInput::Generated => {
+            Some((generator, gpu_hair, filtering)) if input != RibbonInput::Buffer => {
                 state.hair.prepare_generated(
                     context,
                     &hair_views,
@@ -513,6 +511,7 @@ impl PreviewRenderer {
                     gpu_hair,
                     filtering,
                     &runs,
+                    input,
                 )
             }
             _ => state
@@ -531,7 +530,7 @@ impl PreviewRenderer {
             let Some((generator, gpu_hair, filtering)) = generator else {
                 return;
             };
-            if (single_batch && generated) || input == RibbonInput::Generated {
+            if (single_batch && generated) || input != RibbonInput::Buffer {
                 return;
             }
             generated = true;

@@ -144,6 +144,20 @@ impl ResourceRegistry {
         )
     }
 
+    pub fn mesh_pipeline(
+        &self,
+        device: &wgpu::Device,
+        descriptor: &wgpu::MeshPipelineDescriptor,
+    ) -> Tracked<wgpu::RenderPipeline> {
+        let pipeline = device.create_mesh_pipeline(descriptor);
+        self.track(
+            pipeline,
+            descriptor.label.unwrap_or("unlabelled pipeline"),
+            ResourceKind::Pipeline,
+            0,
+        )
+    }
+
     pub fn compute_pipeline(
         &self,
         device: &wgpu::Device,

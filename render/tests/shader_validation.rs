@@ -27,7 +27,11 @@ fn embedded() -> Vec<(String, String)> {
     use hairloom_render::renderer::scene_lighting::{
         RibbonInput, ShaderKey, body_shader, hair_shader, hair_shadow_shader,
     };
-    let inputs = [RibbonInput::Buffer, RibbonInput::Generated];
+    let inputs = [
+        RibbonInput::Buffer,
+        RibbonInput::Generated,
+        RibbonInput::Mesh,
+    ];
     let mut sources = vec![(
         "strand_gen".to_string(),
         hairloom_render::renderer::strand_gen::SHADER_SOURCE.to_string(),

@@ -101,7 +101,12 @@ struct RibbonVertex {
 }
 
 fn ribbon_vertex(vertex_index: u32, instance_index: u32) -> RibbonVertex {
-    let centre = ribbon_centre(vertex_index, instance_index);
+    return ribbon_vertex_at(ribbon_centre(vertex_index, instance_index));
+}
+
+// The ribbon vertex on `centre.side` of the strand vertex `centre` (the vertex shaders above,
+// and the mesh shader of shaders/strand_mesh.wgsl, which computes its centres itself).
+fn ribbon_vertex_at(centre: RibbonCentre) -> RibbonVertex {
     let run = centre.run;
     let p = centre.p;
     var tangent = centre.tangent;

@@ -36,7 +36,8 @@ use viewport::Viewport;
 
 /// The editor's wgpu setup: egui's defaults plus the optional features the generator uses
 /// when the adapter has them (timestamps for measured GPU time, f32 texture filtering for
-/// the hardware-filtering switch, f16), and without the GL backend, whose WebGL2 limits have
+/// the hardware-filtering switch, f16, mesh shaders for the fastest generation path), and
+/// without the GL backend, whose WebGL2 limits have
 /// no storage buffers. Shared by the binary and the wgpu snapshot tests.
 pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetup {
     let mut setup = eframe::egui_wgpu::WgpuSetupCreateNew::without_display_handle();
@@ -48,6 +49,7 @@ pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetup {
             | wgpu::Features::SHADER_F16;
         let mut descriptor = egui_descriptor(adapter);
         descriptor.required_features |= adapter.features() & optional;
+        hairloom_render::device::request_mesh_shaders(adapter, &mut descriptor);
         descriptor
     });
     eframe::egui_wgpu::WgpuSetup::CreateNew(setup)

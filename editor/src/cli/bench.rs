@@ -53,8 +53,9 @@ pub enum Which {
         #[arg(long, default_value_t = 3)]
         runs: usize,
         /// Generation paths to measure, comma-separated: compute (one invocation per strand),
-        /// compute-per-vertex, vertex-shader (in the ribbons, no scratch).
-        #[arg(long, value_enum, value_delimiter = ',', default_values = ["compute", "compute-per-vertex", "vertex-shader"])]
+        /// compute-per-vertex, vertex-shader (in the ribbons, no scratch), mesh-shader (task
+        /// and mesh shaders; a row says it skipped where the adapter has none).
+        #[arg(long, value_enum, value_delimiter = ',', default_values = ["compute", "compute-per-vertex", "vertex-shader", "mesh-shader"])]
         paths: Vec<super::GenerationArg>,
         /// Filtering to measure, comma-separated (exact, hardware).
         #[arg(long, value_enum, value_delimiter = ',', default_values = ["exact", "hardware"])]
@@ -398,9 +399,8 @@ fn gpu(
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-    use hairloom_render::renderer::strand_gen::{
-        GenerationPath, StrandGenRenderer, full_detail_plan,
-    };
+    use hairloom_render::renderer::scene_lighting::RibbonInput;
+    use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = super::render::parse_size(size)?;
     let document = hairloom_core::io::project::load(&path)?.document;
@@ -408,6 +408,15 @@ fn gpu(
     let generator = StrandGenRenderer::new(&context);
     let generators: Vec<StrandGenRenderer> = paths
         .iter()
+        .filter(
+            |&&path| match StrandGenRenderer::check_path(&context, path) {
+                Ok(()) => true,
+                Err(error) => {
+                    println!("{}: skipped: {error}", path.name());
+                    false
+                }
+            },
+        )
         .map(|&path| StrandGenRenderer::with_path(&context, path))
         .collect();
     let preview = PreviewRenderer::new(&context);
@@ -509,7 +518,7 @@ fn gpu(
                 let mut refused = None;
                 for generator in generators
                     .iter()
-                    .filter(|g| g.path() != GenerationPath::VertexShader)
+                    .filter(|g| g.path().ribbon_input() == RibbonInput::Buffer)
                 {
                     match median_timing(
                         || generator.time_generation(&context, &hair, &full, filtering),

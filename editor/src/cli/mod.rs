@@ -193,6 +193,8 @@ enum GenerationArg {
     Compute,
     ComputePerVertex,
     VertexShader,
+    /// Task and mesh shaders (adapters with `EXPERIMENTAL_MESH_SHADER`).
+    MeshShader,
 }
 
 impl From<GenerationArg> for GenerationPath {
@@ -201,6 +203,7 @@ impl From<GenerationArg> for GenerationPath {
             GenerationArg::Compute => GenerationPath::ComputePerStrand,
             GenerationArg::ComputePerVertex => GenerationPath::ComputePerVertex,
             GenerationArg::VertexShader => GenerationPath::VertexShader,
+            GenerationArg::MeshShader => GenerationPath::MeshShader,
         }
     }
 }

@@ -15,7 +15,7 @@ use crate::device::GpuContext;
 use crate::renderer::body_shadow::{depth_array, shadow_depth_state};
 use crate::renderer::preview_hair::{HairRenderer, PreparedHair, RibbonInput};
 use crate::renderer::scene_lighting::{first_hair_depth_entry, hair_shadow_shader};
-use crate::renderer::{PipelineSpec, pipeline};
+use crate::renderer::{PipelineSpec, ribbon_pipeline};
 use crate::resources::Tracked;
 
 pub const OPACITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -63,7 +63,7 @@ impl HairShadowRenderer {
         let topology = HairRenderer::topology(input);
         let deep = kind == SelfShadowing::DeepOpacityMaps;
         let depth_pipeline = deep.then(|| {
-            pipeline(
+            ribbon_pipeline(
                 context,
                 &PipelineSpec {
                     label: "hair_shadow_depth",
@@ -77,6 +77,7 @@ impl HairShadowRenderer {
                     depth: Some(shadow_depth_state(0.0)),
                     sample_count: 1,
                 },
+                input,
             )
         });
         let first_hair_layout = deep.then(|| {
@@ -105,7 +106,7 @@ impl HairShadowRenderer {
             .collect();
         let mut pipeline_groups = vec![hair.draw_layout(input), scene_layout];
         pipeline_groups.extend(first_hair_layout.as_ref());
-        let opacity_pipeline = pipeline(
+        let opacity_pipeline = ribbon_pipeline(
             context,
             &PipelineSpec {
                 label: "hair_shadow_opacity",
@@ -119,6 +120,7 @@ impl HairShadowRenderer {
                 depth: None,
                 sample_count: 1,
             },
+            input,
         );
         let opacity = context.resources.texture(
             device,

@@ -8,6 +8,7 @@
 //! |---|---|---|
 //! | [`strand_gen`] | `strand_gen.wgsl` | every frame with generated hair |
 //! | [`preview_hair`] | `preview_hair.wgsl` + `light/*` | always (the lit ribbons; OIT entry with width-based coverage) |
+//! | [`preview_hair`], [`hair_shadow`] | + `strand_mesh.wgsl` | the mesh-shader generation path (task and mesh stages in place of the vertex shader) |
 //! | [`preview_body`] | `preview_body.wgsl` + `light/*` | always |
 //! | [`hair_shadow`] | `hair_shadow.wgsl` | opacity shadow maps or deep opacity maps |
 //! | [`body_shadow`] | `preview_body.wgsl` (`vs_shadow`) | body shadows |
@@ -44,7 +45,11 @@ pub(crate) struct PipelineSpec<'a> {
     pub sample_count: u32,
 }
 
-pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgpu::RenderPipeline> {
+/// The shader module and pipeline layout of `spec`.
+fn module_and_layout(
+    context: &GpuContext,
+    spec: &PipelineSpec,
+) -> (wgpu::ShaderModule, wgpu::PipelineLayout) {
     let device = &context.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(spec.label),
@@ -57,6 +62,12 @@ pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgp
         bind_group_layouts: &groups,
         immediate_size: 0,
     });
+    (module, layout)
+}
+
+pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgpu::RenderPipeline> {
+    let device = &context.device;
+    let (module, layout) = module_and_layout(context, spec);
     context.resources.render_pipeline(
         device,
         &wgpu::RenderPipelineDescriptor {
@@ -85,6 +96,63 @@ pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgp
                 targets: spec.targets,
             }),
             multiview_mask: None,
+            cache: None,
+        },
+    )
+}
+
+/// [`pipeline`] for a pass that draws ribbons from `input`: mesh-shader ribbons
+/// ([`scene_lighting::RibbonInput::Mesh`]) take the source's task and mesh entry points
+/// (`ts_main`, `ms_main` of `strand_mesh.wgsl`) in place of its vertex shader.
+pub(crate) fn ribbon_pipeline(
+    context: &GpuContext,
+    spec: &PipelineSpec,
+    input: scene_lighting::RibbonInput,
+) -> Tracked<wgpu::RenderPipeline> {
+    if input != scene_lighting::RibbonInput::Mesh {
+        return pipeline(context, spec);
+    }
+    let (module, layout) = module_and_layout(context, spec);
+    // strand_mesh.wgsl reads no workgroup memory it has not written (each strand's set-up,
+    // its styled and morphed points), and the outputs past the counts it sets are never
+    // read, so the zeroing naga would add to every mesh workgroup (its 256 outputs too) is
+    // skipped.
+    let stage_options = || wgpu::PipelineCompilationOptions {
+        zero_initialize_workgroup_memory: false,
+        ..Default::default()
+    };
+    context.resources.mesh_pipeline(
+        &context.device,
+        &wgpu::MeshPipelineDescriptor {
+            label: Some(spec.label),
+            layout: Some(&layout),
+            task: Some(wgpu::TaskState {
+                module: &module,
+                entry_point: Some("ts_main"),
+                compilation_options: stage_options(),
+            }),
+            mesh: wgpu::MeshState {
+                module: &module,
+                entry_point: Some("ms_main"),
+                compilation_options: stage_options(),
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: spec.depth.clone(),
+            multisample: wgpu::MultisampleState {
+                count: spec.sample_count,
+                ..Default::default()
+            },
+            fragment: spec.fragment_entry.map(|entry| wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: spec.targets,
+            }),
+            multiview: None,
             cache: None,
         },
     )

@@ -15,10 +15,14 @@ use crate::device::GpuContext;
 pub use crate::renderer::scene_lighting::RibbonInput;
 use crate::renderer::scene_lighting::{ActiveEffects, ShaderKey, hair_shader};
 use crate::renderer::strand_gen::{
-    GENERATED_BINDING_OFFSET, GpuHair, StrandGenRenderer, source_layout_entries,
+    GENERATED_BINDING_OFFSET, GpuHair, StrandGenRenderer, mesh_shaders_available,
+    source_layout_entries,
 };
+
+/// Where `strand_mesh.wgsl`'s task shader binds the bundles' bounding spheres (group 0).
+pub const MESH_SPHERES_BINDING: u32 = 32;
 use crate::renderer::{
-    PipelineSpec, Targets, pipeline, uniform_entry, view_color_target, view_depth,
+    PipelineSpec, Targets, ribbon_pipeline, uniform_entry, view_color_target, view_depth,
 };
 use crate::resources::Tracked;
 
@@ -71,6 +75,9 @@ pub struct HairRenderer {
     draw_layout: wgpu::BindGroupLayout,
     /// Group 0 with strand_gen's resources, for ribbons that generate their vertices.
     generated_layout: wgpu::BindGroupLayout,
+    /// The same for task and mesh shaders, with the bundles' bounding spheres; only on a
+    /// device with mesh shaders.
+    mesh_layout: Option<wgpu::BindGroupLayout>,
     /// Bytes between two uniform entries (the adapter's dynamic-offset alignment).
     uniform_stride: u64,
     targets: Targets,
@@ -132,10 +139,32 @@ impl HairRenderer {
             label: Some("preview_hair_generated"),
             entries: &generated_entries,
         });
+        let mesh_layout = mesh_shaders_available(device).then(|| {
+            let stages = wgpu::ShaderStages::TASK | wgpu::ShaderStages::MESH;
+            let mut entries: Vec<wgpu::BindGroupLayoutEntry> = generated_entries
+                .iter()
+                .map(|entry| wgpu::BindGroupLayoutEntry {
+                    visibility: match entry.binding {
+                        0 => stages | wgpu::ShaderStages::FRAGMENT,
+                        _ => stages,
+                    },
+                    ..*entry
+                })
+                .collect();
+            entries.push(wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::TASK,
+                ..storage(MESH_SPHERES_BINDING, 16)
+            });
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("preview_hair_mesh"),
+                entries: &entries,
+            })
+        });
         let alignment = device.limits().min_uniform_buffer_offset_alignment as u64;
         Self {
             draw_layout,
             generated_layout,
+            mesh_layout,
             uniform_stride: (size_of::<HairUniforms>() as u64).div_ceil(alignment) * alignment,
             targets,
             pipelines: None,
@@ -152,13 +181,16 @@ impl HairRenderer {
         match input {
             RibbonInput::Buffer => &self.draw_layout,
             RibbonInput::Generated => &self.generated_layout,
+            // Without mesh shaders no mesh pipeline exists (the path is refused first:
+            // `StrandGenRenderer::check_path`).
+            RibbonInput::Mesh => self.mesh_layout.as_ref().unwrap_or(&self.generated_layout),
         }
     }
 
     /// The primitive topology of ribbons from `input`.
     pub fn topology(input: RibbonInput) -> wgpu::PrimitiveTopology {
         match input {
-            RibbonInput::Buffer => wgpu::PrimitiveTopology::TriangleList,
+            RibbonInput::Buffer | RibbonInput::Mesh => wgpu::PrimitiveTopology::TriangleList,
             RibbonInput::Generated => wgpu::PrimitiveTopology::TriangleStrip,
         }
     }
@@ -182,7 +214,7 @@ impl HairRenderer {
         let topology = Self::topology(input);
         let mut groups = vec![self.draw_layout(input), scene_layout];
         groups.extend(effects_layout);
-        let depth = pipeline(
+        let depth = ribbon_pipeline(
             context,
             &PipelineSpec {
                 label: "preview_hair_depth",
@@ -201,8 +233,9 @@ impl HairRenderer {
                 depth: Some(view_depth(&self.targets, true)),
                 sample_count: self.targets.sample_count,
             },
+            input,
         );
-        let main = pipeline(
+        let main = ribbon_pipeline(
             context,
             &PipelineSpec {
                 label: "preview_hair",
@@ -219,6 +252,7 @@ impl HairRenderer {
                 }),
                 sample_count: self.targets.sample_count,
             },
+            input,
         );
         let oit = key.1.then(|| {
             let add = wgpu::BlendComponent {
@@ -231,7 +265,7 @@ impl HairRenderer {
                 dst_factor: wgpu::BlendFactor::OneMinusSrc,
                 operation: wgpu::BlendOperation::Add,
             };
-            pipeline(
+            ribbon_pipeline(
                 context,
                 &PipelineSpec {
                     label: "preview_hair_oit",
@@ -264,6 +298,7 @@ impl HairRenderer {
                     depth: Some(view_depth(&self.targets, false)),
                     sample_count: self.targets.sample_count,
                 },
+                input,
             )
         });
         self.pipelines = Some(HairPipelines {
@@ -354,8 +389,9 @@ impl HairRenderer {
     }
 
     /// As [`Self::prepare`], for ribbons that generate their own vertices from `hair`
-    /// ([`RibbonInput::Generated`]): the bind group holds strand_gen's resources instead of
-    /// vertices.
+    /// ([`RibbonInput::Generated`] or [`RibbonInput::Mesh`]): the bind group holds
+    /// strand_gen's resources instead of vertices (and, for mesh shaders, the bundles'
+    /// bounding spheres).
     #[expect(
         clippy::too_many_arguments,
         reason = "one frame's generation inputs, passed through"
@@ -369,6 +405,7 @@ impl HairRenderer {
         hair: &GpuHair,
         filtering: Filtering,
         runs: &wgpu::Buffer,
+        input: RibbonInput,
     ) -> PreparedHair {
         let (uniforms, batch_count) = self.uniforms(context, views, batches);
         // first_run and run_count are per batch in the ribbons' uniforms; these are unused.
@@ -381,16 +418,22 @@ impl HairRenderer {
             },
         ];
         entries.extend(generator.source_entries(GENERATED_BINDING_OFFSET, hair, &params));
+        if input == RibbonInput::Mesh {
+            entries.push(wgpu::BindGroupEntry {
+                binding: MESH_SPHERES_BINDING,
+                resource: hair.bundle_spheres().as_entire_binding(),
+            });
+        }
         let group = context
             .device
             .create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("preview_hair_generated"),
-                layout: &self.generated_layout,
+                layout: self.draw_layout(input),
                 entries: &entries,
             });
         PreparedHair {
             group,
-            input: RibbonInput::Generated,
+            input,
             stride: self.uniform_stride,
             batch_count,
         }
@@ -399,7 +442,8 @@ impl HairRenderer {
     /// Draws batch `batch` (whose runs are `runs`) of view `view` with `pipeline`; groups 1
     /// and 2, when the pipeline has them, are set by the caller. Ribbons from a buffer are one
     /// triangle-list draw (6 vertices per segment); generated ribbons one draw per run, a
-    /// strip of 2 vertices per strand vertex for each of its strands (the instances).
+    /// strip of 2 vertices per strand vertex for each of its strands (the instances);
+    /// mesh-shader ribbons one task workgroup per run.
     pub fn draw_with(
         pass: &mut wgpu::RenderPass<'_>,
         pipeline: &wgpu::RenderPipeline,
@@ -427,6 +471,7 @@ impl HairRenderer {
                     );
                 }
             }
+            RibbonInput::Mesh => pass.draw_mesh_tasks(runs.len() as u32, 1, 1),
         }
     }
 

@@ -17,6 +17,7 @@ use hairloom_core::runtime::textures::{Precision, RuntimeTextures, Texture3d};
 use wgpu::util::DeviceExt;
 
 use crate::device::{GpuContext, read_buffer};
+use crate::renderer::scene_lighting::RibbonInput;
 use crate::resources::Tracked;
 
 /// The WGSL source: `shaders/shared/strand_run.wgsl`, `shaders/shared/strand_vertex.wgsl`,
@@ -93,6 +94,10 @@ pub enum StrandGenError {
         "{adapter} cannot filter 32-bit float textures in hardware; use exact filtering or f16 textures"
     )]
     NoFloat32Filtering { adapter: String },
+    #[error(
+        "{adapter} has no mesh shaders (wgpu's EXPERIMENTAL_MESH_SHADER, Vulkan VK_EXT_mesh_shader); choose another generation path"
+    )]
+    NoMeshShaders { adapter: String },
     #[error("reading generated positions back failed: {0}")]
     Readback(String),
     /// A resource would exceed what the adapter allows; nothing was created.
@@ -206,13 +211,20 @@ pub enum GenerationPath {
     /// draws the hair. Readbacks ([`StrandGenRenderer::generate_positions`],
     /// [`StrandGenRenderer::store`]) still use the per-strand compute entry.
     VertexShader,
+    /// No compute pass and no scratch buffer: task shaders cull each run's bundle against the
+    /// pass's view and launch mesh shaders that generate strand groups with each strand's
+    /// set-up and every vertex computed once (`strand_mesh.wgsl`; seed 000 §4). Only where
+    /// the device has [`wgpu::Features::EXPERIMENTAL_MESH_SHADER`]
+    /// ([`GenerationPath::available`]).
+    MeshShader,
 }
 
 impl GenerationPath {
-    pub const ALL: [GenerationPath; 3] = [
+    pub const ALL: [GenerationPath; 4] = [
         GenerationPath::ComputePerStrand,
         GenerationPath::ComputePerVertex,
         GenerationPath::VertexShader,
+        GenerationPath::MeshShader,
     ];
 
     pub fn name(self) -> &'static str {
@@ -220,8 +232,53 @@ impl GenerationPath {
             GenerationPath::ComputePerStrand => "compute per strand",
             GenerationPath::ComputePerVertex => "compute per vertex",
             GenerationPath::VertexShader => "vertex shader",
+            GenerationPath::MeshShader => "mesh shader",
         }
     }
+
+    /// Whether `device` can run this path (every path but mesh shaders runs anywhere).
+    pub fn available(self, device: &wgpu::Device) -> bool {
+        self != GenerationPath::MeshShader || mesh_shaders_available(device)
+    }
+
+    /// The fastest path `device` has: mesh shaders where it has them, else compute per strand
+    /// (what `--generation auto` picks).
+    pub fn preferred(device: &wgpu::Device) -> Self {
+        if mesh_shaders_available(device) {
+            GenerationPath::MeshShader
+        } else {
+            GenerationPath::ComputePerStrand
+        }
+    }
+
+    /// Where the ribbons of this path take their vertices from: a buffer the compute pass
+    /// fills, or their own generation (vertex shader, mesh shader: no compute pass, no
+    /// scratch buffer).
+    pub fn ribbon_input(self) -> RibbonInput {
+        match self {
+            GenerationPath::ComputePerStrand | GenerationPath::ComputePerVertex => {
+                RibbonInput::Buffer
+            }
+            GenerationPath::VertexShader => RibbonInput::Generated,
+            GenerationPath::MeshShader => RibbonInput::Mesh,
+        }
+    }
+}
+
+/// Whether `device` was created with mesh shaders (wgpu's `EXPERIMENTAL_MESH_SHADER`, which
+/// [`crate::device::GpuContext::new_headless`] requests where the adapter has it) and limits
+/// that hold `strand_mesh.wgsl`'s groups: 128 invocations, 256 ribbon vertices and 256
+/// triangles per mesh workgroup (what NVIDIA, AMD and DirectX 12 guarantee).
+pub fn mesh_shaders_available(device: &wgpu::Device) -> bool {
+    let limits = device.limits();
+    device
+        .features()
+        .contains(wgpu::Features::EXPERIMENTAL_MESH_SHADER)
+        && limits.max_mesh_invocations_per_workgroup >= 128
+        && limits.max_mesh_invocations_per_dimension >= 128
+        && limits.max_mesh_output_vertices >= 256
+        && limits.max_mesh_output_primitives >= 256
+        && limits.max_task_payload_size >= 4
 }
 
 /// Pipeline and bind-group layout of `strand_gen` (one per device).
@@ -275,6 +332,14 @@ pub fn full_detail_plan(root_count: usize, vertex_count: u32) -> FramePlan {
     plan
 }
 
+impl GpuHair {
+    /// Each bundle's bounding sphere (`[centre, radius]`, block order): what the mesh path's
+    /// task shaders cull with.
+    pub fn bundle_spheres(&self) -> &wgpu::Buffer {
+        &self.bundle_spheres
+    }
+}
+
 /// Measured cost of generating a set of strands.
 #[derive(Clone, Copy, Debug)]
 pub struct GenerationTiming {
@@ -302,6 +367,8 @@ pub struct GpuHair {
     u: wgpu::TextureView,
     v: wgpu::TextureView,
     bundle_buffer: Tracked<wgpu::Buffer>,
+    /// Each bundle's bounding sphere (centre, radius), for the mesh path's task shaders.
+    bundle_spheres: Tracked<wgpu::Buffer>,
     samples: Tracked<wgpu::Buffer>,
     sample_set: u32,
     /// Strands at full detail: bundles × `per_bundle`.
@@ -431,6 +498,19 @@ fn bundle_placements(textures: &RuntimeTextures, block_styling: &[u32]) -> Vec<B
         bundles.push(BundleGpu::default());
     }
     bundles
+}
+
+/// Each bundle's bounding sphere as `[centre, radius]` (never empty: a storage buffer cannot
+/// be).
+fn bundle_spheres(bounds: &[BundleBounds]) -> Vec<[f32; 4]> {
+    let mut spheres: Vec<[f32; 4]> = bounds
+        .iter()
+        .map(|b| b.centre.extend(b.radius_m).to_array())
+        .collect();
+    if spheres.is_empty() {
+        spheres.push([0.0; 4]);
+    }
+    spheres
 }
 
 /// The styling array, or the default parameters when it is empty.
@@ -579,6 +659,9 @@ impl StrandGenRenderer {
         let styling_bytes: &[u8] = bytemuck::cast_slice(&styling);
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
+        let bounds = hair.bundle_bounds();
+        let spheres = bundle_spheres(&bounds);
+        let sphere_bytes: &[u8] = bytemuck::cast_slice(&spheres);
         Ok(GpuHair {
             position_offset: textures.position_offset.to_array(),
             textures: vec![t0, t1, t2, t3, t4],
@@ -588,11 +671,12 @@ impl StrandGenRenderer {
             u,
             v,
             bundle_buffer: buffer("strand_gen_bundles", bundle_bytes),
+            bundle_spheres: buffer("strand_mesh_bundle_spheres", sphere_bytes),
             samples: buffer("strand_gen_samples", sample_bytes),
             sample_set: sample_set as u32,
             root_count: block_count * per_bundle,
             styling: buffer("strand_gen_styling", styling_bytes),
-            bundles: hair.bundle_bounds(),
+            bundles: bounds,
             per_bundle: per_bundle as u32,
             layout: TextureLayout::of(hair, per_bundle as u32),
             bytes: a
@@ -600,7 +684,10 @@ impl StrandGenRenderer {
                 + c
                 + d
                 + e
-                + (bundle_bytes.len() + sample_bytes.len() + styling_bytes.len()) as u64,
+                + (bundle_bytes.len()
+                    + sphere_bytes.len()
+                    + sample_bytes.len()
+                    + styling_bytes.len()) as u64,
         })
     }
 
@@ -635,6 +722,11 @@ impl StrandGenRenderer {
         }
         gpu.position_offset = textures.position_offset.to_array();
         gpu.bundles = hair.bundle_bounds();
+        context.queue.write_buffer(
+            &gpu.bundle_spheres,
+            0,
+            bytemuck::cast_slice(&bundle_spheres(&gpu.bundles)),
+        );
         self.update_styling(context, gpu, hair);
         true
     }
@@ -742,6 +834,18 @@ impl StrandGenRenderer {
             _ => strand_total,
         };
         pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP_SIZE), 1, 1);
+    }
+
+    /// Refuses a path the device cannot run (mesh shaders without
+    /// `EXPERIMENTAL_MESH_SHADER`), naming the adapter.
+    pub fn check_path(context: &GpuContext, path: GenerationPath) -> Result<(), StrandGenError> {
+        if path.available(&context.device) {
+            Ok(())
+        } else {
+            Err(StrandGenError::NoMeshShaders {
+                adapter: crate::device::describe(&context.adapter_info),
+            })
+        }
     }
 
     /// Where strands are generated.

@@ -9,6 +9,7 @@ use super::*;
 use eframe::egui_wgpu::{CallbackResources, CallbackTrait, ScreenDescriptor};
 use hairloom_core::model::scene::Scene;
 use hairloom_core::model::styling::StylingSet;
+use hairloom_render::renderer::strand_gen::GenerationPath;
 use hairloom_render::renderer::viewport_blit::ViewportBlitRenderer;
 
 /// The viewport's GPU side, kept in egui_wgpu's callback resources.
@@ -38,7 +39,11 @@ impl ViewportGpu {
     /// sample: eframe's default and egui_kittest's).
     pub(super) fn new(context: GpuContext, target_format: wgpu::TextureFormat) -> Self {
         Self {
-            generator: Arc::new(StrandGenRenderer::new(&context)),
+            // Mesh shaders where the device has them, else compute per strand.
+            generator: Arc::new(StrandGenRenderer::with_path(
+                &context,
+                GenerationPath::preferred(&context.device),
+            )),
             preview: PreviewRenderer::new(&context),
             blit: ViewportBlitRenderer::new(&context, target_format, 1),
             context,
