@@ -4,10 +4,11 @@
 // `PassVertex` and `pass_vertex`), so every pass that draws the hair — depth pre-pass, lit,
 // width OIT, opacity maps — can run it in place of its vertex shader; render/src/ prepends
 // `enable wgpu_mesh_shader;`.
-// - Task shader, one workgroup per run (a bundle at one detail level, from the frame plan):
-//   culls the bundle's bounding sphere against this pass's view (the camera, or a light for
-//   the shadow passes, which the frame plan does not cull for) and launches one mesh
-//   workgroup per strand group.
+// - Task shader, one workgroup per bundle: culls the bundle's bounding sphere against this
+//   pass's view (the camera, or a light in the shadow passes), computes its level of detail
+//   from the frame's camera (eq. 7-12: strands, vertices per strand, morph factor, thickness;
+//   shared/strand_lod.wgsl, mirror frame_plan::bundle_lod — the same strands every other
+//   path draws) and launches one mesh workgroup per strand group. No CPU frame plan.
 // - Mesh shader, one workgroup per strand group: one invocation per strand vertex. The
 //   strand's set-up (root, root uv, the styling ops' random values) is computed once per
 //   strand and shared through workgroup memory, every vertex once, odd vertices morphed from
@@ -15,27 +16,33 @@
 //   each invocation writes its two ribbon vertices and the two triangles to the next vertex.
 //   No scratch buffer, and nothing evaluated twice (the vertex-shader path evaluates 3-7
 //   styled vertices per ribbon vertex).
-// Work distribution: a run of n vertices per strand puts ⌊128 / n⌋ whole strands in a group
-// when n ≤ 128; longer strands are cut into chunks of 127 vertices that overlap by one (chunk
-// starts are even, so every odd vertex's neighbours are in its chunk), one chunk per group.
+// Work distribution: a run of n vertices per strand puts ⌊96 / n⌋ whole strands (at most 16)
+// in a group when n ≤ 96; longer strands are cut into chunks of 95 vertices that overlap by
+// one (chunk starts are even, so every odd vertex's neighbours are in its chunk), one chunk
+// per group.
 // The same triangles as the vertex-shader path's strips, so the same picture
 // (render/tests/strand_mesh.rs); CPU mirror of the points and tangents: StrandGen::main
 // followed by runtime::preview_hair, as for the other paths.
 
-// Strand vertices (invocations) per mesh workgroup; ribbon vertices are twice this.
-const MESH_STRAND_VERTICES: u32 = 128u;
+// Strand vertices (invocations) per mesh workgroup; ribbon vertices are twice this. Sized so
+// a group's memory fits NVIDIA's mesh-shader limits (28 KiB of workgroup memory, which naga's
+// SPIR-V also keeps the outputs in; 32 KiB of outputs): 192 ribbon vertices of 8 attribute
+// slots is 24 KiB, and render/tests/shader_validation.rs adds up the workgroup memory.
+const MESH_STRAND_VERTICES: u32 = 96u;
 // Segments per chunk of a strand longer than a group (even: chunks start on even vertices).
-const MESH_CHUNK_SEGMENTS: u32 = 126u;
-// Most whole strands in a group (2-vertex strands).
-const MESH_MAX_STRANDS: u32 = 64u;
+const MESH_CHUNK_SEGMENTS: u32 = 94u;
+// Most whole strands in a group (short strands far away), each with its set-up in workgroup
+// memory.
+const MESH_MAX_STRANDS: u32 = 16u;
 
-// Each bundle's bounding sphere (centre, radius), in the hair's model space
-// (`RuntimeTextures::bundle_bounds`, as the frame plan culls with).
-@group(0) @binding(32) var<storage, read> bundle_spheres: array<vec4<f32>>;
+// Each bundle's bounds and sizes, in the hair's model space (`RuntimeTextures::bundle_bounds`,
+// as the frame plan culls and plans with), and the frame's LOD camera and settings.
+@group(0) @binding(32) var<storage, read> bundle_lods: array<BundleLodGpu>;
+@group(0) @binding(33) var<uniform> lod: LodParams;
 
 struct MeshTask {
-    // Index into `runs` of the run the task's groups draw.
-    run: u32,
+    // The bundle's strands at its level of detail.
+    run: StrandRun,
 }
 
 var<task_payload> task: MeshTask;
@@ -87,14 +94,17 @@ fn sphere_in_view(m: mat4x4<f32>, centre: vec3<f32>, radius: f32) -> bool {
 @payload(task)
 @workgroup_size(1)
 fn ts_main(@builtin(workgroup_id) group: vec3<u32>) -> @builtin(mesh_task_size) vec3<u32> {
-    let index = hair.batch.x + min(group.x, max(hair.batch.y, 1u) - 1u);
-    task.run = index;
-    let run = runs[index];
-    if group.x >= hair.batch.y || run.strand_count == 0u {
+    let index = group.y * lod.counts.w + group.x;
+    if index >= lod.counts.z {
         return vec3<u32>(0u, 1u, 1u);
     }
-    let sphere = bundle_spheres[run.first_root / max(params.per_bundle, 1u)];
-    if !sphere_in_view(hair.view_projection, sphere.xyz, sphere.w) {
+    let bundle = bundle_lods[index];
+    if lod.switches.z != 0.0 && !sphere_in_view(hair.view_projection, bundle.centre, bundle.radius_m) {
+        return vec3<u32>(0u, 1u, 1u);
+    }
+    let run = bundle_lod(index, bundle, lod);
+    task.run = run;
+    if run.strand_count == 0u {
         return vec3<u32>(0u, 1u, 1u);
     }
     let work = mesh_work(max(run.vertex_count, 2u));
@@ -107,8 +117,8 @@ struct RibbonTriangle {
 }
 
 struct MeshOutput {
-    @builtin(vertices) vertices: array<PassVertex, 256>,
-    @builtin(primitives) primitives: array<RibbonTriangle, 256>,
+    @builtin(vertices) vertices: array<PassVertex, 192>,
+    @builtin(primitives) primitives: array<RibbonTriangle, 192>,
     @builtin(vertex_count) vertex_count: u32,
     @builtin(primitive_count) primitive_count: u32,
 }
@@ -116,8 +126,8 @@ struct MeshOutput {
 var<workgroup> mesh_out: MeshOutput;
 // Each strand's set-up, computed by its first invocation.
 var<workgroup> mesh_inputs: array<StrandInput, MESH_MAX_STRANDS>;
-// The styled vertices, then the morphed ones.
-var<workgroup> mesh_styled: array<vec3<f32>, MESH_STRAND_VERTICES>;
+// The styled vertices, then the morphed ones: odd vertices are morphed in place, reading only
+// their even neighbours, which never change.
 var<workgroup> mesh_points: array<vec3<f32>, MESH_STRAND_VERTICES>;
 
 // Morphed strand vertex q of the slot whose vertex k0 is mesh_points[base]: from workgroup
@@ -132,12 +142,12 @@ fn mesh_point(base: u32, k0: u32, chunk: u32, q: u32, input: StrandInput, n: u32
 
 @mesh(mesh_out)
 @payload(task)
-@workgroup_size(128)
+@workgroup_size(96)
 fn ms_main(
     @builtin(local_invocation_index) t: u32,
     @builtin(workgroup_id) group: vec3<u32>,
 ) {
-    let run = runs[task.run];
+    let run = task.run;
     let n = max(run.vertex_count, 2u);
     let work = mesh_work(n);
     let first_strand = (group.x / work.chunks_per_strand) * work.strands_per_group;
@@ -160,16 +170,13 @@ fn ms_main(
     }
     workgroupBarrier();
     if in_group {
-        mesh_styled[t] = styled_vertex(mesh_inputs[slot], k, n);
+        mesh_points[t] = styled_vertex(mesh_inputs[slot], k, n);
     }
     workgroupBarrier();
-    if in_group {
+    if in_group && run.gamma > 0.0 && k % 2u == 1u && k + 1u < n {
         // Eq. 11, as strand_gen.wgsl `main`: an odd vertex toward its neighbours' midpoint.
-        var p = mesh_styled[t];
-        if run.gamma > 0.0 && k % 2u == 1u && k + 1u < n {
-            p = mix(p, 0.5 * (mesh_styled[t - 1u] + mesh_styled[t + 1u]), run.gamma);
-        }
-        mesh_points[t] = p;
+        let middle = 0.5 * (mesh_points[t - 1u] + mesh_points[t + 1u]);
+        mesh_points[t] = mix(mesh_points[t], middle, run.gamma);
     }
     workgroupBarrier();
     if !in_group {

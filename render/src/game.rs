@@ -68,7 +68,9 @@ use crate::renderer::Targets;
 use crate::renderer::body_shadow::BodyShadowRenderer;
 use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::preview_body::{BodyRenderer, GpuBody, PreparedBody};
-use crate::renderer::preview_hair::{HairRenderer, HairUniforms, PreparedHair, RibbonInput};
+use crate::renderer::preview_hair::{
+    HairRenderer, HairUniforms, MeshLod, PreparedHair, RibbonInput,
+};
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, effects_layout};
 use crate::renderer::strand_gen::{GenerationPath, GpuHair, StrandGenError, StrandGenRenderer};
 use crate::resources::Tracked;
@@ -458,7 +460,11 @@ impl GameHair {
                 &self.gpu,
                 self.filtering,
                 &runs,
-                input,
+                (input == RibbonInput::Mesh).then_some(MeshLod {
+                    camera: lod_camera,
+                    settings: self.lod,
+                    max_vertices_log2: self.vertex_count.saturating_sub(1).max(1).ilog2(),
+                }),
             ),
         };
         let body = self.body_renderer.prepare(context, &body_views);

@@ -28,7 +28,7 @@ use crate::renderer::body_shadow::BodyShadowRenderer;
 use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody};
-use crate::renderer::preview_hair::{HairRenderer, HairUniforms, RibbonInput};
+use crate::renderer::preview_hair::{HairRenderer, HairUniforms, MeshLod, RibbonInput};
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
 use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
 use crate::view::View;
@@ -308,23 +308,28 @@ impl PreviewRenderer {
         })
     }
 
-    /// The bundle-level work of a frame: which strands at which detail, in batches.
-    pub fn plan(&self, scene: &PreviewScene, width: u32, height: u32) -> FramePlan {
+    /// The camera as LOD sees it in a `width` × `height` frame of `scene`.
+    fn lod_camera(scene: &PreviewScene, width: u32, height: u32) -> LodCamera {
         let (width, height) = (width.max(1), height.max(1));
+        LodCamera {
+            eye: scene.camera.eye,
+            view_projection: scene.camera.view_projection(width as f32 / height as f32),
+            fov_y_rad: scene.camera.fov_y_rad,
+            resolution_px: height as f32,
+        }
+    }
+
+    /// The bundle-level work of a frame: which strands at which detail, in batches. (The
+    /// mesh path's task shaders plan the same on the GPU; this plan then only counts.)
+    pub fn plan(&self, scene: &PreviewScene, width: u32, height: u32) -> FramePlan {
         match &scene.hair {
             HairSource::Generated { hair, lod, .. } => {
-                let camera = LodCamera {
-                    eye: scene.camera.eye,
-                    view_projection: scene.camera.view_projection(width as f32 / height as f32),
-                    fov_y_rad: scene.camera.fov_y_rad,
-                    resolution_px: height as f32,
-                };
                 let max_log2 = scene.vertex_count.saturating_sub(1).max(1).ilog2();
                 plan_frame(
                     &hair.bundles,
                     hair.per_bundle,
                     max_log2,
-                    &camera,
+                    &Self::lod_camera(scene, width, height),
                     lod,
                     batch_vertex_limit(scene.vertex_count),
                 )
@@ -511,7 +516,14 @@ impl PreviewRenderer {
                     gpu_hair,
                     filtering,
                     &runs,
-                    input,
+                    (input == RibbonInput::Mesh).then(|| MeshLod {
+                        camera: Self::lod_camera(scene, width, height),
+                        settings: match &scene.hair {
+                            HairSource::Generated { lod, .. } => *lod,
+                            _ => LodSettings::default(),
+                        },
+                        max_vertices_log2: scene.vertex_count.saturating_sub(1).max(1).ilog2(),
+                    }),
                 )
             }
             _ => state

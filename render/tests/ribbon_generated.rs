@@ -225,66 +225,24 @@ fn vertex_shader_generation_matches_compute_and_the_cpu_mirror() {
 /// and with the compute path: the same picture.
 #[test]
 fn vertex_shader_frames_match_compute_frames() {
-    use hairloom_core::model::scene::{Coverage, SelfShadowing};
-    use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
-    use hairloom_render::renderer::preview_body::GpuBody;
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };
-    let document = common::sample("head_curly");
-    let runtime = RuntimeHair::from_document(
-        &document,
-        &RuntimeOptions {
-            strands_per_bundle: 12,
-            ..RuntimeOptions::default()
-        },
+    let (pictures, plan) = common::frames(
+        &context,
+        "head_curly",
+        12,
+        33,
+        LodSettings::default(),
+        Vec3::new(0.6, 0.2, 1.0),
+        &[
+            GenerationPath::ComputePerStrand,
+            GenerationPath::VertexShader,
+        ],
     );
-    let mut scene = document.scene.clone();
-    scene.effects.self_shadowing = SelfShadowing::DeepOpacityMaps;
-    scene.effects.body_shadows = true;
-    scene.effects.coverage = Coverage::WidthOit;
-    let body = GpuBody::upload(&context, &document.body);
-    let (lo, hi) = runtime.textures.hair_bounds().expect("hair");
-    let camera = Camera::framing(lo, hi, Vec3::new(0.6, 0.2, 1.0));
-    let preview = PreviewRenderer::new(&context);
-    let (width, height) = (160, 160);
-    let mut pictures = Vec::new();
-    for path in [
-        GenerationPath::ComputePerStrand,
-        GenerationPath::VertexShader,
-    ] {
-        let generator = StrandGenRenderer::with_path(&context, path);
-        let hair = generator.upload(&context, &runtime).expect("upload");
-        let frame = default_scene(
-            &body,
-            HairSource::Generated {
-                generator: &generator,
-                hair: &hair,
-                filtering: Filtering::Exact,
-                lod: LodSettings::default(),
-            },
-            33,
-            (lo, hi),
-            camera,
-            &scene,
-        );
-        let plan = preview.plan(&frame, width, height);
-        assert!(plan.strands > 0);
-        pictures.push(
-            preview
-                .render(&context, &frame, &plan, width, height)
-                .expect("frame"),
-        );
-    }
-    let (compute, vertex_shader) = (&pictures[0], &pictures[1]);
-    let pixels = compute.len() / 4;
-    let differing = compute
-        .chunks(4)
-        .zip(vertex_shader.chunks(4))
-        .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2))
-        .count();
-    // Pixels unlike the top-left corner's (the background).
-    let drawn = compute.chunks(4).filter(|p| p[..3] != compute[..3]).count();
+    assert!(plan.strands > 0);
+    let pixels = pictures[0].len() / 4;
+    let (differing, drawn) = common::compare(&pictures[0], &pictures[1]);
     eprintln!("{differing} of {pixels} pixels differ by more than 2/255 ({drawn} drawn)");
     assert!(drawn > pixels / 10, "the head is in the picture");
     assert!(

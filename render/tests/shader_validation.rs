@@ -116,7 +116,7 @@ fn wgsl_struct_size(module: &naga::Module, name: &str) -> Option<u32> {
 fn gpu_structs_match_their_wgsl() {
     use hairloom_core::light::scene_uniforms::{GpuLight, GpuShadowView, SceneUniforms};
     use hairloom_core::runtime::gpu_types::{
-        BundleGpu, StrandGenParams, StrandRoot, StrandRun, StylingGpu,
+        BundleGpu, BundleLodGpu, LodParams, StrandGenParams, StrandRoot, StrandRun, StylingGpu,
     };
     use hairloom_render::renderer::preview_body::BodyUniforms;
     use hairloom_render::renderer::preview_hair::{HairUniforms, default_hair_shader};
@@ -125,7 +125,15 @@ fn gpu_structs_match_their_wgsl() {
     let body_shader = hairloom_render::renderer::scene_lighting::body_shader(
         &hairloom_render::renderer::scene_lighting::ShaderKey::all()[0],
     );
-    let (hair, body) = (hair_shader.as_str(), body_shader.as_str());
+    let mesh_shader = hairloom_render::renderer::scene_lighting::hair_shader(
+        &hairloom_render::renderer::scene_lighting::ShaderKey::all()[0],
+        hairloom_render::renderer::scene_lighting::RibbonInput::Mesh,
+    );
+    let (hair, body, mesh) = (
+        hair_shader.as_str(),
+        body_shader.as_str(),
+        mesh_shader.as_str(),
+    );
     for (source, name, rust_size) in [
         (
             SHADER_SOURCE,
@@ -143,6 +151,8 @@ fn gpu_structs_match_their_wgsl() {
         (hair, "SceneLight", size_of::<GpuLight>()),
         (hair, "ShadowView", size_of::<GpuShadowView>()),
         (body, "SceneUniforms", size_of::<SceneUniforms>()),
+        (mesh, "BundleLodGpu", size_of::<BundleLodGpu>()),
+        (mesh, "LodParams", size_of::<LodParams>()),
     ] {
         let module = parse(name, source);
         let wgsl_size = wgsl_struct_size(&module, name)
@@ -150,6 +160,80 @@ fn gpu_structs_match_their_wgsl() {
         assert_eq!(
             wgsl_size as usize, rust_size,
             "{name}: WGSL {wgsl_size} bytes, Rust {rust_size}"
+        );
+    }
+}
+
+/// The mesh path's groups fit NVIDIA's mesh-shader limits, which wgpu does not check:
+/// 28 KiB of workgroup memory (naga's SPIR-V keeps the outputs there too, then copies them
+/// out) and 32 KiB of outputs counted in 16-byte attribute slots.
+#[test]
+fn mesh_shader_groups_fit_nvidia_limits() {
+    use hairloom_core::model::scene::SelfShadowing;
+    use hairloom_render::renderer::scene_lighting::{
+        RibbonInput, ShaderKey, hair_shader, hair_shadow_shader,
+    };
+    let mut sources: Vec<(String, String)> = ShaderKey::all()
+        .iter()
+        .map(|key| (format!("{key:?}"), hair_shader(key, RibbonInput::Mesh)))
+        .collect();
+    for kind in [
+        SelfShadowing::OpacityShadowMaps,
+        SelfShadowing::DeepOpacityMaps,
+    ] {
+        sources.push((
+            format!("shadow {kind:?}"),
+            hair_shadow_shader(kind, RibbonInput::Mesh),
+        ));
+    }
+    for (name, source) in &sources {
+        let module = parse(name, source);
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).expect("layout");
+        let workgroup_bytes: u32 = module
+            .global_variables
+            .iter()
+            .filter(|(_, v)| v.space == naga::AddressSpace::WorkGroup)
+            .map(|(_, v)| layouter[v.ty].size)
+            .sum();
+        assert!(
+            workgroup_bytes <= 28 * 1024,
+            "{name}: {workgroup_bytes} B of workgroup memory"
+        );
+        // The vertices' attribute slots: the position and each location.
+        let vertices = module
+            .types
+            .iter()
+            .find_map(|(_, t)| match &t.inner {
+                naga::TypeInner::Struct { members, .. }
+                    if members.iter().any(|m| {
+                        m.binding == Some(naga::Binding::BuiltIn(naga::BuiltIn::Vertices))
+                    }) =>
+                {
+                    members.iter().find_map(|m| {
+                        (m.binding == Some(naga::Binding::BuiltIn(naga::BuiltIn::Vertices)))
+                            .then_some(m.ty)
+                    })
+                }
+                _ => None,
+            })
+            .expect("mesh output");
+        let naga::TypeInner::Array { base, size, .. } = module.types[vertices].inner else {
+            panic!("{name}: vertices is not an array");
+        };
+        let naga::ArraySize::Constant(count) = size else {
+            panic!("{name}: vertices has no fixed size");
+        };
+        let naga::TypeInner::Struct { members, .. } = &module.types[base].inner else {
+            panic!("{name}: a vertex is not a struct");
+        };
+        let output_bytes = count.get() * members.len() as u32 * 16;
+        assert!(
+            output_bytes <= 32 * 1024,
+            "{name}: {output_bytes} B of vertex outputs"
+        );
+        eprintln!(
+            "{name}: {workgroup_bytes} B workgroup memory, {output_bytes} B of vertex outputs"
         );
     }
 }

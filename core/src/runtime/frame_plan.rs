@@ -130,6 +130,68 @@ pub(crate) fn sphere_in_view(
         })
 }
 
+/// What LOD draws of one bundle: strands (with density), vertices per strand, the morph
+/// factor and the thickness compensation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BundleLod {
+    pub strands: u32,
+    pub vertex_count: u32,
+    pub gamma: f32,
+    pub thickness: f32,
+}
+
+/// Eq. 7-12 for bundle `index` of `per_bundle` strands at full detail
+/// `2^max_vertices_log2 + 1` vertices (culling aside): what [`plan_frame`] draws of it, and
+/// what the mesh path's task shader computes on the GPU (`shaders/shared/strand_lod.wgsl`
+/// `bundle_lod`, tested against this).
+pub fn bundle_lod(
+    index: u32,
+    bounds: &BundleBounds,
+    per_bundle: u32,
+    max_vertices_log2: u32,
+    camera: &LodCamera,
+    settings: &LodSettings,
+) -> BundleLod {
+    if !settings.enabled {
+        return BundleLod {
+            strands: density_count(bounds.density as f64, per_bundle),
+            vertex_count: (1u32 << max_vertices_log2) + 1,
+            gamma: 0.0,
+            thickness: 1.0,
+        };
+    }
+    // Eq. 7 with the minimum distance of the bundle to the camera.
+    let distance = (bounds.centre.distance(camera.eye) - bounds.radius_m).max(0.0) as f64;
+    let (resolution, fov) = (camera.resolution_px as f64, camera.fov_y_rad as f64);
+    let strand_level = detail_level(
+        bounds.root_size_m as f64,
+        resolution,
+        distance,
+        fov,
+        settings.alpha_strands,
+    );
+    let delta = crate::strands::random::hash_to_unit(crate::strands::random::pcg_hash(index));
+    // A thinned bundle (density < 1) drops strands at the same rate from its own count,
+    // never drawing more than it grows at full detail.
+    let density = bounds.density as f64;
+    let strands = strand_count(strand_level * density, per_bundle, delta)
+        .min(density_count(density, per_bundle));
+    let vertex_level = detail_level(
+        bounds.strand_length_m as f64,
+        resolution,
+        distance,
+        fov,
+        settings.alpha_vertices,
+    );
+    let lod = vertex_lod(vertex_level, max_vertices_log2, settings.lambda);
+    BundleLod {
+        strands,
+        vertex_count: lod.vertex_count(),
+        gamma: lod.gamma as f32,
+        thickness: thickness_factor(strand_level, per_bundle) as f32,
+    }
+}
+
 /// Eq. 7-12 for every bundle of `per_bundle` strands (roots bundle-major, as
 /// `RuntimeTextures::strand_roots` makes them), full detail `2^max_vertices_log2 + 1`
 /// vertices: culling, strand counts with thickness compensation, vertex levels with morphing.
@@ -144,54 +206,25 @@ pub fn plan_frame(
     let mut plan = FramePlan::default();
     let mut batch: Vec<StrandRun> = Vec::new();
     let (mut vertex_offset, mut segment_offset) = (0u32, 0u32);
-    let full_vertices = (1u32 << max_vertices_log2) + 1;
     for (index, bounds) in bundles.iter().enumerate() {
         if settings.cull && !sphere_in_view(&camera.view_projection, bounds.centre, bounds.radius_m)
         {
             plan.culled_bundles += 1;
             continue;
         }
-        let (strands, vertex_count, gamma, thickness) = if settings.enabled {
-            // Eq. 7 with the minimum distance of the bundle to the camera.
-            let distance = (bounds.centre.distance(camera.eye) - bounds.radius_m).max(0.0) as f64;
-            let (resolution, fov) = (camera.resolution_px as f64, camera.fov_y_rad as f64);
-            let strand_level = detail_level(
-                bounds.root_size_m as f64,
-                resolution,
-                distance,
-                fov,
-                settings.alpha_strands,
-            );
-            let delta = crate::strands::random::hash_to_unit(crate::strands::random::pcg_hash(
-                index as u32,
-            ));
-            // A thinned bundle (density < 1) drops strands at the same rate from its own
-            // count, never drawing more than it grows at full detail.
-            let density = bounds.density as f64;
-            let count = strand_count(strand_level * density, per_bundle, delta)
-                .min(density_count(density, per_bundle));
-            let vertex_level = detail_level(
-                bounds.strand_length_m as f64,
-                resolution,
-                distance,
-                fov,
-                settings.alpha_vertices,
-            );
-            let lod = vertex_lod(vertex_level, max_vertices_log2, settings.lambda);
-            (
-                count,
-                lod.vertex_count(),
-                lod.gamma as f32,
-                thickness_factor(strand_level, per_bundle) as f32,
-            )
-        } else {
-            (
-                density_count(bounds.density as f64, per_bundle),
-                full_vertices,
-                0.0,
-                1.0,
-            )
-        };
+        let BundleLod {
+            strands,
+            vertex_count,
+            gamma,
+            thickness,
+        } = bundle_lod(
+            index as u32,
+            bounds,
+            per_bundle,
+            max_vertices_log2,
+            camera,
+            settings,
+        );
         let mut first_root = index as u32 * per_bundle;
         let mut remaining = strands;
         while remaining > 0 {

@@ -175,3 +175,77 @@ pub fn styling_array(set: &crate::model::styling::StylingSet) -> Vec<StylingGpu>
 /// Filtering mode values of [`StrandGenParams::filtering`].
 pub const FILTERING_EXACT: u32 = 0;
 pub const FILTERING_HARDWARE: u32 = 1;
+
+/// One bundle as the mesh path's task shader sees it: its bounding sphere (culling, distance)
+/// and the sizes and density eq. 7-12 take (mirror: `runtime::frame_plan::BundleBounds`).
+/// Keep in sync with `shaders/shared/strand_lod.wgsl` (`BundleLodGpu`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BundleLodGpu {
+    pub centre: [f32; 3],
+    pub radius_m: f32,
+    pub root_size_m: f32,
+    pub strand_length_m: f32,
+    pub density: f32,
+    pub _padding: u32,
+}
+
+impl From<&crate::runtime::frame_plan::BundleBounds> for BundleLodGpu {
+    fn from(bounds: &crate::runtime::frame_plan::BundleBounds) -> Self {
+        Self {
+            centre: bounds.centre.to_array(),
+            radius_m: bounds.radius_m,
+            root_size_m: bounds.root_size_m,
+            strand_length_m: bounds.strand_length_m,
+            density: bounds.density,
+            _padding: 0,
+        }
+    }
+}
+
+/// The frame's LOD camera and settings for the mesh path's task shader (eq. 7-12 on the
+/// GPU; mirror: `runtime::frame_plan::bundle_lod`).
+/// Keep in sync with `shaders/shared/strand_lod.wgsl` (`LodParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LodParams {
+    /// The camera's position (w unused).
+    pub eye: [f32; 4],
+    /// x: vertical resolution in pixels; y: vertical field of view (rad); z: α of strand
+    /// LOD; w: α of vertex LOD.
+    pub detail: [f32; 4],
+    /// x: λ (morph window); y: 1 when LOD is on; z: 1 when bundles outside the view are
+    /// culled; w unused.
+    pub switches: [f32; 4],
+    /// x: strands per bundle; y: log2 of the full-detail segments; z: bundles; w: task
+    /// workgroups per row of the draw (bundle = y × w + x).
+    pub counts: [u32; 4],
+}
+
+impl LodParams {
+    pub fn new(
+        camera: &crate::runtime::frame_plan::LodCamera,
+        settings: &crate::runtime::frame_plan::LodSettings,
+        per_bundle: u32,
+        max_vertices_log2: u32,
+        bundles: u32,
+        row: u32,
+    ) -> Self {
+        Self {
+            eye: camera.eye.extend(1.0).to_array(),
+            detail: [
+                camera.resolution_px,
+                camera.fov_y_rad,
+                settings.alpha_strands as f32,
+                settings.alpha_vertices as f32,
+            ],
+            switches: [
+                settings.lambda as f32,
+                settings.enabled as u32 as f32,
+                settings.cull as u32 as f32,
+                0.0,
+            ],
+            counts: [per_bundle, max_vertices_log2, bundles, row.max(1)],
+        }
+    }
+}

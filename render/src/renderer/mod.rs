@@ -65,6 +65,19 @@ fn module_and_layout(
     (module, layout)
 }
 
+/// The fragment stage of `spec` (none for a depth-only pipeline).
+fn fragment_state<'a>(
+    spec: &'a PipelineSpec,
+    module: &'a wgpu::ShaderModule,
+) -> Option<wgpu::FragmentState<'a>> {
+    spec.fragment_entry.map(|entry| wgpu::FragmentState {
+        module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        targets: spec.targets,
+    })
+}
+
 pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgpu::RenderPipeline> {
     let device = &context.device;
     let (module, layout) = module_and_layout(context, spec);
@@ -89,12 +102,7 @@ pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgp
                 count: spec.sample_count,
                 ..Default::default()
             },
-            fragment: spec.fragment_entry.map(|entry| wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: spec.targets,
-            }),
+            fragment: fragment_state(spec, &module),
             multiview_mask: None,
             cache: None,
         },
@@ -146,12 +154,7 @@ pub(crate) fn ribbon_pipeline(
                 count: spec.sample_count,
                 ..Default::default()
             },
-            fragment: spec.fragment_entry.map(|entry| wgpu::FragmentState {
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: spec.targets,
-            }),
+            fragment: fragment_state(spec, &module),
             multiview: None,
             cache: None,
         },

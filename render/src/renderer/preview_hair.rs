@@ -8,8 +8,10 @@
 use bytemuck::{Pod, Zeroable};
 
 use hairloom_core::runtime::frame_plan::FramePlan;
-use hairloom_core::runtime::gpu_types::StrandRun;
+use hairloom_core::runtime::frame_plan::{LodCamera, LodSettings};
+use hairloom_core::runtime::gpu_types::{BundleLodGpu, LodParams, StrandRun};
 use hairloom_core::runtime::strand_gen::Filtering;
+use wgpu::util::DeviceExt;
 
 use crate::device::GpuContext;
 pub use crate::renderer::scene_lighting::RibbonInput;
@@ -19,8 +21,10 @@ use crate::renderer::strand_gen::{
     source_layout_entries,
 };
 
-/// Where `strand_mesh.wgsl`'s task shader binds the bundles' bounding spheres (group 0).
-pub const MESH_SPHERES_BINDING: u32 = 32;
+/// Where `strand_mesh.wgsl`'s task shader binds the bundles' LOD bounds and the frame's LOD
+/// parameters (group 0).
+pub const MESH_BUNDLES_BINDING: u32 = 32;
+pub const MESH_LOD_BINDING: u32 = 33;
 use crate::renderer::{
     PipelineSpec, Targets, ribbon_pipeline, uniform_entry, view_color_target, view_depth,
 };
@@ -53,6 +57,15 @@ pub struct HairUniforms {
     pub width: [f32; 4],
     /// x, y: the batch's runs (first, count); z: shadow slot; w: 0.
     pub batch: [u32; 4],
+}
+
+/// What the mesh path's task shaders plan a frame's LOD from: the camera, the settings and the
+/// full-detail vertex level (as the CPU frame plan does, `frame_plan::bundle_lod`).
+#[derive(Clone, Copy, Debug)]
+pub struct MeshLod {
+    pub camera: LodCamera,
+    pub settings: LodSettings,
+    pub max_vertices_log2: u32,
 }
 
 /// Formats of the weighted blended transparency targets.
@@ -90,6 +103,8 @@ pub struct PreparedHair {
     input: RibbonInput,
     stride: u64,
     batch_count: usize,
+    /// Mesh-shader ribbons: the task workgroups of one draw (x, y: one per bundle).
+    mesh_tasks: [u32; 2],
 }
 
 impl HairRenderer {
@@ -153,7 +168,11 @@ impl HairRenderer {
                 .collect();
             entries.push(wgpu::BindGroupLayoutEntry {
                 visibility: wgpu::ShaderStages::TASK,
-                ..storage(MESH_SPHERES_BINDING, 16)
+                ..storage(MESH_BUNDLES_BINDING, size_of::<BundleLodGpu>() as u64)
+            });
+            entries.push(wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::TASK,
+                ..uniform_entry(MESH_LOD_BINDING, size_of::<LodParams>(), false)
             });
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview_hair_mesh"),
@@ -385,6 +404,7 @@ impl HairRenderer {
             input: RibbonInput::Buffer,
             stride: self.uniform_stride,
             batch_count,
+            mesh_tasks: [0; 2],
         }
     }
 
@@ -405,8 +425,13 @@ impl HairRenderer {
         hair: &GpuHair,
         filtering: Filtering,
         runs: &wgpu::Buffer,
-        input: RibbonInput,
+        mesh_lod: Option<MeshLod>,
     ) -> PreparedHair {
+        let input = if mesh_lod.is_some() {
+            RibbonInput::Mesh
+        } else {
+            RibbonInput::Generated
+        };
         let (uniforms, batch_count) = self.uniforms(context, views, batches);
         // first_run and run_count are per batch in the ribbons' uniforms; these are unused.
         let params = generator.params_buffer(context, hair, filtering, 0, &[]);
@@ -418,10 +443,39 @@ impl HairRenderer {
             },
         ];
         entries.extend(generator.source_entries(GENERATED_BINDING_OFFSET, hair, &params));
-        if input == RibbonInput::Mesh {
+        // The mesh path's task shaders plan LOD themselves: one workgroup per bundle, in rows
+        // the adapter's per-dimension limit allows.
+        let mut mesh_tasks = [0; 2];
+        let lod_buffer = mesh_lod.map(|mesh_lod| {
+            let bundles = hair.bundles.len() as u32;
+            let row = bundles
+                .min(context.device.limits().max_task_workgroups_per_dimension)
+                .max(1);
+            mesh_tasks = [row, bundles.div_ceil(row)];
+            let params = LodParams::new(
+                &mesh_lod.camera,
+                &mesh_lod.settings,
+                hair.per_bundle,
+                mesh_lod.max_vertices_log2,
+                bundles,
+                row,
+            );
+            context
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("strand_mesh_lod"),
+                    contents: bytemuck::bytes_of(&params),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                })
+        });
+        if let Some(lod_buffer) = &lod_buffer {
             entries.push(wgpu::BindGroupEntry {
-                binding: MESH_SPHERES_BINDING,
-                resource: hair.bundle_spheres().as_entire_binding(),
+                binding: MESH_BUNDLES_BINDING,
+                resource: hair.bundle_lods().as_entire_binding(),
+            });
+            entries.push(wgpu::BindGroupEntry {
+                binding: MESH_LOD_BINDING,
+                resource: lod_buffer.as_entire_binding(),
             });
         }
         let group = context
@@ -436,6 +490,7 @@ impl HairRenderer {
             input,
             stride: self.uniform_stride,
             batch_count,
+            mesh_tasks,
         }
     }
 
@@ -443,7 +498,8 @@ impl HairRenderer {
     /// and 2, when the pipeline has them, are set by the caller. Ribbons from a buffer are one
     /// triangle-list draw (6 vertices per segment); generated ribbons one draw per run, a
     /// strip of 2 vertices per strand vertex for each of its strands (the instances);
-    /// mesh-shader ribbons one task workgroup per run.
+    /// mesh-shader ribbons one task workgroup per bundle, whatever the batches (drawn with
+    /// the first; the task shaders cull and plan LOD).
     pub fn draw_with(
         pass: &mut wgpu::RenderPass<'_>,
         pipeline: &wgpu::RenderPipeline,
@@ -453,7 +509,10 @@ impl HairRenderer {
         runs: &[StrandRun],
     ) {
         let segments = FramePlan::batch_segments(runs) as u32;
-        if segments == 0 {
+        let mesh = prepared.input == RibbonInput::Mesh;
+        // Mesh-shader ribbons draw every bundle in one go (their task shaders plan LOD), with
+        // the first batch.
+        if (mesh && batch > 0) || (!mesh && segments == 0) {
             return;
         }
         pass.set_pipeline(pipeline);
@@ -471,7 +530,10 @@ impl HairRenderer {
                     );
                 }
             }
-            RibbonInput::Mesh => pass.draw_mesh_tasks(runs.len() as u32, 1, 1),
+            RibbonInput::Mesh => {
+                let [row, rows] = prepared.mesh_tasks;
+                pass.draw_mesh_tasks(row, rows, 1);
+            }
         }
     }
 

@@ -137,6 +137,7 @@ pub const RIBBON_STORED: &str = shader_file!("shared/ribbon_stored.wgsl");
 pub const RIBBON_GENERATED: &str = shader_file!("shared/ribbon_generated.wgsl");
 pub const STRAND_VERTEX: &str = shader_file!("shared/strand_vertex.wgsl");
 pub const STRAND_MESH: &str = shader_file!("strand_mesh.wgsl");
+pub const STRAND_LOD: &str = shader_file!("shared/strand_lod.wgsl");
 
 /// Where the ribbons' strand vertices come from.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -166,7 +167,13 @@ fn ribbon_modules(input: RibbonInput) -> String {
 /// enable the WGSL extension they need.
 fn with_mesh_stages(input: RibbonInput, source: String) -> String {
     match input {
-        RibbonInput::Mesh => ["enable wgpu_mesh_shader;\n", &source, STRAND_MESH].concat(),
+        RibbonInput::Mesh => [
+            "enable wgpu_mesh_shader;\n",
+            &source,
+            STRAND_LOD,
+            STRAND_MESH,
+        ]
+        .concat(),
         RibbonInput::Buffer | RibbonInput::Generated => source,
     }
 }

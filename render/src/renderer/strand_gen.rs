@@ -8,8 +8,8 @@
 use hairloom_core::io::ktx2::TexelFormat;
 use hairloom_core::runtime::frame_plan::{BundleBounds, FramePlan};
 use hairloom_core::runtime::gpu_types::{
-    BundleGpu, FILTERING_EXACT, FILTERING_HARDWARE, StrandGenParams, StrandRun, StylingGpu,
-    styling_array,
+    BundleGpu, BundleLodGpu, FILTERING_EXACT, FILTERING_HARDWARE, StrandGenParams, StrandRun,
+    StylingGpu, styling_array,
 };
 use hairloom_core::runtime::hair::RuntimeHair;
 use hairloom_core::runtime::strand_gen::Filtering;
@@ -267,18 +267,19 @@ impl GenerationPath {
 
 /// Whether `device` was created with mesh shaders (wgpu's `EXPERIMENTAL_MESH_SHADER`, which
 /// [`crate::device::GpuContext::new_headless`] requests where the adapter has it) and limits
-/// that hold `strand_mesh.wgsl`'s groups: 128 invocations, 256 ribbon vertices and 256
-/// triangles per mesh workgroup (what NVIDIA, AMD and DirectX 12 guarantee).
+/// that hold `strand_mesh.wgsl`'s groups: 96 invocations, 192 ribbon vertices and 192
+/// triangles per mesh workgroup, and its task payload (what NVIDIA, AMD and DirectX 12
+/// allow).
 pub fn mesh_shaders_available(device: &wgpu::Device) -> bool {
     let limits = device.limits();
     device
         .features()
         .contains(wgpu::Features::EXPERIMENTAL_MESH_SHADER)
-        && limits.max_mesh_invocations_per_workgroup >= 128
-        && limits.max_mesh_invocations_per_dimension >= 128
-        && limits.max_mesh_output_vertices >= 256
-        && limits.max_mesh_output_primitives >= 256
-        && limits.max_task_payload_size >= 4
+        && limits.max_mesh_invocations_per_workgroup >= 96
+        && limits.max_mesh_invocations_per_dimension >= 96
+        && limits.max_mesh_output_vertices >= 192
+        && limits.max_mesh_output_primitives >= 192
+        && limits.max_task_payload_size >= size_of::<StrandRun>() as u32
 }
 
 /// Pipeline and bind-group layout of `strand_gen` (one per device).
@@ -333,10 +334,10 @@ pub fn full_detail_plan(root_count: usize, vertex_count: u32) -> FramePlan {
 }
 
 impl GpuHair {
-    /// Each bundle's bounding sphere (`[centre, radius]`, block order): what the mesh path's
-    /// task shaders cull with.
-    pub fn bundle_spheres(&self) -> &wgpu::Buffer {
-        &self.bundle_spheres
+    /// Each bundle's bounds and LOD sizes (block order): what the mesh path's task shaders
+    /// cull and plan with.
+    pub fn bundle_lods(&self) -> &wgpu::Buffer {
+        &self.bundle_lods
     }
 }
 
@@ -367,8 +368,8 @@ pub struct GpuHair {
     u: wgpu::TextureView,
     v: wgpu::TextureView,
     bundle_buffer: Tracked<wgpu::Buffer>,
-    /// Each bundle's bounding sphere (centre, radius), for the mesh path's task shaders.
-    bundle_spheres: Tracked<wgpu::Buffer>,
+    /// Each bundle's bounds and sizes for LOD, for the mesh path's task shaders.
+    bundle_lods: Tracked<wgpu::Buffer>,
     samples: Tracked<wgpu::Buffer>,
     sample_set: u32,
     /// Strands at full detail: bundles × `per_bundle`.
@@ -500,17 +501,14 @@ fn bundle_placements(textures: &RuntimeTextures, block_styling: &[u32]) -> Vec<B
     bundles
 }
 
-/// Each bundle's bounding sphere as `[centre, radius]` (never empty: a storage buffer cannot
-/// be).
-fn bundle_spheres(bounds: &[BundleBounds]) -> Vec<[f32; 4]> {
-    let mut spheres: Vec<[f32; 4]> = bounds
-        .iter()
-        .map(|b| b.centre.extend(b.radius_m).to_array())
-        .collect();
-    if spheres.is_empty() {
-        spheres.push([0.0; 4]);
+/// Each bundle's bounds and sizes for the mesh path's LOD (never empty: a storage buffer
+/// cannot be).
+fn bundle_lods(bounds: &[BundleBounds]) -> Vec<BundleLodGpu> {
+    let mut bundles: Vec<BundleLodGpu> = bounds.iter().map(BundleLodGpu::from).collect();
+    if bundles.is_empty() {
+        bundles.push(BundleLodGpu::default());
     }
-    spheres
+    bundles
 }
 
 /// The styling array, or the default parameters when it is empty.
@@ -660,8 +658,8 @@ impl StrandGenRenderer {
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         let bounds = hair.bundle_bounds();
-        let spheres = bundle_spheres(&bounds);
-        let sphere_bytes: &[u8] = bytemuck::cast_slice(&spheres);
+        let lods = bundle_lods(&bounds);
+        let lod_bytes: &[u8] = bytemuck::cast_slice(&lods);
         Ok(GpuHair {
             position_offset: textures.position_offset.to_array(),
             textures: vec![t0, t1, t2, t3, t4],
@@ -671,7 +669,7 @@ impl StrandGenRenderer {
             u,
             v,
             bundle_buffer: buffer("strand_gen_bundles", bundle_bytes),
-            bundle_spheres: buffer("strand_mesh_bundle_spheres", sphere_bytes),
+            bundle_lods: buffer("strand_mesh_bundle_lods", lod_bytes),
             samples: buffer("strand_gen_samples", sample_bytes),
             sample_set: sample_set as u32,
             root_count: block_count * per_bundle,
@@ -684,10 +682,8 @@ impl StrandGenRenderer {
                 + c
                 + d
                 + e
-                + (bundle_bytes.len()
-                    + sphere_bytes.len()
-                    + sample_bytes.len()
-                    + styling_bytes.len()) as u64,
+                + (bundle_bytes.len() + lod_bytes.len() + sample_bytes.len() + styling_bytes.len())
+                    as u64,
         })
     }
 
@@ -723,9 +719,9 @@ impl StrandGenRenderer {
         gpu.position_offset = textures.position_offset.to_array();
         gpu.bundles = hair.bundle_bounds();
         context.queue.write_buffer(
-            &gpu.bundle_spheres,
+            &gpu.bundle_lods,
             0,
-            bytemuck::cast_slice(&bundle_spheres(&gpu.bundles)),
+            bytemuck::cast_slice(&bundle_lods(&gpu.bundles)),
         );
         self.update_styling(context, gpu, hair);
         true
