@@ -5,7 +5,8 @@
 #   tools/gpu-bench.sh pack          # here: build, strip into .gpu/hairloom (~20 MB)
 #   tools/gpu-bench.sh run [OUT]     # there: adapters, `bench gpu` side by side, `bench crowd`
 #
-# `run` names the adapter first and writes adapters.txt, gpu.txt and crowd.txt into OUT (default $OUT when
+# `run` names the adapter first and writes adapters.txt, gpu.txt, crowd_default.txt and
+# crowd_compute.txt into OUT (default $OUT when
 # set, else out/gpu-bench). It unpacks carried Vulkan loaders (.gl/*.deb, see the device
 # notes) when the machine has none, and points the loader at NVIDIA's ICD when it is there.
 # Knobs: STRANDS (default 10000,100000,300000), RUNS (3), SIZE (1280x720), TEXTURES (f16,f32),
@@ -41,9 +42,13 @@ run)
     "$bin" adapters | tee "$out/adapters.txt"
     "$bin" bench gpu --strands "${STRANDS:-10000,100000,300000}" --runs "${RUNS:-3}" \
         --size "${SIZE:-1280x720}" --textures "${TEXTURES:-f16,f32}" | tee "$out/gpu.txt"
-    # The paper's Fig. 1 scene: up to 100 characters of 100K strands each, LOD on.
-    "$bin" bench crowd --characters "${CHARACTERS:-1,10,100}" --strands "${CROWD_STRANDS:-100000}" \
-        --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" | tee "$out/crowd.txt"
+    # The paper's Fig. 1 scene: up to 100 characters of 100K strands each, LOD on; the game
+    # runtime's default path (mesh shaders where the adapter has them), then compute.
+    for generation in default compute; do
+        flag=(); [ "$generation" = default ] || flag=(--generation "$generation")
+        "$bin" bench crowd --characters "${CHARACTERS:-1,10,100}" --strands "${CROWD_STRANDS:-100000}" \
+            --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" "${flag[@]}" | tee "$out/crowd_$generation.txt"
+    done
     ;;
 *)
     echo "usage: $0 pack | run [OUT]" >&2

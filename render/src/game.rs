@@ -297,6 +297,11 @@ impl GameHair {
         self.set_lighting(&scene)
     }
 
+    /// Where strands are generated now (see [`Self::set_generation`]).
+    pub fn generation(&self) -> GenerationPath {
+        self.generator.path()
+    }
+
     fn ribbon_input(&self) -> RibbonInput {
         self.generator.path().ribbon_input()
     }

@@ -133,10 +133,14 @@ pub enum Which {
         /// Write each crowd's frame as crowd_N.png into this folder.
         #[arg(long)]
         out: Option<std::path::PathBuf>,
-        /// Generate in the ribbons' vertex shader (no compute pass, no scratch) instead of
-        /// by compute.
+        /// Generate in the ribbons' vertex shader (no compute pass, no scratch); the same as
+        /// `--generation vertex-shader`.
         #[arg(long)]
         vertex_shader: bool,
+        /// Where strands are generated (default: the game runtime's choice, mesh shaders
+        /// where the adapter has them, else compute per strand).
+        #[arg(long, value_enum)]
+        generation: Option<super::GenerationArg>,
     },
     /// What each lighting effect costs: the frame with none, each alone, the scene's own
     /// combination and everything, at 10K and 100K strands (time and GPU memory).
@@ -228,6 +232,7 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             runs,
             out,
             vertex_shader,
+            generation,
         } => super::bench_crowd::run(&super::bench_crowd::CrowdSettings {
             project,
             characters,
@@ -235,7 +240,11 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             size,
             runs,
             out,
-            vertex_shader,
+            generation: if vertex_shader {
+                Some(hairloom_render::renderer::strand_gen::GenerationPath::VertexShader)
+            } else {
+                generation.map(Into::into)
+            },
         }),
         Which::Edit {
             project,

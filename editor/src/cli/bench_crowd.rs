@@ -28,8 +28,9 @@ pub struct CrowdSettings {
     pub runs: usize,
     /// Where to write each crowd's last frame as `crowd_N.png` (to look at what was timed).
     pub out: Option<PathBuf>,
-    /// Generate in the ribbons' vertex shader (no compute pass, no scratch).
-    pub vertex_shader: bool,
+    /// Where strands are generated; `None`: the game runtime's default
+    /// ([`GenerationPath::preferred`]).
+    pub generation: Option<GenerationPath>,
 }
 
 pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
@@ -53,8 +54,8 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
         &hair,
         Targets::view(sample_count),
     )?;
-    if settings.vertex_shader {
-        game.set_generation(GenerationPath::VertexShader)?;
+    if let Some(path) = settings.generation {
+        game.set_generation(path)?;
     }
     let view = View::new(&context, width, height, sample_count);
     let (lo, hi) = hair
@@ -72,11 +73,7 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
     println!("machine: {}", super::machine());
     println!(
         "generation: {}; characters one after another, each planned, submitted and finished before the next (one scratch buffer alive at a time); times: wall from the first character's planning to the last one's end, median of {} after a warm-up",
-        if settings.vertex_shader {
-            "in the vertex shader"
-        } else {
-            "compute, per strand"
-        },
+        game.generation().name(),
         settings.runs
     );
     println!(
