@@ -86,14 +86,15 @@ run: toolchain gpu-deps
 
 # `cargo test --all-targets` builds examples as test harnesses, so the game example that
 # render/tests/game_window.rs opens in a window is built as a program first.
-# The mesh-shader tests run again on Mesa 25's lavapipe, where they must not skip.
+# The mesh-shader tests, and the game runtime (whose default is mesh shaders where the
+# device has them), run again on Mesa 25's lavapipe, where the mesh tests must not skip.
 test: toolchain deps mesh-deps
 	$(CARGO) build -p hairloom-render --example game
 	$(CARGO) test --workspace --all-targets
 	$(CARGO) test --workspace --doc
 	VK_ICD_FILENAMES=$(MESA_BACKPORT)/lvp_icd.json \
 	  LD_LIBRARY_PATH=$(MESA_BACKPORT)/root/usr/lib/x86_64-linux-gnu \
-	  HAIRLOOM_REQUIRE_MESH_SHADERS=1 $(CARGO) test -p hairloom-render --test strand_mesh
+	  HAIRLOOM_REQUIRE_MESH_SHADERS=1 $(CARGO) test -p hairloom-render --test strand_mesh --test game
 
 lint: toolchain
 	$(CARGO) fmt --all -- --check

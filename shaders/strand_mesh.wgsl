@@ -24,6 +24,8 @@
 // (render/tests/strand_mesh.rs); CPU mirror of the points and tangents: StrandGen::main
 // followed by runtime::preview_hair, as for the other paths.
 
+// Keep these three in sync with render/src/renderer/strand_gen.rs (`mesh_groups`, the CPU
+// mirror of this work distribution).
 // Strand vertices (invocations) per mesh workgroup; ribbon vertices are twice this. Sized so
 // a group's memory fits NVIDIA's mesh-shader limits (28 KiB of workgroup memory, which naga's
 // SPIR-V also keeps the outputs in; 32 KiB of outputs): 192 ribbon vertices of 8 attribute

@@ -72,7 +72,9 @@ use crate::renderer::preview_hair::{
     HairRenderer, HairUniforms, MeshLod, PreparedHair, RibbonInput,
 };
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, effects_layout};
-use crate::renderer::strand_gen::{GenerationPath, GpuHair, StrandGenError, StrandGenRenderer};
+use crate::renderer::strand_gen::{
+    GenerationPath, GpuHair, StrandGenError, StrandGenRenderer, check_mesh_groups,
+};
 use crate::resources::Tracked;
 
 /// The game's targets: the formats and sample count of the pass [`GameHair::draw`] records
@@ -176,12 +178,23 @@ impl GameHair {
         targets: HairTargets,
     ) -> Result<Self, GameHairError> {
         let context = GpuContext::from_parts(adapter.clone(), device.clone(), queue.clone());
-        // Mesh shaders where the engine's device has them, else compute per strand.
-        let generator =
-            StrandGenRenderer::with_path(&context, GenerationPath::preferred(&context.device));
+        let max_log2 = hair.lod.max_vertices_log2.min(8);
+        // Mesh shaders where the engine's device has them (and their workgroups hold a
+        // bundle), else compute per strand.
+        let mut path = GenerationPath::preferred(&context.device);
+        if path == GenerationPath::MeshShader
+            && check_mesh_groups(
+                &context.device.limits(),
+                hair.strands_per_bundle,
+                (1 << max_log2) + 1,
+            )
+            .is_err()
+        {
+            path = GenerationPath::ComputePerStrand;
+        }
+        let generator = StrandGenRenderer::with_path(&context, path);
         let gpu = generator.upload(&context, hair)?;
         let bounds = hair.textures.hair_bounds().ok_or(GameHairError::NoHair)?;
-        let max_log2 = hair.lod.max_vertices_log2.min(8);
         let mut this = Self {
             lighting: SceneLighting::new(&context),
             hair: HairRenderer::with_targets(&context, targets),
@@ -291,6 +304,13 @@ impl GameHair {
             return Ok(());
         }
         StrandGenRenderer::check_path(&self.context, path)?;
+        if path == GenerationPath::MeshShader {
+            check_mesh_groups(
+                &self.context.device.limits(),
+                self.gpu.per_bundle,
+                self.vertex_count,
+            )?;
+        }
         self.generator = StrandGenRenderer::with_path(&self.context, path);
         self.frame = None;
         let scene = self.scene.clone();

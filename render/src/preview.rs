@@ -30,7 +30,10 @@ use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody};
 use crate::renderer::preview_hair::{HairRenderer, HairUniforms, MeshLod, RibbonInput};
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
-use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit};
+use crate::renderer::strand_gen::{
+    GenerationPath, GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit,
+    check_mesh_groups,
+};
 use crate::view::View;
 
 /// A perspective camera looking at `target`.
@@ -373,9 +376,15 @@ impl PreviewRenderer {
         // Ribbons read their vertices from a buffer unless the generator makes them in the
         // vertex shader.
         let input = match &scene.hair {
-            HairSource::Generated { generator, .. } => {
+            HairSource::Generated {
+                generator, hair, ..
+            } => {
                 StrandGenRenderer::check_path(context, generator.path())
                     .map_err(PreviewError::Generation)?;
+                if generator.path() == GenerationPath::MeshShader {
+                    check_mesh_groups(&device.limits(), hair.per_bundle, scene.vertex_count)
+                        .map_err(PreviewError::Generation)?;
+                }
                 generator.path().ribbon_input()
             }
             _ => RibbonInput::Buffer,

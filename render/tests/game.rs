@@ -140,6 +140,9 @@ fn game_runtime_draws_what_the_preview_draws() {
     .expect("the bundle loads");
     game.set_lod(lod);
     game.set_vertices_log2(VERTICES_LOG2);
+    // The preview's path (the game's default is mesh shaders where the device has them).
+    game.set_generation(GenerationPath::ComputePerStrand)
+        .expect("compute per strand");
     let game_camera = GameCamera {
         view_projection: camera.view_projection(1.0),
         eye: camera.eye,
@@ -196,6 +199,25 @@ fn game_runtime_draws_what_the_preview_draws() {
         differing * 1000 <= (SIZE * SIZE) as usize,
         "{differing} pixels differ"
     );
+    // Task and mesh shaders where the device has them (Mesa 25's lavapipe under `make
+    // test`'s mesh run, NVIDIA): their own LOD, no scratch, the same picture.
+    if GenerationPath::MeshShader.available(&context.device) {
+        game.set_generation(GenerationPath::MeshShader)
+            .expect("the mesh-shader path");
+        assert_eq!(game.generation(), GenerationPath::MeshShader);
+        let (mesh_stats, mesh_drawn) = draw(&context, &mut game, &view, &game_camera, background);
+        assert_eq!(mesh_stats.scratch_bytes, 0, "no scratch buffer");
+        let differing = drawn
+            .chunks_exact(4)
+            .zip(mesh_drawn.chunks_exact(4))
+            .filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2))
+            .count();
+        eprintln!("game runtime, mesh-shader generation: {differing} pixels differ by > 2/255");
+        assert!(
+            differing * 1000 <= (SIZE * SIZE) as usize,
+            "{differing} pixels differ"
+        );
+    }
     game.set_generation(GenerationPath::ComputePerStrand)
         .expect("back to compute");
 
