@@ -47,7 +47,7 @@ run)
     for generation in default compute; do
         flag=(); [ "$generation" = default ] || flag=(--generation "$generation")
         "$bin" bench crowd --characters "${CHARACTERS:-1,10,100}" --strands "${CROWD_STRANDS:-100000}" \
-            --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" "${flag[@]}" | tee "$out/crowd_$generation.txt"
+            --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" ${flag[@]+"${flag[@]}"} | tee "$out/crowd_$generation.txt"
     done
     ;;
 *)

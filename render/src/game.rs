@@ -185,6 +185,7 @@ impl GameHair {
         if path == GenerationPath::MeshShader
             && check_mesh_groups(
                 &context.device.limits(),
+                hair.textures.atlas.blocks.len(),
                 hair.strands_per_bundle,
                 (1 << max_log2) + 1,
             )
@@ -307,6 +308,7 @@ impl GameHair {
         if path == GenerationPath::MeshShader {
             check_mesh_groups(
                 &self.context.device.limits(),
+                self.gpu.bundles.len(),
                 self.gpu.per_bundle,
                 self.vertex_count,
             )?;

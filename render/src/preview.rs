@@ -382,8 +382,13 @@ impl PreviewRenderer {
                 StrandGenRenderer::check_path(context, generator.path())
                     .map_err(PreviewError::Generation)?;
                 if generator.path() == GenerationPath::MeshShader {
-                    check_mesh_groups(&device.limits(), hair.per_bundle, scene.vertex_count)
-                        .map_err(PreviewError::Generation)?;
+                    check_mesh_groups(
+                        &device.limits(),
+                        hair.bundles.len(),
+                        hair.per_bundle,
+                        scene.vertex_count,
+                    )
+                    .map_err(PreviewError::Generation)?;
                 }
                 generator.path().ribbon_input()
             }

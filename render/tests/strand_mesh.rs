@@ -201,7 +201,8 @@ fn lod_readback(@builtin(global_invocation_id) id: vec3<u32>) {
 
 /// The task shaders' level of detail (eq. 7-12 in f32 on the GPU) against the frame plan's
 /// (`frame_plan::bundle_lod`, f64), bundle by bundle: near, middle, far and very far, LOD
-/// off, a wide morph window, and the samples' thinned rim bundles (density < 1).
+/// off, a wide morph window, the samples' thinned rim bundles (density < 1), and strand
+/// counts that are not powers of two.
 #[test]
 fn task_shader_lod_matches_the_frame_plan() {
     use glam::Mat4;
@@ -224,7 +225,6 @@ fn task_shader_lod_matches_the_frame_plan() {
     );
     let bounds = runtime.bundle_bounds();
     assert!(bounds.iter().any(|b| b.density < 1.0), "thinned bundles");
-    let gpu_bundles: Vec<BundleLodGpu> = bounds.iter().map(BundleLodGpu::from).collect();
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("lod_readback"),
         source: wgpu::ShaderSource::Wgsl([SHADER_SOURCE, STRAND_LOD, LOD_READBACK].concat().into()),
@@ -237,16 +237,24 @@ fn task_shader_lod_matches_the_frame_plan() {
         compilation_options: Default::default(),
         cache: None,
     });
-    let bundle_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(&gpu_bundles),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
     let (lo, hi) = runtime.textures.hair_bounds().expect("hair");
     let centre = (lo + hi) * 0.5;
-    let (max_log2, per_bundle) = (5, 64);
+    let max_log2 = 5;
     let (mut compared, mut levels, mut morphing, mut partial) = (0, Vec::new(), 0, 0);
-    for distance in [0.6f32, 3.0, 12.0, 60.0] {
+    // Strand counts that are not powers of two too: density · N rounds differently in f32.
+    for (per_bundle, distance) in [64u32, 10, 37]
+        .into_iter()
+        .flat_map(|n| [0.6f32, 3.0, 12.0, 60.0].map(|d| (n, d)))
+    {
+        let gpu_bundles: Vec<BundleLodGpu> = bounds
+            .iter()
+            .map(|b| BundleLodGpu::new(b, per_bundle))
+            .collect();
+        let bundle_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytemuck::cast_slice(&gpu_bundles),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         for settings in [
             LodSettings::default(),
             common::morphing_lod(lo, hi).1,
@@ -328,7 +336,8 @@ fn task_shader_lod_matches_the_frame_plan() {
                     &camera,
                     &settings,
                 );
-                let what = format!("bundle {index} at {distance} m, {settings:?}");
+                let what =
+                    format!("bundle {index} of {per_bundle} strands at {distance} m, {settings:?}");
                 assert_eq!(gpu.first_root, index as u32 * per_bundle, "{what}");
                 assert_eq!(gpu.strand_count, cpu.strands, "{what}");
                 assert_eq!(gpu.vertex_count, cpu.vertex_count, "{what}");

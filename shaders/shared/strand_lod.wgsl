@@ -11,13 +11,14 @@ struct BundleLodGpu {
     root_size_m: f32,
     strand_length_m: f32,
     density: f32,
-    _padding: u32,
+    // ⌈density · N⌉, counted on the CPU (f64) so both sides agree exactly.
+    grown_strands: u32,
 }
 
 struct LodParams {
     eye: vec4<f32>,
-    // x: vertical resolution (px); y: vertical field of view (rad); z, w: α of strand and
-    // vertex LOD.
+    // x: vertical resolution (px); y: tan of the vertical field of view; z, w: α of strand
+    // and vertex LOD.
     detail: vec4<f32>,
     // x: λ; y: 1 when LOD is on; z: 1 when bundles outside the view are culled.
     switches: vec4<f32>,
@@ -26,29 +27,28 @@ struct LodParams {
     counts: vec4<u32>,
 }
 
+// NaN by its bits (a driver may fold `x != x` away).
+fn lod_is_nan(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7fffffffu) > 0x7f800000u;
+}
+
 // Eq. 7 (lod.rs `detail_level`): L = min(1, h R α / (d tan θ)); a non-positive or infinite
 // extent draws everything, a NaN level nothing.
-fn lod_detail_level(size_m: f32, resolution_px: f32, distance_m: f32, fov_rad: f32, alpha: f32) -> f32 {
-    let extent = distance_m * tan(fov_rad);
-    if !(extent > 0.0 && extent <= 3.4e38) {
+fn lod_detail_level(size_m: f32, resolution_px: f32, distance_m: f32, tan_fov: f32, alpha: f32) -> f32 {
+    let extent = distance_m * tan_fov;
+    if !(extent > 0.0) || (bitcast<u32>(extent) & 0x7fffffffu) >= 0x7f800000u {
         return 1.0;
     }
     let level = size_m * resolution_px * alpha / extent;
-    if level != level {
+    if lod_is_nan(level) {
         return 0.0;
     }
     return clamp(level, 0.0, 1.0);
 }
 
-// ⌈density · N⌉, at most N (lod.rs `density_count`).
-fn lod_density_count(density: f32, strands: u32) -> u32 {
-    let d = select(clamp(density, 0.0, 1.0), 0.0, density != density);
-    return min(u32(ceil(d * f32(strands))), strands);
-}
-
 // Eq. 8 (lod.rs `strand_count`): ⌈L (N + δ)⌉, at most N.
 fn lod_strand_count(level: f32, strands: u32, delta: f32) -> u32 {
-    let l = select(clamp(level, 0.0, 1.0), 0.0, level != level);
+    let l = select(clamp(level, 0.0, 1.0), 0.0, lod_is_nan(level));
     return min(u32(ceil(l * (f32(strands) + delta))), strands);
 }
 
@@ -63,8 +63,12 @@ fn lod_thickness(level: f32, strands: u32) -> f32 {
 
 // Eq. 9, 10, 12 (lod.rs `vertex_lod`): (vertex count, γ).
 fn lod_vertices(level: f32, max_e: u32, lambda: f32) -> vec2<f32> {
-    let l = select(clamp(level, 0.0, 1.0), 0.0, level != level);
-    let window = select(clamp(lambda, 0.0, 1.0), 0.0, lambda != lambda);
+    let l = select(clamp(level, 0.0, 1.0), 0.0, lod_is_nan(level));
+    let window = select(clamp(lambda, 0.0, 1.0), 0.0, lod_is_nan(lambda));
+    if !(l > 0.0) {
+        // log2(0) is undefined in SPIR-V; the CPU's −∞ gives e = ẽ = 0: two vertices.
+        return vec2<f32>(2.0, 0.0);
+    }
     let x = log2(l * f32(1u << max_e));
     let e = u32(clamp(ceil(x), 0.0, f32(max_e)));
     let e_tilde = u32(clamp(ceil(x - window), 0.0, f32(max_e)));
@@ -83,7 +87,7 @@ fn bundle_lod(index: u32, bundle: BundleLodGpu, lod: LodParams) -> StrandRun {
     var run: StrandRun;
     run.first_root = index * per_bundle;
     if lod.switches.y == 0.0 {
-        run.strand_count = lod_density_count(bundle.density, per_bundle);
+        run.strand_count = bundle.grown_strands;
         run.vertex_count = (1u << max_e) + 1u;
         run.gamma = 0.0;
         run.thickness = 1.0;
@@ -93,10 +97,7 @@ fn bundle_lod(index: u32, bundle: BundleLodGpu, lod: LodParams) -> StrandRun {
     let strand_level = lod_detail_level(bundle.root_size_m, lod.detail.x, distance, lod.detail.y, lod.detail.z);
     let delta = hash_to_unit(pcg_hash(index));
     let density = bundle.density;
-    run.strand_count = min(
-        lod_strand_count(strand_level * density, per_bundle, delta),
-        lod_density_count(density, per_bundle),
-    );
+    run.strand_count = min(lod_strand_count(strand_level * density, per_bundle, delta), bundle.grown_strands);
     let vertex_level = lod_detail_level(bundle.strand_length_m, lod.detail.x, distance, lod.detail.y, lod.detail.w);
     let vertices = lod_vertices(vertex_level, max_e, lod.switches.x);
     run.vertex_count = u32(vertices.x);

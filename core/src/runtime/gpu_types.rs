@@ -187,18 +187,20 @@ pub struct BundleLodGpu {
     pub root_size_m: f32,
     pub strand_length_m: f32,
     pub density: f32,
-    pub _padding: u32,
+    /// The strands the bundle grows, `⌈density · N⌉` (`lod::density_count`, in f64 here so
+    /// the GPU's count is the CPU's exactly).
+    pub grown_strands: u32,
 }
 
-impl From<&crate::runtime::frame_plan::BundleBounds> for BundleLodGpu {
-    fn from(bounds: &crate::runtime::frame_plan::BundleBounds) -> Self {
+impl BundleLodGpu {
+    pub fn new(bounds: &crate::runtime::frame_plan::BundleBounds, per_bundle: u32) -> Self {
         Self {
             centre: bounds.centre.to_array(),
             radius_m: bounds.radius_m,
             root_size_m: bounds.root_size_m,
             strand_length_m: bounds.strand_length_m,
             density: bounds.density,
-            _padding: 0,
+            grown_strands: crate::strands::lod::density_count(bounds.density as f64, per_bundle),
         }
     }
 }
@@ -211,8 +213,8 @@ impl From<&crate::runtime::frame_plan::BundleBounds> for BundleLodGpu {
 pub struct LodParams {
     /// The camera's position (w unused).
     pub eye: [f32; 4],
-    /// x: vertical resolution in pixels; y: vertical field of view (rad); z: α of strand
-    /// LOD; w: α of vertex LOD.
+    /// x: vertical resolution in pixels; y: tan of the vertical field of view; z: α of
+    /// strand LOD; w: α of vertex LOD.
     pub detail: [f32; 4],
     /// x: λ (morph window); y: 1 when LOD is on; z: 1 when bundles outside the view are
     /// culled; w unused.
@@ -235,7 +237,8 @@ impl LodParams {
             eye: camera.eye.extend(1.0).to_array(),
             detail: [
                 camera.resolution_px,
-                camera.fov_y_rad,
+                // tan θ in f64, as eq. 7 on the CPU takes it.
+                (camera.fov_y_rad as f64).tan() as f32,
                 settings.alpha_strands as f32,
                 settings.alpha_vertices as f32,
             ],

@@ -61,7 +61,7 @@ pub fn strand_count(level: f64, strands: u32, delta: f64) -> u32 {
 
 /// Strands a bundle of `strands` grows at `density` (the fraction that grow, see
 /// `Bundle::density`): `⌈density · N⌉`, none for 0 (or NaN), all for 1.
-pub(crate) fn density_count(density: f64, strands: u32) -> u32 {
+pub fn density_count(density: f64, strands: u32) -> u32 {
     let density = if density.is_nan() {
         0.0
     } else {

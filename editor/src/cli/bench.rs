@@ -135,7 +135,7 @@ pub enum Which {
         out: Option<std::path::PathBuf>,
         /// Generate in the ribbons' vertex shader (no compute pass, no scratch); the same as
         /// `--generation vertex-shader`.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "generation")]
         vertex_shader: bool,
         /// Where strands are generated (default: the game runtime's choice, mesh shaders
         /// where the adapter has them, else compute per strand).

@@ -285,23 +285,48 @@ pub fn mesh_groups(strands: u32, vertex_count: u32) -> u64 {
     u64::from(strands.div_ceil(per_group)) * u64::from(chunks)
 }
 
-/// Refuses mesh-shader generation of bundles of `per_bundle` strands at up to
-/// `vertex_count` vertices when one bundle's task would launch more mesh workgroups than the
-/// device allows (`max_mesh_workgroup_total_count`, which wgpu leaves to the driver).
+/// Refuses mesh-shader generation of `bundles` bundles of `per_bundle` strands at up to
+/// `vertex_count` vertices when the task shaders would exceed the device's limits: one task
+/// workgroup per bundle (`max_task_workgroup_total_count`), and one bundle's mesh workgroups
+/// in one dimension (`max_mesh_workgroup_total_count`, `max_mesh_workgroups_per_dimension`,
+/// which wgpu leaves to the driver).
 pub fn check_mesh_groups(
     limits: &wgpu::Limits,
+    bundles: usize,
     per_bundle: u32,
     vertex_count: u32,
 ) -> Result<(), StrandGenError> {
+    let task_limit = u64::from(limits.max_task_workgroup_total_count);
+    if bundles as u64 > task_limit {
+        return Err(StrandGenError::AdapterLimit {
+            what: "the task workgroups (one per bundle)".into(),
+            value: bundles as u64,
+            limit_name: "max_task_workgroup_total_count",
+            limit: task_limit,
+            hint: "; split the hair into smaller projects, or use another generation path".into(),
+        });
+    }
     let groups = mesh_groups(per_bundle, vertex_count);
-    let limit = u64::from(limits.max_mesh_workgroup_total_count);
+    let (limit_name, limit) =
+        if limits.max_mesh_workgroups_per_dimension < limits.max_mesh_workgroup_total_count {
+            (
+                "max_mesh_workgroups_per_dimension",
+                limits.max_mesh_workgroups_per_dimension,
+            )
+        } else {
+            (
+                "max_mesh_workgroup_total_count",
+                limits.max_mesh_workgroup_total_count,
+            )
+        };
+    let limit = u64::from(limit);
     if groups > limit {
         return Err(StrandGenError::AdapterLimit {
             what: format!(
                 "one bundle's mesh workgroups ({per_bundle} strands of {vertex_count} vertices)"
             ),
             value: groups,
-            limit_name: "max_mesh_workgroup_total_count",
+            limit_name,
             limit,
             hint: "; use fewer strands per bundle or vertices, or another generation path".into(),
         });
@@ -547,8 +572,11 @@ fn bundle_placements(textures: &RuntimeTextures, block_styling: &[u32]) -> Vec<B
 
 /// Each bundle's bounds and sizes for the mesh path's LOD (never empty: a storage buffer
 /// cannot be).
-fn bundle_lods(bounds: &[BundleBounds]) -> Vec<BundleLodGpu> {
-    let mut bundles: Vec<BundleLodGpu> = bounds.iter().map(BundleLodGpu::from).collect();
+fn bundle_lods(bounds: &[BundleBounds], per_bundle: u32) -> Vec<BundleLodGpu> {
+    let mut bundles: Vec<BundleLodGpu> = bounds
+        .iter()
+        .map(|b| BundleLodGpu::new(b, per_bundle))
+        .collect();
     if bundles.is_empty() {
         bundles.push(BundleLodGpu::default());
     }
@@ -702,7 +730,7 @@ impl StrandGenRenderer {
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         let bounds = hair.bundle_bounds();
-        let lods = bundle_lods(&bounds);
+        let lods = bundle_lods(&bounds, per_bundle as u32);
         let lod_bytes: &[u8] = bytemuck::cast_slice(&lods);
         Ok(GpuHair {
             position_offset: textures.position_offset.to_array(),
@@ -765,7 +793,7 @@ impl StrandGenRenderer {
         context.queue.write_buffer(
             &gpu.bundle_lods,
             0,
-            bytemuck::cast_slice(&bundle_lods(&gpu.bundles)),
+            bytemuck::cast_slice(&bundle_lods(&gpu.bundles, gpu.per_bundle)),
         );
         self.update_styling(context, gpu, hair);
         true
@@ -1180,12 +1208,16 @@ mod tests {
     fn a_bundle_over_the_mesh_group_limit_is_refused_by_name() {
         let limits = wgpu::Limits {
             max_mesh_workgroup_total_count: 1024,
+            max_mesh_workgroups_per_dimension: 65535,
+            max_task_workgroup_total_count: 1000,
             ..wgpu::Limits::default()
         };
-        assert!(check_mesh_groups(&limits, 64, 33).is_ok());
+        assert!(check_mesh_groups(&limits, 500, 64, 33).is_ok());
+        let error = check_mesh_groups(&limits, 1001, 64, 33).expect_err("too many bundles");
+        assert!(error.to_string().contains("max_task_workgroup_total_count"));
         // 4,096 strands of 1,025 vertices: 11 chunks each.
         assert_eq!(mesh_groups(4096, 1025), 4096 * 11);
-        let error = check_mesh_groups(&limits, 4096, 1025).expect_err("over the limit");
+        let error = check_mesh_groups(&limits, 500, 4096, 1025).expect_err("over the limit");
         let message = error.to_string();
         assert!(
             message.contains("max_mesh_workgroup_total_count") && message.contains("45056"),
