@@ -24,18 +24,14 @@
 // (render/tests/strand_mesh.rs); CPU mirror of the points and tangents: StrandGen::main
 // followed by runtime::preview_hair, as for the other paths.
 
-// Keep these three in sync with render/src/renderer/strand_gen.rs (`mesh_groups`, the CPU
-// mirror of this work distribution).
-// Strand vertices (invocations) per mesh workgroup; ribbon vertices are twice this. Sized so
-// a group's memory fits NVIDIA's mesh-shader limits (28 KiB of workgroup memory, which naga's
-// SPIR-V also keeps the outputs in; 32 KiB of outputs): 192 ribbon vertices of 8 attribute
-// slots is 24 KiB, and render/tests/shader_validation.rs adds up the workgroup memory.
-const MESH_STRAND_VERTICES: u32 = 96u;
-// Segments per chunk of a strand longer than a group (even: chunks start on even vertices).
-const MESH_CHUNK_SEGMENTS: u32 = 94u;
-// Most whole strands in a group (short strands far away), each with its set-up in workgroup
-// memory.
-const MESH_MAX_STRANDS: u32 = 16u;
+// The work distribution's sizes — MESH_STRAND_VERTICES (invocations per mesh workgroup; ribbon
+// vertices are twice this), MESH_CHUNK_SEGMENTS (segments per chunk of a longer strand; even,
+// so chunks start on even vertices) and MESH_MAX_STRANDS (whole strands per group, each with
+// its set-up in workgroup memory) — are written ahead of this file by render/src/ from
+// render/src/renderer/strand_gen.rs, whose `mesh_groups` is the CPU mirror. They are sized so
+// a group fits NVIDIA's mesh-shader limits (28 KiB of workgroup memory, which naga's SPIR-V
+// also keeps the outputs in; 32 KiB of outputs); render/tests/shader_validation.rs adds both
+// up.
 
 // Each bundle's bounds and sizes, in the hair's model space (`RuntimeTextures::bundle_bounds`,
 // as the frame plan culls and plans with), and the frame's LOD camera and settings.
@@ -119,8 +115,8 @@ struct RibbonTriangle {
 }
 
 struct MeshOutput {
-    @builtin(vertices) vertices: array<PassVertex, 192>,
-    @builtin(primitives) primitives: array<RibbonTriangle, 192>,
+    @builtin(vertices) vertices: array<PassVertex, 2u * MESH_STRAND_VERTICES>,
+    @builtin(primitives) primitives: array<RibbonTriangle, 2u * MESH_STRAND_VERTICES>,
     @builtin(vertex_count) vertex_count: u32,
     @builtin(primitive_count) primitive_count: u32,
 }
@@ -144,7 +140,7 @@ fn mesh_point(base: u32, k0: u32, chunk: u32, q: u32, input: StrandInput, n: u32
 
 @mesh(mesh_out)
 @payload(task)
-@workgroup_size(96)
+@workgroup_size(MESH_STRAND_VERTICES)
 fn ms_main(
     @builtin(local_invocation_index) t: u32,
     @builtin(workgroup_id) group: vec3<u32>,

@@ -205,8 +205,7 @@ fn lod_readback(@builtin(global_invocation_id) id: vec3<u32>) {
 /// counts that are not powers of two.
 #[test]
 fn task_shader_lod_matches_the_frame_plan() {
-    use glam::Mat4;
-    use hairloom_core::runtime::frame_plan::{LodCamera, bundle_lod};
+    use hairloom_core::runtime::frame_plan::bundle_lod;
     use hairloom_core::runtime::gpu_types::{BundleLodGpu, LodParams, StrandRun};
     use hairloom_render::device::read_buffer;
     use hairloom_render::renderer::scene_lighting::STRAND_LOD;
@@ -264,14 +263,7 @@ fn task_shader_lod_matches_the_frame_plan() {
             },
         ] {
             let eye = centre + Vec3::new(0.3, 0.1, 1.0).normalize() * distance;
-            let fov_y_rad = 30f32.to_radians();
-            let camera = LodCamera {
-                eye,
-                view_projection: Mat4::perspective_rh(fov_y_rad, 1.0, 0.01, 100.0)
-                    * Mat4::look_at_rh(eye, centre, Vec3::Y),
-                fov_y_rad,
-                resolution_px: 1080.0,
-            };
+            let camera = common::lod_camera(eye, centre);
             let params = LodParams::new(
                 &camera,
                 &settings,

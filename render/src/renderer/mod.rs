@@ -65,6 +65,22 @@ fn module_and_layout(
     (module, layout)
 }
 
+/// `topology` with no culling: ribbons face the viewer from either winding.
+fn primitive_state(topology: wgpu::PrimitiveTopology) -> wgpu::PrimitiveState {
+    wgpu::PrimitiveState {
+        topology,
+        cull_mode: None,
+        ..Default::default()
+    }
+}
+
+fn multisample_state(spec: &PipelineSpec) -> wgpu::MultisampleState {
+    wgpu::MultisampleState {
+        count: spec.sample_count,
+        ..Default::default()
+    }
+}
+
 /// The fragment stage of `spec` (none for a depth-only pipeline).
 fn fragment_state<'a>(
     spec: &'a PipelineSpec,
@@ -92,16 +108,9 @@ pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgp
                 compilation_options: Default::default(),
                 buffers: spec.buffers,
             },
-            primitive: wgpu::PrimitiveState {
-                topology: spec.topology,
-                cull_mode: None,
-                ..Default::default()
-            },
+            primitive: primitive_state(spec.topology),
             depth_stencil: spec.depth.clone(),
-            multisample: wgpu::MultisampleState {
-                count: spec.sample_count,
-                ..Default::default()
-            },
+            multisample: multisample_state(spec),
             fragment: fragment_state(spec, &module),
             multiview_mask: None,
             cache: None,
@@ -123,7 +132,7 @@ pub(crate) fn ribbon_pipeline(
     let (module, layout) = module_and_layout(context, spec);
     // strand_mesh.wgsl reads no workgroup memory it has not written (each strand's set-up,
     // its styled and morphed points), and the outputs past the counts it sets are never
-    // read, so the zeroing naga would add to every mesh workgroup (its 256 outputs too) is
+    // read, so the zeroing naga would add to every mesh workgroup (its outputs too) is
     // skipped.
     let stage_options = || wgpu::PipelineCompilationOptions {
         zero_initialize_workgroup_memory: false,
@@ -144,16 +153,9 @@ pub(crate) fn ribbon_pipeline(
                 entry_point: Some("ms_main"),
                 compilation_options: stage_options(),
             },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
+            primitive: primitive_state(wgpu::PrimitiveTopology::TriangleList),
             depth_stencil: spec.depth.clone(),
-            multisample: wgpu::MultisampleState {
-                count: spec.sample_count,
-                ..Default::default()
-            },
+            multisample: multisample_state(spec),
             fragment: fragment_state(spec, &module),
             multiview: None,
             cache: None,

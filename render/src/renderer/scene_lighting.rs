@@ -162,6 +162,19 @@ fn ribbon_modules(input: RibbonInput) -> String {
     }
 }
 
+/// `strand_mesh.wgsl`'s work-distribution sizes, from their one definition in
+/// [`crate::renderer::strand_gen`].
+fn mesh_sizes() -> String {
+    use crate::renderer::strand_gen::{
+        MESH_CHUNK_SEGMENTS, MESH_MAX_STRANDS, MESH_STRAND_VERTICES,
+    };
+    format!(
+        "const MESH_STRAND_VERTICES: u32 = {MESH_STRAND_VERTICES}u;\n\
+         const MESH_CHUNK_SEGMENTS: u32 = {MESH_CHUNK_SEGMENTS}u;\n\
+         const MESH_MAX_STRANDS: u32 = {MESH_MAX_STRANDS}u;\n"
+    )
+}
+
 /// A pass's finished source for ribbons from `input`: mesh-shader ribbons append the task and
 /// mesh entry points (which build the pass's own vertices through its `pass_vertex`) and
 /// enable the WGSL extension they need.
@@ -171,6 +184,7 @@ fn with_mesh_stages(input: RibbonInput, source: String) -> String {
             "enable wgpu_mesh_shader;\n",
             &source,
             STRAND_LOD,
+            &mesh_sizes(),
             STRAND_MESH,
         ]
         .concat(),

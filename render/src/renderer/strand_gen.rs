@@ -265,7 +265,9 @@ impl GenerationPath {
     }
 }
 
-/// Strand vertices (invocations) of one mesh workgroup in `strand_mesh.wgsl`.
+/// Strand vertices (invocations) of one mesh workgroup in `strand_mesh.wgsl` (these three
+/// sizes are written into the shader from here). 96: 192 ribbon vertices of 8 attribute slots
+/// is 24 KiB of outputs, and the group's workgroup memory stays under NVIDIA's 28 KiB.
 pub const MESH_STRAND_VERTICES: u32 = 96;
 /// Segments per chunk of a strand longer than a mesh workgroup (even: chunks start on even
 /// vertices).
