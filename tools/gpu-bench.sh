@@ -5,8 +5,8 @@
 #   tools/gpu-bench.sh pack          # here: build, strip into .gpu/hairloom (~20 MB)
 #   tools/gpu-bench.sh run [OUT]     # there: adapters, `bench gpu` side by side, `bench crowd`
 #
-# `run` names the adapter first and writes adapters.txt, gpu.txt, crowd_default.txt and
-# crowd_compute.txt into OUT (default $OUT when
+# `run` names the adapter first and writes adapters.txt, gpu.txt, crowd_default.txt,
+# crowd_compute.txt and effects.txt into OUT (default $OUT when
 # set, else out/gpu-bench). It unpacks carried Vulkan loaders (.gl/*.deb, see the device
 # notes) when the machine has none, and points the loader at NVIDIA's ICD when it is there.
 # Knobs: STRANDS (default 10000,100000,300000), RUNS (3), SIZE (1280x720), TEXTURES (f16,f32),
@@ -49,6 +49,8 @@ run)
         "$bin" bench crowd --characters "${CHARACTERS:-1,10,100}" --strands "${CROWD_STRANDS:-100000}" \
             --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" ${flag[@]+"${flag[@]}"} | tee "$out/crowd_$generation.txt"
     done
+    # What each lighting effect costs on this adapter (about 25 s on an H200).
+    "$bin" bench effects --size "${SIZE:-1280x720}" --runs "${RUNS:-3}" | tee "$out/effects.txt"
     ;;
 *)
     echo "usage: $0 pack | run [OUT]" >&2

@@ -15,6 +15,12 @@ pub enum DeviceError {
         "no GPU adapter found; on Debian install mesa-vulkan-drivers and libvulkan1 for the lavapipe software adapter (`make test` does this)"
     )]
     NoAdapter,
+    /// Only OpenGL adapters were found: their GLSL back end has no storage buffers in the
+    /// vertex stage and cannot load from depth textures, which every frame uses.
+    #[error(
+        "only OpenGL adapters found ({available}); hairloom needs Vulkan, Metal or DX12: on Debian install mesa-vulkan-drivers and libvulkan1 (`make test` does this)"
+    )]
+    OnlyOpenGl { available: String },
     #[error("no adapter matches {ADAPTER_ENV}={wanted:?}; available: {available}")]
     NoMatch { wanted: String, available: String },
     #[error("{adapter}: cannot create a device: {source}")]
@@ -78,6 +84,17 @@ pub fn choose_adapter(
     if infos.is_empty() {
         return Err(DeviceError::NoAdapter);
     }
+    let names = |infos: &mut dyn Iterator<Item = &wgpu::AdapterInfo>| {
+        infos
+            .map(|i| format!("{} ({:?})", i.name, i.backend))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if infos.iter().all(|i| i.backend == wgpu::Backend::Gl) {
+        return Err(DeviceError::OnlyOpenGl {
+            available: names(&mut infos.iter()),
+        });
+    }
     let filter: Box<dyn Fn(&wgpu::AdapterInfo) -> bool> = match wanted.map(str::trim) {
         None | Some("") => Box::new(|_| true),
         Some(w) if w.eq_ignore_ascii_case("cpu") => {
@@ -92,21 +109,12 @@ pub fn choose_adapter(
         }
     };
     (0..infos.len())
-        .filter(|&i| filter(&infos[i]))
-        // Prefer Vulkan/Metal/DX12 over GL for the same device type.
-        .min_by_key(|&i| {
-            (
-                rank(infos[i].device_type),
-                infos[i].backend == wgpu::Backend::Gl,
-            )
-        })
+        // Never GL (see `DeviceError::OnlyOpenGl`): the renderer's shaders do not run there.
+        .filter(|&i| infos[i].backend != wgpu::Backend::Gl && filter(&infos[i]))
+        .min_by_key(|&i| rank(infos[i].device_type))
         .ok_or_else(|| DeviceError::NoMatch {
             wanted: wanted.unwrap_or_default().to_string(),
-            available: infos
-                .iter()
-                .map(|i| i.name.clone())
-                .collect::<Vec<_>>()
-                .join(", "),
+            available: names(&mut infos.iter().filter(|i| i.backend != wgpu::Backend::Gl)),
         })
 }
 
@@ -126,10 +134,19 @@ pub fn describe(info: &wgpu::AdapterInfo) -> String {
     )
 }
 
+/// The adapter features the renderer uses when the adapter has them: timestamps (measured
+/// GPU time), f32 texture filtering (the hardware-filtering switch), f16, and the
+/// adapter-specific format features (8× MSAA where the adapter has it: see
+/// [`crate::view::sample_count`]). Requested by the headless device and the editor's window.
+pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+    .union(wgpu::Features::FLOAT32_FILTERABLE)
+    .union(wgpu::Features::SHADER_F16)
+    .union(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+
 impl GpuContext {
     /// Creates a device on the adapter chosen by [`choose_adapter`] with
     /// `HAIRLOOM_ADAPTER` from the environment. Requests the adapter's optional features
-    /// that later stages use when it has them (timestamps, f32 filtering, f16).
+    /// that later stages use when it has them ([`OPTIONAL_FEATURES`]).
     pub fn new_headless() -> Result<Self, DeviceError> {
         let adapters = pollster::block_on(instance().enumerate_adapters(wgpu::Backends::all()));
         let infos: Vec<wgpu::AdapterInfo> = adapters.iter().map(|a| a.get_info()).collect();
@@ -140,12 +157,9 @@ impl GpuContext {
             .nth(index)
             .ok_or(DeviceError::NoAdapter)?;
         let adapter_info = adapter.get_info();
-        let optional = wgpu::Features::TIMESTAMP_QUERY
-            | wgpu::Features::FLOAT32_FILTERABLE
-            | wgpu::Features::SHADER_F16;
         let mut descriptor = wgpu::DeviceDescriptor {
             label: Some("hairloom"),
-            required_features: adapter.features() & optional,
+            required_features: adapter.features() & OPTIONAL_FEATURES,
             required_limits: adapter.limits(),
             ..Default::default()
         };
@@ -441,6 +455,23 @@ mod tests {
         assert!(matches!(
             choose_adapter(&[], None),
             Err(DeviceError::NoAdapter)
+        ));
+        // A GL adapter is never chosen, even when asked for by name.
+        let gl_only = [info(
+            "llvmpipe (LLVM 15)",
+            wgpu::DeviceType::Cpu,
+            wgpu::Backend::Gl,
+        )];
+        let error = choose_adapter(&gl_only, None).err().map(|e| e.to_string());
+        assert!(
+            error
+                .as_deref()
+                .is_some_and(|e| e.contains("only OpenGL") && e.contains("mesa-vulkan-drivers")),
+            "{error:?}"
+        );
+        assert!(matches!(
+            choose_adapter(&infos[..2], Some("h100")),
+            Err(DeviceError::NoMatch { .. })
         ));
     }
 }

@@ -11,14 +11,42 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// sRGB-encoded bytes, which is what egui composites.
 pub const UI_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// The MSAA sample count for the view's targets: 8× where the adapter allows it for both
-/// colour and depth, else 4×, else none.
+/// The MSAA sample count for the view's targets: 8× where the device allows it for colour,
+/// depth and the width-based coverage targets, else 4× (which WebGPU guarantees), else none.
+///
+/// Counts beyond 1 and 4 are adapter-specific: a device may use them only when it was made
+/// with `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` (found on an NVIDIA H200, whose adapter
+/// reports 8× for `Rgba8UnormSrgb` but whose device, made without the feature, refuses it).
 pub fn sample_count(context: &GpuContext) -> u32 {
-    let flags = |format| context.adapter.get_texture_format_features(format).flags;
-    let (color, depth) = (flags(COLOR_FORMAT), flags(DEPTH_FORMAT));
+    supported_sample_count(
+        context.device.features(),
+        |format| context.adapter.get_texture_format_features(format).flags,
+        &[
+            COLOR_FORMAT,
+            DEPTH_FORMAT,
+            crate::renderer::preview_hair::OIT_ACCUMULATION_FORMAT,
+            crate::renderer::preview_hair::OIT_REVEALAGE_FORMAT,
+        ],
+    )
+}
+
+/// The largest of 8 and 4 samples that every format in `formats` supports on a device with
+/// `device_features`, else 1 (see [`sample_count`]).
+pub fn supported_sample_count(
+    device_features: wgpu::Features,
+    adapter_flags: impl Fn(wgpu::TextureFormat) -> wgpu::TextureFormatFeatureFlags,
+    formats: &[wgpu::TextureFormat],
+) -> u32 {
+    let adapter_specific =
+        device_features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
     [8, 4]
         .into_iter()
-        .find(|&count| color.sample_count_supported(count) && depth.sample_count_supported(count))
+        .filter(|&count| count == 4 || adapter_specific)
+        .find(|&count| {
+            formats
+                .iter()
+                .all(|&format| adapter_flags(format).sample_count_supported(count))
+        })
         .unwrap_or(1)
 }
 
@@ -182,5 +210,40 @@ impl View {
             pixels.extend_from_slice(&mapped[start..start + (width * 4) as usize]);
         }
         Ok(pixels)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eight_samples_need_the_adapter_specific_feature_on_the_device() {
+        use wgpu::TextureFormatFeatureFlags as F;
+        let all = |_| F::MULTISAMPLE_X2 | F::MULTISAMPLE_X4 | F::MULTISAMPLE_X8;
+        let formats = [COLOR_FORMAT, DEPTH_FORMAT];
+        // The H200's case: the adapter reports 8×, the device was made without the feature.
+        assert_eq!(
+            supported_sample_count(wgpu::Features::empty(), all, &formats),
+            4
+        );
+        let specific = wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
+        assert_eq!(supported_sample_count(specific, all, &formats), 8);
+        // One format without 8× keeps every target at 4×.
+        let depth_without_8 = |format| {
+            if format == DEPTH_FORMAT {
+                F::MULTISAMPLE_X4
+            } else {
+                all(format)
+            }
+        };
+        assert_eq!(
+            supported_sample_count(specific, depth_without_8, &formats),
+            4
+        );
+        assert_eq!(
+            supported_sample_count(specific, |_| F::empty(), &formats),
+            1
+        );
     }
 }

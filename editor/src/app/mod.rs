@@ -36,7 +36,7 @@ use viewport::Viewport;
 
 /// The editor's wgpu setup: egui's defaults plus the optional features the generator uses
 /// when the adapter has them (timestamps for measured GPU time, f32 texture filtering for
-/// the hardware-filtering switch, f16, mesh shaders for the fastest generation path), and
+/// the hardware-filtering switch, f16, 8× MSAA where the adapter has it, mesh shaders for the fastest generation path), and
 /// without the GL backend, whose WebGL2 limits have
 /// no storage buffers. Shared by the binary and the wgpu snapshot tests.
 pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetup {
@@ -44,11 +44,9 @@ pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetup {
     setup.instance_descriptor.backends = wgpu::Backends::PRIMARY;
     let egui_descriptor = setup.device_descriptor.clone();
     setup.device_descriptor = std::sync::Arc::new(move |adapter| {
-        let optional = wgpu::Features::TIMESTAMP_QUERY
-            | wgpu::Features::FLOAT32_FILTERABLE
-            | wgpu::Features::SHADER_F16;
         let mut descriptor = egui_descriptor(adapter);
-        descriptor.required_features |= adapter.features() & optional;
+        descriptor.required_features |=
+            adapter.features() & hairloom_render::device::OPTIONAL_FEATURES;
         hairloom_render::device::request_mesh_shaders(adapter, &mut descriptor);
         descriptor
     });
