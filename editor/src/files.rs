@@ -2,7 +2,6 @@
 //! document, and exporting the runtime bundle and strand files (each written atomically).
 //! Long work reports progress through a callback that may also cancel it.
 
-use std::io::{IsTerminal, Write};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
@@ -12,7 +11,9 @@ use hairloom_core::io::alembic::{groom::Groom, groom_file};
 use hairloom_core::io::import::{ImportOptions, import_file};
 use hairloom_core::io::project::write_atomic;
 use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
-use hairloom_core::io::strand_files::{ScalpMesh, glb_lines, hair_file, usda_file};
+use hairloom_core::io::strand_files::{
+    ScalpMesh, StrandExportSize, glb_lines, hair_file, usda_file,
+};
 use hairloom_core::runtime::hair::{LodEntry, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, runtime_strands};
 use hairloom_core::runtime::textures::Precision;
@@ -100,12 +101,17 @@ fn runtime_curve_strands(
     precision: Precision,
     strands_per_bundle: u32,
     vertices_log2: u32,
-) -> Vec<Strand> {
+) -> anyhow::Result<Vec<Strand>> {
+    check_export_size(document, strands_per_bundle, vertices_log2)?;
     let hair = RuntimeHair::from_document(
         document,
         &runtime_options(precision, strands_per_bundle, vertices_log2),
     );
-    runtime_strands(&hair, (1usize << vertices_log2) + 1, Filtering::Exact)
+    Ok(runtime_strands(
+        &hair,
+        (1usize << vertices_log2) + 1,
+        Filtering::Exact,
+    ))
 }
 
 /// How a runtime bundle is exported: `2^vertices_log2 + 1` vertices per strand at full detail.
@@ -162,13 +168,15 @@ pub fn check_strand_file(file: &Path) -> anyhow::Result<()> {
 }
 
 /// Generates every strand; `progress` gets the fraction done after each bundle and may
-/// stop the work (`None` then).
+/// stop the work (`Ok(None)` then). An export above the cap on points
+/// ([`StrandExportSize::check`]) is refused before anything is generated.
 pub fn generate_strands(
     document: &Document,
     strands_per_bundle: u32,
     vertices_log2: u32,
     progress: &mut dyn FnMut(f32) -> ControlFlow<()>,
-) -> Option<Vec<Strand>> {
+) -> anyhow::Result<Option<Vec<Strand>>> {
+    check_export_size(document, strands_per_bundle, vertices_log2)?;
     let options = StrandOptions {
         strands_per_bundle,
         vertices_log2,
@@ -181,10 +189,10 @@ pub fn generate_strands(
     for index in 0..bundle_count {
         strands.extend(plan.bundle_strands(&context, index));
         if progress((index + 1) as f32 / bundle_count.max(1) as f32).is_break() {
-            return None;
+            return Ok(None);
         }
     }
-    Some(strands)
+    Ok(Some(strands))
 }
 
 /// Writes `strands`, grown from `document`, in the format `file`'s extension names; returns
@@ -244,40 +252,40 @@ pub fn run(
         println!("{summary}");
     }
     if !strand_files.is_empty() {
-        let mut stderr = std::io::stderr();
-        // Redrawn in place on a terminal; logs and pipes get nothing.
-        let show_progress = stderr.is_terminal();
-        let mut last_percent = usize::MAX;
+        let mut bar = crate::progress::TerminalProgress::new("generating strands");
         let strands = match curve {
             StrandCurve::Runtime => {
-                runtime_curve_strands(document, precision, strands_per_bundle, vertices_log2)
+                runtime_curve_strands(document, precision, strands_per_bundle, vertices_log2)?
             }
             StrandCurve::Exact => {
                 generate_strands(document, strands_per_bundle, vertices_log2, &mut |done| {
-                    let percent = (done * 100.0) as usize;
-                    if show_progress && percent != last_percent {
-                        let filled = percent / 5;
-                        let _ = write!(
-                            stderr,
-                            "\rgenerating strands [{}{}] {percent:>3}%",
-                            "#".repeat(filled),
-                            " ".repeat(20 - filled)
-                        );
-                        last_percent = percent;
-                    }
+                    bar.update(done as f64);
                     ControlFlow::Continue(())
-                })
+                })?
                 .unwrap_or_default()
             }
         };
-        if show_progress && curve == StrandCurve::Exact {
-            let _ = writeln!(stderr);
-        }
+        bar.finish();
         for file in strand_files {
             println!("{}", write_strand_file(&strands, document, file)?);
         }
     }
     Ok(())
+}
+
+/// Refuses a strand export above the cap on points before anything is generated.
+fn check_export_size(
+    document: &Document,
+    strands_per_bundle: u32,
+    vertices_log2: u32,
+) -> anyhow::Result<()> {
+    StrandExportSize::of(&document.hair_mesh, strands_per_bundle, vertices_log2)
+        .check()
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "{e}: lower the strands per bundle or the vertices per strand (--strands-per-bundle, --vertices-log2)"
+            )
+        })
 }
 
 /// Refuses strands of more than `2^MAX_VERTICES_LOG2 + 1` vertices (the runtime bundle's
@@ -327,7 +335,7 @@ pub fn write_cards(
     check_vertices_log2(vertices_log2)?;
     let strands = generate_strands(document, strands_per_bundle, vertices_log2, &mut |_| {
         ControlFlow::Continue(())
-    })
+    })?
     .unwrap_or_default();
     let options = CardOptions::default();
     let cards = hair_cards(document, &strands, &options);

@@ -526,3 +526,76 @@ fn export_cards_refuses_oversized_strands_by_name() {
     assert!(stderr.contains("--vertices-log2 16"), "{stderr}");
     assert!(!cards.exists());
 }
+
+/// Issue "Nothing lost, nothing blocked": every strand export at the documented maxima
+/// (4096 strands per bundle, 1025 vertices per strand; a project of 115,200 bundles at the
+/// defaults) is refused up front with the size it would need — never an allocation abort —
+/// and writes nothing.
+#[test]
+fn strand_exports_at_the_documented_maxima_are_refused_with_their_size() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let teapot = samples()
+        .into_iter()
+        .find(|p| p.to_string_lossy().contains("teapot"))
+        .expect("teapot sample");
+    let maxima = ["--strands-per-bundle", "4096", "--vertices-log2", "10"];
+    let outputs = ["x.hair", "x.usda", "x.glb", "x.abc"].map(|name| dir.path().join(name));
+    let mut cases: Vec<Vec<std::ffi::OsString>> = outputs
+        .iter()
+        .map(|out| vec!["--strands".into(), out.clone().into_os_string()])
+        .collect();
+    cases.push(vec![
+        "--strands".into(),
+        outputs[0].clone().into_os_string(),
+        "--curve".into(),
+        "runtime".into(),
+    ]);
+    cases.push(vec![
+        "--cards".into(),
+        dir.path().join("cards").into_os_string(),
+    ]);
+    for args in &cases {
+        let (code, _, stderr) = run(hairloom()
+            .arg("export")
+            .arg(&teapot)
+            .args(args)
+            .args(maxima));
+        assert_ne!(code, 0, "{args:?}");
+        assert!(
+            stderr.contains("1209139200 points")
+                && stderr.contains("GB of memory")
+                && stderr.contains("--strands-per-bundle"),
+            "{args:?}: {stderr}"
+        );
+        // Exit code 2 is an error the program reported; an abort is a signal (-1 here).
+        assert_eq!(code, 2, "{args:?}: {stderr}");
+    }
+    // A project of 115,200 bundles passes `check` and is refused at the default settings.
+    let mut mesh = hairloom_tests::grid_mesh(360, 320, 1, 0.01);
+    for column in &mut mesh.columns {
+        for p in &mut column.positions {
+            *p *= 0.01;
+        }
+    }
+    let big = dir.path().join("big.hairloom");
+    hairloom_core::io::project::save(
+        &big,
+        &hairloom_core::Project::new(hairloom_core::Document::new("big", mesh)),
+    )
+    .expect("save");
+    let (code, _, stderr) = run(hairloom().arg("check").arg(&big));
+    assert_eq!(code, 0, "{stderr}");
+    let (code, _, stderr) = run(hairloom()
+        .arg("export")
+        .arg(&big)
+        .arg("--strands")
+        .arg(&outputs[0]));
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("7372800 strands × 33 vertices"), "{stderr}");
+    let written: Vec<_> = std::fs::read_dir(dir.path())
+        .expect("list")
+        .map(|e| e.expect("entry").file_name())
+        .filter(|name| name != "big.hairloom")
+        .collect();
+    assert!(written.is_empty(), "written: {written:?}");
+}

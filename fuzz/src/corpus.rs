@@ -18,7 +18,40 @@ pub fn seeds(target: Target) -> Vec<(String, Vec<u8>)> {
         Target::GltfImport => gltf_seeds(),
         Target::RuntimeBundle => bundle_seeds(),
         Target::Ktx2 => ktx2_seeds(),
+        Target::StrandExport => strand_export_seeds(),
     }
+}
+
+/// Issue "Nothing lost, nothing blocked": exports at every documented maximum (4096
+/// strands per bundle, 1025 vertices per strand) and past it, over a small project and one
+/// of 20,000 layers; and small exports that are generated and written.
+fn strand_export_seeds() -> Vec<(String, Vec<u8>)> {
+    use crate::targets::strand_export_input;
+    let projects = project_seeds();
+    let (_, grid) = &projects[0];
+    let (_, deep) = &projects[1];
+    vec![
+        (
+            "grid_1_strand_3_vertices".into(),
+            strand_export_input(1, 1, grid),
+        ),
+        (
+            "grid_8_strands_17_vertices".into(),
+            strand_export_input(8, 4, grid),
+        ),
+        (
+            "crafted_grid_at_the_maxima".into(),
+            strand_export_input(4096, 10, grid),
+        ),
+        (
+            "crafted_grid_past_the_maxima".into(),
+            strand_export_input(4097, 11, grid),
+        ),
+        (
+            "crafted_layers_20000_at_the_maxima".into(),
+            strand_export_input(4096, 10, deep),
+        ),
+    ]
 }
 
 fn project_seeds() -> Vec<(String, Vec<u8>)> {

@@ -20,14 +20,19 @@ pub enum Target {
     RuntimeBundle,
     /// `io::ktx2::read_texture` of a whole KTX2 file.
     Ktx2,
+    /// A strand export of a project (the input after its first two bytes) at the size those
+    /// bytes pick, up to and past the documented maxima (see [`strand_export_input`]):
+    /// refused by the cap with its size, or generated and written in every format.
+    StrandExport,
 }
 
 impl Target {
-    pub const ALL: [Target; 4] = [
+    pub const ALL: [Target; 5] = [
         Target::ProjectLoad,
         Target::GltfImport,
         Target::RuntimeBundle,
         Target::Ktx2,
+        Target::StrandExport,
     ];
 
     pub fn name(self) -> &'static str {
@@ -36,6 +41,7 @@ impl Target {
             Target::GltfImport => "gltf_import",
             Target::RuntimeBundle => "runtime_bundle",
             Target::Ktx2 => "ktx2",
+            Target::StrandExport => "strand_export",
         }
     }
 
@@ -49,6 +55,7 @@ impl Target {
             Target::GltfImport => gltf_import(input),
             Target::RuntimeBundle => runtime_bundle(input),
             Target::Ktx2 => ktx2(input),
+            Target::StrandExport => strand_export(input),
         }
     }
 }
@@ -121,6 +128,65 @@ fn ktx2(input: &[u8]) {
     .find(|f| f.vk_number() == word(12))
     .unwrap_or(TexelFormat::Rgba32Float);
     let _ = read_texture(input, format, [word(20), word(24), word(28)]);
+}
+
+/// Strands per bundle a [`Target::StrandExport`] input's first byte picks: the documented
+/// maximum (4096) among them, and one past it.
+const STRANDS_PER_BUNDLE: [u32; 6] = [1, 8, 64, 256, 4096, 4097];
+
+/// A strand-export fuzz input: `strands_per_bundle` (one of [`STRANDS_PER_BUNDLE`]) and
+/// `vertices_log2` (0 to 11: the documented maximum 10 and one past it) before the project.
+pub fn strand_export_input(strands_per_bundle: u32, vertices_log2: u32, project: &[u8]) -> Vec<u8> {
+    let pick = STRANDS_PER_BUNDLE
+        .iter()
+        .position(|&n| n == strands_per_bundle)
+        .unwrap_or(0);
+    let mut input = vec![pick as u8, vertices_log2 as u8];
+    input.extend_from_slice(project);
+    input
+}
+
+/// Points above which an accepted export is only checked, not generated: the fuzz run's
+/// own time bound (the cap itself is what the check tests).
+const FUZZ_GENERATED_POINTS: u64 = 20_000;
+
+fn strand_export(input: &[u8]) {
+    use hairloom_core::io::alembic::{groom::Groom, groom_file};
+    use hairloom_core::io::strand_files::{
+        ScalpMesh, StrandExportSize, glb_lines, hair_file, usda_file,
+    };
+    use hairloom_core::strands::reference::{StrandOptions, generate};
+    let [pick, log2, project @ ..] = input else {
+        return;
+    };
+    let strands_per_bundle = STRANDS_PER_BUNDLE[*pick as usize % STRANDS_PER_BUNDLE.len()];
+    let vertices_log2 = u32::from(*log2 % 12);
+    let Ok(project) =
+        hairloom_core::io::project::from_bytes(project, std::path::Path::new("fuzz.hairloom"))
+    else {
+        return;
+    };
+    let document = &project.document;
+    let size = StrandExportSize::of(&document.hair_mesh, strands_per_bundle, vertices_log2);
+    if size.check().is_err() || size.points > FUZZ_GENERATED_POINTS {
+        return;
+    }
+    let strands = generate(
+        document,
+        &StrandOptions {
+            strands_per_bundle,
+            vertices_log2,
+            ..StrandOptions::default()
+        },
+    );
+    assert!(
+        strands.iter().map(|s| s.points.len() as u64).sum::<u64>() <= size.points,
+        "the export holds more points than its size said"
+    );
+    let _ = hair_file(&strands, 1e-4, [0.3, 0.2, 0.1]);
+    let _ = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), 1e-4);
+    let _ = glb_lines(&strands);
+    let _ = groom_file(&Groom::new(document, &strands, 1e-4));
 }
 
 /// The manifest of a runtime bundle's files, for crafting cases.

@@ -363,14 +363,19 @@ fn a_runtime_bundle_export_killed_at_any_point_loads_wholly_old_or_new() {
         saw_old && saw_new,
         "the kills covered before and after the commit"
     );
-    // A finished export leaves exactly its own files (stale ones and temporaries gone).
+    // A finished export leaves exactly its own files and its ledger (stale ones and
+    // temporaries gone, also those of a writer killed between its commit and its clean-up).
     write_bundle_folder(&dir, &new, |_| {}).expect("new bundle");
     let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
         .expect("list")
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
         .collect();
     on_disk.sort();
-    let mut expected: Vec<String> = new.iter().map(|(n, _)| n.clone()).collect();
+    let mut expected: Vec<String> = new
+        .iter()
+        .map(|(n, _)| n.clone())
+        .chain([hairloom_core::io::runtime_bundle::EXPORT_LEDGER_FILE.to_string()])
+        .collect();
     expected.sort();
     assert_eq!(on_disk, expected);
 }

@@ -134,7 +134,9 @@ impl InputFolder {
 }
 
 /// Reads a regular file of at most `cap_bytes` (the file the user named: no folder rule).
-pub(crate) fn read_regular_file(
+/// A FIFO cannot block the open, and the cap holds while reading (a `/proc` file that
+/// reports size 0, or a file that grows, stops there).
+pub fn read_regular_file(
     path: &Path,
     cap_bytes: u64,
     what: &'static str,

@@ -235,6 +235,10 @@ pub const WRITE_CHUNK_BYTES: usize = 64 * 1024;
 /// Temporaries of the same target left by a writer that was killed (its process is gone)
 /// are removed first.
 ///
+/// Permissions (Unix): a new file gets `0666` less the process's umask, as any program's
+/// new file does; a file written over keeps its permission bits and, where the writer may
+/// set it, its group — so a project shared with a group stays shared after a save.
+///
 /// `after_chunk(bytes_written_so_far)` runs after every [`WRITE_CHUNK_BYTES`]; tests use it
 /// to crash a writer halfway.
 pub fn write_atomic(
@@ -249,11 +253,9 @@ pub fn write_atomic(
     let file_name = path.file_name().ok_or_else(|| {
         std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path names no file")
     })?;
-    let prefix = temp_prefix(&file_name.to_string_lossy());
-    remove_stale_temporaries(&folder, &prefix);
-    let mut temp = tempfile::Builder::new()
-        .prefix(&format!("{prefix}{}-", std::process::id()))
-        .tempfile_in(&folder)?;
+    let file_name = file_name.to_string_lossy();
+    remove_dead_writers_temporaries(&folder, |target| target == file_name);
+    let mut temp = new_temporary(&folder, &file_name, path)?;
     let mut written = 0;
     for chunk in bytes.chunks(WRITE_CHUNK_BYTES) {
         temp.write_all(chunk)?;
@@ -271,24 +273,69 @@ pub fn write_atomic(
     Ok(())
 }
 
+/// The temporary [`write_atomic`] writes `target` (called `file_name`, in `folder`) through,
+/// with the permissions the finished file must have.
+fn new_temporary(
+    folder: &Path,
+    file_name: &str,
+    target: &Path,
+) -> std::io::Result<tempfile::NamedTempFile> {
+    let prefix = format!("{}{}-", temp_prefix(file_name), std::process::id());
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt as _;
+        // Passed to open(2), which applies the umask: what a new file of any program gets.
+        // (`tempfile`'s own default is 0600, which locked collaborators out of every file.)
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let temp = builder.tempfile_in(folder)?;
+    #[cfg(unix)]
+    if let Some(old) = std::fs::metadata(target)
+        .ok()
+        .filter(std::fs::Metadata::is_file)
+    {
+        use std::os::unix::fs::{MetadataExt as _, PermissionsExt as _};
+        // The permission bits only: set-id bits are not carried onto a rewritten file.
+        let mode = old.permissions().mode() & 0o777;
+        temp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(mode))?;
+        // Only the owner or root may change the group, and only to one of theirs; where
+        // that is refused the file keeps the writer's group, as a new file would.
+        let _ = std::os::unix::fs::fchown(temp.as_file(), None, Some(old.gid()));
+    }
+    #[cfg(not(unix))]
+    let _ = target;
+    Ok(temp)
+}
+
 /// Start of the names of [`write_atomic`]'s temporaries for a file called `file_name`.
 pub(crate) fn temp_prefix(file_name: &str) -> String {
     format!(".{file_name}.tmp-")
 }
 
-/// Removes `PREFIX<pid>-…` (and the older `PREFIX<pid>`) files in `folder` whose writing
-/// process no longer runs. Where liveness cannot be told (no `/proc`), only temporaries
-/// older than a day are removed. Failures are ignored: this is housekeeping.
-fn remove_stale_temporaries(folder: &Path, prefix: &str) {
+/// Removes [`write_atomic`]'s temporaries in `folder` (`.TARGET.tmp-PID-…`, and the older
+/// `.TARGET.tmp-PID`) whose `TARGET` passes `is_target` and whose writing process no longer
+/// runs. Where liveness cannot be told (no `/proc`), only temporaries older than a day are
+/// removed. Failures are ignored: this is housekeeping.
+pub(crate) fn remove_dead_writers_temporaries(folder: &Path, is_target: impl Fn(&str) -> bool) {
     let Ok(entries) = std::fs::read_dir(folder) else {
         return;
     };
     let own_pid = std::process::id();
     for entry in entries.flatten() {
         let name = entry.file_name();
-        let Some(rest) = name.to_str().and_then(|n| n.strip_prefix(prefix)) else {
+        let Some((target, rest)) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix('.'))
+            .and_then(|n| n.rsplit_once(".tmp-"))
+        else {
             continue;
         };
+        if !is_target(target) {
+            continue;
+        }
         let Ok(pid) = rest.split('-').next().unwrap_or_default().parse::<u32>() else {
             continue;
         };

@@ -144,17 +144,28 @@ fn is_bundle_data_file(name: &str) -> bool {
 
 /// Writes a runtime bundle's `files` (from [`bundle_files`], manifest last) into `dir`, so
 /// that a reader at any moment — including after a crash — sees the old bundle or the new
-/// one, whole: every data file is written atomically under its content-addressed name
-/// (one already there has the right content by construction and is kept), then the
-/// manifest is renamed into place (the single commit point), then data files of ours that
-/// the new manifest does not name are removed.
+/// one, whole: every data file is written atomically under its content-addressed name (one
+/// already there is kept only when its bytes are these bytes), then the manifest is renamed
+/// into place (the single commit point), then data files of earlier exports into `dir` that
+/// the new manifest does not name are removed — each only if its content still matches the
+/// hash in its name, so a file the export did not write, or one a user changed since, is
+/// never removed.
+///
+/// Which files earlier exports wrote is kept in [`EXPORT_LEDGER_FILE`], written before any
+/// data file: an export killed before its commit, or between its commit and its clean-up,
+/// leaves names there that the next export removes. Folders exported before the ledger
+/// existed count the names their manifest gives.
+///
+/// The folder may hold anything else (a user's `body.glb`, their own textures): it is never
+/// touched. A `manifest.json` there that is not a Hairloom runtime manifest is refused
+/// before anything is written (it is the user's, and the export would replace it).
+/// Temporaries that killed exports left behind for any bundle file are removed.
 pub fn write_bundle_folder(
     dir: &std::path::Path,
     files: &[(String, Vec<u8>)],
     mut after_file: impl FnMut(&str),
 ) -> std::io::Result<()> {
-    use crate::io::project::write_atomic;
-    std::fs::create_dir_all(dir)?;
+    use crate::io::project::{remove_dead_writers_temporaries, write_atomic};
     let Some(((manifest_name, manifest), data)) = files.split_last() else {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
@@ -167,14 +178,25 @@ pub fn write_bundle_folder(
             "the manifest must be the last file",
         ));
     }
+    std::fs::create_dir_all(dir)?;
+    let previous = files_of_previous_bundle(dir)?;
+    remove_dead_writers_temporaries(dir, |target| {
+        target == MANIFEST_FILE || target == EXPORT_LEDGER_FILE || is_bundle_data_file(target)
+    });
+    // Every name an earlier export may have left, and every name this one will write,
+    // recorded before the first data file is.
+    let mut ours = read_ledger(dir);
+    ours.extend(previous);
+    ours.extend(data.iter().map(|(name, _)| name.clone()));
+    ours.sort();
+    ours.dedup();
+    write_ledger(dir, &ours)?;
     for (name, bytes) in data {
         let path = dir.join(name);
-        // A content-addressed file already there holds these bytes (it was renamed into
-        // place whole); rewriting it would only cost time.
+        // A content-addressed file already there is reused only when it holds exactly these
+        // bytes: a file damaged since (same name, same size) is written again.
         let content_addressed = name.matches('.').count() == 2 && is_bundle_data_file(name);
-        let already_there = content_addressed
-            && std::fs::symlink_metadata(&path)
-                .is_ok_and(|m| m.is_file() && m.len() == bytes.len() as u64);
+        let already_there = content_addressed && file_holds(&path, bytes);
         if !already_there {
             write_atomic(&path, bytes, |_| {})?;
         }
@@ -183,14 +205,113 @@ pub fn write_bundle_folder(
     write_atomic(&dir.join(MANIFEST_FILE), manifest, |_| {})?;
     after_file(MANIFEST_FILE);
     let named: std::collections::HashSet<&str> = data.iter().map(|(n, _)| n.as_str()).collect();
-    for entry in std::fs::read_dir(dir)?.flatten() {
-        let name = entry.file_name();
-        let Some(name) = name.to_str() else { continue };
-        if is_bundle_data_file(name) && !named.contains(name) {
-            let _ = std::fs::remove_file(entry.path());
+    for name in &ours {
+        if named.contains(name.as_str()) {
+            continue;
+        }
+        let path = dir.join(name);
+        if still_as_written(&path, name) {
+            let _ = std::fs::remove_file(path);
         }
     }
-    Ok(())
+    let mut kept: Vec<String> = named.into_iter().map(str::to_string).collect();
+    kept.sort();
+    write_ledger(dir, &kept)
+}
+
+/// The hidden file in a bundle folder that lists the data files exports into it wrote
+/// (one name a line), so a later export removes only those (see [`write_bundle_folder`]).
+pub const EXPORT_LEDGER_FILE: &str = ".hairloom-export-files";
+
+/// The names [`EXPORT_LEDGER_FILE`] lists that could be bundle data files (none when it is
+/// missing or unreadable: then nothing is removed on its word).
+fn read_ledger(dir: &std::path::Path) -> Vec<String> {
+    use crate::io::input_files::read_regular_file;
+    let Ok(bytes) = read_regular_file(
+        &dir.join(EXPORT_LEDGER_FILE),
+        limits::MANIFEST_BYTES,
+        "a runtime bundle folder's export ledger",
+    ) else {
+        return Vec::new();
+    };
+    String::from_utf8_lossy(&bytes)
+        .lines()
+        .map(str::trim)
+        .filter(|name| is_bundle_data_file(name))
+        .map(str::to_string)
+        .collect()
+}
+
+fn write_ledger(dir: &std::path::Path, names: &[String]) -> std::io::Result<()> {
+    let mut text = String::new();
+    for name in names {
+        text.push_str(name);
+        text.push('\n');
+    }
+    crate::io::project::write_atomic(&dir.join(EXPORT_LEDGER_FILE), text.as_bytes(), |_| {})
+}
+
+/// Whether `path` is a regular file holding exactly `bytes`.
+fn file_holds(path: &std::path::Path, bytes: &[u8]) -> bool {
+    use crate::io::input_files::read_regular_file;
+    let same_size =
+        std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file() && m.len() == bytes.len() as u64);
+    same_size
+        && read_regular_file(path, bytes.len() as u64, "a runtime bundle file")
+            .is_ok_and(|existing| existing == bytes)
+}
+
+/// Whether the content-addressed file `name` at `path` is a regular file (not a link) whose
+/// content still hashes to the name: what an export wrote and nobody changed since.
+fn still_as_written(path: &std::path::Path, name: &str) -> bool {
+    use crate::io::input_files::read_regular_file;
+    let Some((stem, rest)) = name.split_once('.') else {
+        return false;
+    };
+    let Some((_, extension)) = rest.split_once('.') else {
+        // A fixed name from before content addressing: nothing to check it against.
+        return false;
+    };
+    let regular = std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file());
+    regular
+        && read_regular_file(path, limits::FILE_BYTES, "a runtime bundle file")
+            .is_ok_and(|bytes| content_addressed_name(stem, extension, &bytes) == name)
+}
+
+/// The data files the manifest already in `dir` names (none when there is no manifest). A
+/// `manifest.json` that is not a Hairloom runtime manifest is an error: it is someone's
+/// file, and writing the bundle would replace it.
+fn files_of_previous_bundle(dir: &std::path::Path) -> std::io::Result<Vec<String>> {
+    use crate::io::input_files::read_regular_file;
+    let path = dir.join(MANIFEST_FILE);
+    if std::fs::symlink_metadata(&path).is_err() {
+        return Ok(Vec::new());
+    }
+    let not_ours = |why: &str| {
+        std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            format!(
+                "{} is not a Hairloom runtime manifest ({why}); export into an empty folder or one that holds a Hairloom runtime bundle",
+                path.display()
+            ),
+        )
+    };
+    let bytes = read_regular_file(&path, limits::MANIFEST_BYTES, "a runtime bundle manifest")
+        .map_err(|e| not_ours(&e.to_string()))?;
+    let value: serde_json::Value =
+        serde_json::from_slice(&bytes).map_err(|e| not_ours(&format!("not JSON: {e}")))?;
+    if value.get("format").and_then(|f| f.as_str()) != Some("hairloom-runtime") {
+        return Err(not_ours("its \"format\" is not \"hairloom-runtime\""));
+    }
+    let mut names: Vec<String> = ["hair_mesh", "uv", "w", "u", "v"]
+        .iter()
+        .filter_map(|key| value.get(*key)?.get("file")?.as_str())
+        .chain(value.get("body").and_then(|b| b.as_str()))
+        .filter(|name| is_bundle_data_file(name))
+        .map(str::to_string)
+        .collect();
+    names.dedup();
+    Ok(names)
 }
 
 /// The files of a runtime bundle of `document` exported with `options`: `(file name,

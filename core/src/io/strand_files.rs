@@ -5,6 +5,82 @@
 use crate::model::mesh::HairMesh;
 use crate::strands::reference::Strand;
 
+/// Points one strand export may hold (every strand × its vertices). Strands are generated
+/// in memory before they are written (24 B per point as f64, plus the file's own bytes: 12
+/// to about 40 per point), so this bounds an export to about 4 GB of memory; it also keeps
+/// every format inside its own 32-bit counts (`.hair`'s point count, a GLB's length).
+/// See `docs/resource-policy.md`.
+pub const MAX_EXPORT_POINTS: u64 = 64 << 20;
+
+/// How big a strand export of a document would be, counted before anything is generated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StrandExportSize {
+    pub strands_per_bundle: u32,
+    /// At most this many strands (bundles that are thinned grow fewer; one that is
+    /// degenerate grows none).
+    pub strands: u64,
+    pub vertices_per_strand: u64,
+    pub points: u64,
+}
+
+impl StrandExportSize {
+    /// `strands_per_bundle` strands of `2^vertices_log2 + 1` vertices from every bundle of
+    /// `mesh` (each thinned by its density as generation thins it).
+    pub fn of(mesh: &HairMesh, strands_per_bundle: u32, vertices_log2: u32) -> Self {
+        let strands: u64 = mesh
+            .bundles
+            .iter()
+            .map(|b| crate::strands::lod::density_count(b.density, strands_per_bundle) as u64)
+            .sum();
+        let vertices_per_strand = 1u64
+            .checked_shl(vertices_log2)
+            .unwrap_or(u64::MAX)
+            .saturating_add(1);
+        Self {
+            strands_per_bundle,
+            strands,
+            vertices_per_strand,
+            points: strands.saturating_mul(vertices_per_strand),
+        }
+    }
+
+    /// Bytes of memory the export needs while it is written, roughly: the f64 points and
+    /// the largest file's bytes (text USD, about 40 per point).
+    pub fn memory_bytes(&self) -> u64 {
+        self.points.saturating_mul(24 + 40)
+    }
+
+    /// Refuses an export above [`MAX_EXPORT_POINTS`], saying how big it would be (the
+    /// caller adds which of its settings to lower).
+    pub fn check(&self) -> Result<(), String> {
+        use crate::io::runtime_bundle::limits::{MAX_VERTICES_LOG2, STRANDS_PER_BUNDLE};
+        if self.strands_per_bundle > STRANDS_PER_BUNDLE {
+            return Err(format!(
+                "{} strands per bundle is more than the cap of {STRANDS_PER_BUNDLE}",
+                self.strands_per_bundle
+            ));
+        }
+        let most_vertices = (1u64 << MAX_VERTICES_LOG2) + 1;
+        if self.vertices_per_strand > most_vertices {
+            return Err(format!(
+                "{} vertices per strand is more than the cap of {most_vertices}",
+                self.vertices_per_strand
+            ));
+        }
+        if self.points <= MAX_EXPORT_POINTS {
+            return Ok(());
+        }
+        Err(format!(
+            "the strand export would hold {} strands × {} vertices = {} points, about {:.1} GB of memory while it is written; the cap is {} points (docs/resource-policy.md)",
+            self.strands,
+            self.vertices_per_strand,
+            self.points,
+            self.memory_bytes() as f64 / 1e9,
+            MAX_EXPORT_POINTS
+        ))
+    }
+}
+
 /// Cem Yuksel's `.hair` format (cyHair): a 128-byte header then the point array (and a
 /// segments array when strands differ in vertex count). Thickness and colour are defaults
 /// in the header.

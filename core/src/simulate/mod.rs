@@ -27,6 +27,73 @@ use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::{HairMesh, Topology, VertexRef};
 use crate::model::motion::{HairPhysics, Motion, SimQuality};
 
+/// Wall time a simulation for a seek, a render or an export may take before the user is
+/// told, with the estimate, that it will be longer (`docs/resource-policy.md`): the work
+/// then runs on with a progress bar and can be cancelled.
+pub const SIMULATION_BUDGET_S: f64 = 10.0;
+
+/// What simulating to a time will cost, measured on this machine before the work starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SimulationEstimate {
+    pub steps: u64,
+    /// Wall time of one fixed step, measured on a copy of the simulation.
+    pub step_s: f64,
+}
+
+impl SimulationEstimate {
+    /// Times one fixed step of a copy of `sim` (the copy is dropped: `sim` does not move)
+    /// and counts the steps a seek to `time_s` runs.
+    pub fn measure(sim: &HairSim, time_s: f64) -> Self {
+        let steps = sim.steps_to(time_s);
+        let mut probe = sim.clone();
+        let started = std::time::Instant::now();
+        probe.step();
+        Self {
+            steps,
+            step_s: started.elapsed().as_secs_f64(),
+        }
+    }
+
+    pub fn seconds(&self) -> f64 {
+        self.steps as f64 * self.step_s
+    }
+
+    pub fn over_budget(&self) -> bool {
+        self.seconds() > SIMULATION_BUDGET_S
+    }
+
+    /// One line: the steps, the time they will take and, when that is over
+    /// [`SIMULATION_BUDGET_S`], that it is.
+    pub fn describe(&self, time_s: f64) -> String {
+        let line = format!(
+            "simulating to {time_s:.2} s: {} steps at {:.1} ms a step, about {}",
+            self.steps,
+            self.step_s * 1e3,
+            duration_text(self.seconds())
+        );
+        if self.over_budget() {
+            format!("{line} — over the {SIMULATION_BUDGET_S:.0} s budget (it can be cancelled)")
+        } else {
+            line
+        }
+    }
+}
+
+/// `3 h 5 min`, `4 min 10 s`, `12.3 s`.
+pub fn duration_text(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        return "forever".into();
+    }
+    let whole = seconds.round() as u64;
+    if whole >= 3600 {
+        format!("{} h {} min", whole / 3600, (whole % 3600) / 60)
+    } else if whole >= 60 {
+        format!("{} min {} s", whole / 60, whole % 60)
+    } else {
+        format!("{seconds:.1} s")
+    }
+}
+
 /// The longest simulated time a drape may take before it stops settling.
 pub const DRAPE_MAX_S: f64 = 12.0;
 /// The hair is at rest when no vertex moves faster than this for [`DRAPE_REST_STEPS`] steps.

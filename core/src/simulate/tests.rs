@@ -4,6 +4,7 @@
 use super::*;
 use crate::model::motion::{HeadKey, Wind};
 use crate::samples::{sphere_body, sphere_cap};
+use std::ops::ControlFlow;
 
 const HEAD_RADIUS_M: f64 = 0.1;
 /// How far below the body's surface a vertex may end a step: collisions are projected last
@@ -314,4 +315,56 @@ fn draping_some_bundles_leaves_the_others_alone() {
         drape(&mesh, &head(), &[999], &[]),
         Err(EditError::BundleOutOfRange { .. })
     ));
+}
+
+/// Issue "Nothing lost, nothing blocked": a seek says what it costs before it runs, can be
+/// stopped part way at a valid state, and a later seek continues from there.
+#[test]
+fn a_seek_is_estimated_before_it_runs_and_can_be_stopped() {
+    let motion = Motion::head_turn(0.3, 0.6, 70.0);
+    let mut simulated = sim(&cap(3), &motion);
+    let estimate = SimulationEstimate::measure(&simulated, 600.0);
+    assert_eq!(estimate.steps, 36_000, "600 s at 60 Hz");
+    assert_eq!(
+        simulated.time_s(),
+        0.0,
+        "measuring does not move the simulation"
+    );
+    assert!(estimate.step_s > 0.0);
+    let over = SimulationEstimate {
+        steps: 36_000,
+        step_s: 0.217,
+    };
+    let line = over.describe(600.0);
+    assert!(
+        line.contains("36000 steps") && line.contains("2 h 10 min") && line.contains("budget"),
+        "{line}"
+    );
+    assert!(
+        !SimulationEstimate {
+            steps: 10,
+            step_s: 0.001
+        }
+        .over_budget()
+    );
+    // Stopped after 30 steps, then continued to 1 s: the same state as one seek to 1 s.
+    let mut calls = 0;
+    let ran = simulated.seek_with(1.0, &mut |done, total| {
+        assert_eq!(total, 60);
+        calls += 1;
+        if done == 30 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    assert_eq!((ran, calls), (30, 30));
+    assert!((simulated.time_s() - 0.5).abs() < 1e-12);
+    assert_eq!(simulated.steps_to(1.0), 30);
+    simulated.seek(1.0);
+    let mut straight = sim(&cap(3), &motion);
+    straight.seek(1.0);
+    assert_eq!(simulated.positions(), straight.positions());
+    // Back in time: from the start.
+    assert_eq!(simulated.steps_to(0.25), 15);
 }

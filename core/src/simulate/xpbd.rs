@@ -26,6 +26,7 @@
 //! Everything runs in a fixed order on one thread: the same inputs give the same bytes.
 
 use std::collections::BTreeMap;
+use std::ops::ControlFlow;
 
 use glam::DVec3;
 
@@ -384,17 +385,48 @@ impl HairSim {
     /// `time_s`, rounded to whole steps. For scrubbing and `render --time`. Returns the
     /// steps it ran.
     pub fn seek(&mut self, time_s: f64) -> u64 {
-        let target = if time_s.is_finite() {
+        self.seek_with(time_s, &mut |_, _| ControlFlow::Continue(()))
+    }
+
+    /// The fixed steps [`Self::seek`] to `time_s` would run from here (from the start when
+    /// `time_s` is in the past).
+    pub fn steps_to(&self, time_s: f64) -> u64 {
+        let target = self.target_step(time_s);
+        if target < self.steps {
+            target
+        } else {
+            target - self.steps
+        }
+    }
+
+    fn target_step(&self, time_s: f64) -> u64 {
+        if time_s.is_finite() {
             (time_s.max(0.0) / self.step_s()).round() as u64
         } else {
             0
-        };
+        }
+    }
+
+    /// [`Self::seek`], telling `progress(steps_run, steps_to_run)` after every fixed step;
+    /// `ControlFlow::Break` stops it there (the simulation is then at the step reached, a
+    /// valid state that a later seek continues from). Returns the steps it ran.
+    pub fn seek_with(
+        &mut self,
+        time_s: f64,
+        progress: &mut dyn FnMut(u64, u64) -> ControlFlow<()>,
+    ) -> u64 {
+        let target = self.target_step(time_s);
+        let total = self.steps_to(time_s);
         if target < self.steps {
             *self = Self::new(&self.rest, self.sdf.clone(), &self.motion, &self.pinned);
         }
-        let ran = target.saturating_sub(self.steps);
+        let mut ran = 0;
         while self.steps < target {
             self.step();
+            ran += 1;
+            if progress(ran, total).is_break() {
+                break;
+            }
         }
         self.accumulator_s = 0.0;
         ran

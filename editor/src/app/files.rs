@@ -149,17 +149,26 @@ pub struct RecentFiles {
 impl RecentFiles {
     pub const MAX: usize = 8;
 
-    /// The list stored in `file` (empty when it does not exist or cannot be read).
+    /// Larger files are not read (eight paths take a few kilobytes).
+    const MAX_FILE_BYTES: u64 = 64 * 1024;
+
+    /// The list stored in `file` (empty when it does not exist or cannot be read; read as
+    /// any input file is: regular files only, capped).
     pub fn load(file: PathBuf) -> Self {
-        let paths = std::fs::read_to_string(&file)
-            .map(|text| {
-                text.lines()
-                    .filter(|l| !l.trim().is_empty())
-                    .map(PathBuf::from)
-                    .take(Self::MAX)
-                    .collect()
-            })
-            .unwrap_or_default();
+        let paths = hairloom_core::io::input_files::read_regular_file(
+            &file,
+            Self::MAX_FILE_BYTES,
+            "the recent files",
+        )
+        .map(|bytes| {
+            let text = String::from_utf8_lossy(&bytes);
+            text.lines()
+                .filter(|l| !l.trim().is_empty())
+                .map(PathBuf::from)
+                .take(Self::MAX)
+                .collect()
+        })
+        .unwrap_or_default();
         Self { file, paths }
     }
 
@@ -176,7 +185,7 @@ impl RecentFiles {
             .map(|p| format!("{}\n", p.display()))
             .collect();
         if let Some(dir) = self.file.parent() {
-            let _ = std::fs::create_dir_all(dir);
+            let _ = super::recovery::create_private_dir(dir);
         }
         let _ = hairloom_core::io::project::write_atomic(&self.file, text.as_bytes(), |_| {});
     }
@@ -233,6 +242,7 @@ impl ExportJob {
                                 ControlFlow::Continue(())
                             }
                         })
+                        .map_err(|e| format!("{e:#}"))?
                         .ok_or_else(|| "cancelled".to_string())
                     })
                     .and_then(|strands| {

@@ -13,6 +13,8 @@ pub mod recovery;
 pub mod scene_panel;
 pub mod state;
 pub mod styling_panel;
+#[cfg(test)]
+mod test_support;
 pub mod tools_panel;
 pub mod view_memory;
 pub mod viewport;
@@ -214,6 +216,9 @@ impl HairloomApp {
             title: String::new(),
         };
         app.recall_view();
+        if let Some(note) = app.recovery.note() {
+            app.state.message = note.to_string();
+        }
         if let Some(problem) = layout_problem {
             app.state.message = problem;
         }

@@ -253,17 +253,18 @@ impl PanelMemory {
     }
 
     fn read(file: &std::path::Path) -> Result<Option<SavedTile>, String> {
-        let Ok(metadata) = std::fs::metadata(file) else {
-            return Ok(None);
+        use hairloom_core::io::input_files::{InputFileError, read_regular_file};
+        // The same rules as every input file: a FIFO cannot block the start, a link to a
+        // device is refused, and the cap holds while reading.
+        let bytes = match read_regular_file(file, Self::MAX_FILE_BYTES, "a dock layout") {
+            Ok(bytes) => bytes,
+            Err(InputFileError::Io { source, .. })
+                if source.kind() == std::io::ErrorKind::NotFound =>
+            {
+                return Ok(None);
+            }
+            Err(error) => return Err(error.to_string()),
         };
-        if metadata.len() > Self::MAX_FILE_BYTES {
-            return Err(format!(
-                "{} bytes, more than a layout's {} bytes",
-                metadata.len(),
-                Self::MAX_FILE_BYTES
-            ));
-        }
-        let bytes = std::fs::read(file).map_err(|e| e.to_string())?;
         // serde_json's recursion limit stops a nesting bomb before `check` sees it.
         serde_json::from_slice(&bytes)
             .map(Some)
@@ -282,7 +283,7 @@ impl PanelMemory {
             return;
         };
         if let Some(dir) = self.file.parent() {
-            let _ = std::fs::create_dir_all(dir);
+            let _ = super::recovery::create_private_dir(dir);
         }
         let _ = hairloom_core::io::project::write_atomic(&self.file, &text, |_| {});
         self.stored = Some(saved);
@@ -411,7 +412,7 @@ mod tests {
                 .into_bytes(),
                 "recursion limit",
             ),
-            (vec![b' '; 100 * 1024], "more than a layout's"),
+            (vec![b' '; 100 * 1024], "larger than the cap of 65536 bytes"),
         ];
         for (bytes, expected) in cases {
             std::fs::write(&file, &bytes).expect("write");
@@ -423,6 +424,19 @@ mod tests {
                 "expected {expected:?} in {problem:?}"
             );
         }
+        // Special files: a FIFO blocked the start forever, a link to /dev/zero was read until
+        // memory ran out. Both are refused at once, by name.
+        crate::app::test_support::make_fifo(&file);
+        let fifo = file.clone();
+        let problem = crate::app::test_support::returns_promptly(move || PanelMemory::load(fifo).2)
+            .expect("a problem is named");
+        assert!(problem.contains("a FIFO"), "{problem}");
+        std::fs::remove_file(&file).expect("remove");
+        std::os::unix::fs::symlink("/dev/zero", &file).expect("link");
+        let (_, tree, problem) = PanelMemory::load(file.clone());
+        assert!(tree.is_none());
+        let problem = problem.expect("a problem is named");
+        assert!(problem.contains("a device"), "{problem}");
         // Nested too deep for the dock, yet within serde's limit.
         let mut deep = SavedTile::Pane { pane: Pane::Tools };
         for _ in 0..20 {

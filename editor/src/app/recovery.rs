@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
+use hairloom_core::io::input_files::read_regular_file;
 use hairloom_core::io::project;
 
 use super::state::EditorState;
@@ -26,26 +27,90 @@ pub struct PendingRecovery {
     pub origin: Option<PathBuf>,
 }
 
+/// Caps on the small per-user files kept beside the recovery file: read under the same rules
+/// as any input (regular files only, a FIFO cannot block, the cap holds while reading).
+const MAX_ORIGIN_BYTES: u64 = 64 * 1024;
+
 #[derive(Clone, Debug)]
 pub struct Recovery {
     dir: PathBuf,
+    /// A folder of this session only, when no folder of the user's could be used: removed
+    /// when the editor closes (the last clone drops it).
+    _session: Option<std::sync::Arc<tempfile::TempDir>>,
+    /// Why the user's own folder is not used, for the status bar.
+    note: Option<String>,
 }
 
 impl Recovery {
     pub fn in_dir(dir: impl Into<PathBuf>) -> Self {
-        Self { dir: dir.into() }
+        Self {
+            dir: dir.into(),
+            _session: None,
+            note: None,
+        }
     }
 
     /// `$HAIRLOOM_RECOVERY_DIR`, else `$XDG_DATA_HOME/hairloom`, else
-    /// `~/.local/share/hairloom`, else the temporary folder.
+    /// `~/.local/share/hairloom` (see [`Self::location_from`]).
     pub fn default_location() -> Self {
-        let env = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
+        Self::location_from(|name| std::env::var_os(name))
+    }
+
+    /// The recovery folder the environment `env` names. Never a folder shared by all users:
+    /// with none of the variables set, or where the folder named belongs to another user
+    /// (whose `recovery-origin.txt` would decide where Save writes), the editor keeps its
+    /// autosaves, recent files and remembered views in a private folder of this session
+    /// (mode 0700, removed on exit) and says so in [`Self::note`].
+    pub fn location_from(env: impl Fn(&str) -> Option<std::ffi::OsString>) -> Self {
+        let env = |name: &str| env(name).filter(|v| !v.is_empty());
         let dir = env(RECOVERY_DIR_ENV)
             .map(PathBuf::from)
             .or_else(|| env("XDG_DATA_HOME").map(|d| PathBuf::from(d).join("hairloom")))
-            .or_else(|| env("HOME").map(|h| PathBuf::from(h).join(".local/share/hairloom")))
-            .unwrap_or_else(|| std::env::temp_dir().join("hairloom"));
-        Self { dir }
+            .or_else(|| env("HOME").map(|h| PathBuf::from(h).join(".local/share/hairloom")));
+        let Some(dir) = dir else {
+            return Self::for_this_session(format!(
+                "neither HOME nor XDG_DATA_HOME is set (nor {RECOVERY_DIR_ENV})"
+            ));
+        };
+        match not_ours(&dir) {
+            None => Self::in_dir(dir),
+            Some(problem) => Self::for_this_session(problem),
+        }
+    }
+
+    /// A private folder of this session, and the note that says why.
+    fn for_this_session(problem: String) -> Self {
+        let mut builder = tempfile::Builder::new();
+        builder.prefix("hairloom-session-");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt as _;
+            builder.permissions(std::fs::Permissions::from_mode(0o700));
+        }
+        match builder.tempdir() {
+            Ok(session) => Self {
+                dir: session.path().to_path_buf(),
+                note: Some(format!(
+                    "{problem}: autosaves and recent files last only this session (in {})",
+                    session.path().display()
+                )),
+                _session: Some(std::sync::Arc::new(session)),
+            },
+            // No private folder at all: a path that cannot exist, so every write fails
+            // (and says so) and nothing is read.
+            Err(error) => Self {
+                dir: PathBuf::from("/nonexistent/hairloom-recovery"),
+                note: Some(format!(
+                    "{problem}, and no private folder could be made ({error}): autosave is off"
+                )),
+                _session: None,
+            },
+        }
+    }
+
+    /// Why autosaves do not go to the user's own folder this session, if they do not.
+    pub fn note(&self) -> Option<&str> {
+        self.note.as_deref()
     }
 
     pub fn project_path(&self) -> PathBuf {
@@ -56,9 +121,10 @@ impl Recovery {
         self.dir.join(ORIGIN_FILE)
     }
 
-    /// Writes the state's project (and where it came from) for recovery.
+    /// Writes the state's project (and where it came from) for recovery. A folder made
+    /// here is private to the user (0700).
     pub fn write(&self, state: &EditorState) -> std::io::Result<()> {
-        std::fs::create_dir_all(&self.dir)?;
+        create_private_dir(&self.dir)?;
         let origin = state
             .path
             .as_deref()
@@ -77,9 +143,9 @@ impl Recovery {
     /// The recovery file left by an earlier run, if any.
     pub fn pending(&self) -> Option<PendingRecovery> {
         let metadata = std::fs::metadata(self.project_path()).ok()?;
-        let origin = std::fs::read_to_string(self.origin_path())
+        let origin = read_regular_file(&self.origin_path(), MAX_ORIGIN_BYTES, "a recovery note")
             .ok()
-            .map(|s| s.trim().to_string())
+            .map(|bytes| String::from_utf8_lossy(&bytes).trim().to_string())
             .filter(|s| !s.is_empty())
             .map(PathBuf::from);
         Some(PendingRecovery {
@@ -119,7 +185,8 @@ impl Recovery {
 
     /// The recovery file's document alone (its history dropped), if that is valid.
     fn document_without_history(path: &Path) -> Result<EditorState, String> {
-        let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+        let bytes = read_regular_file(path, project::MAX_PROJECT_BYTES, "a recovery file")
+            .map_err(|e| e.to_string())?;
         let mut value: serde_json::Value =
             serde_json::from_slice(&bytes).map_err(|e| e.to_string())?;
         let object = value.as_object_mut().ok_or("not a JSON object")?;
@@ -139,6 +206,40 @@ impl Recovery {
     pub fn dir(&self) -> &Path {
         &self.dir
     }
+}
+
+/// Why `dir` may not hold this user's recovery files: it exists and belongs to another user
+/// (or is not a folder). `None` when it is missing (it is made private) or is ours.
+fn not_ours(dir: &Path) -> Option<String> {
+    let metadata = std::fs::metadata(dir).ok()?;
+    if !metadata.is_dir() {
+        return Some(format!("{} is not a folder", dir.display()));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt as _;
+        // This process's user is the owner of its own /proc entry (Linux); elsewhere the
+        // check is skipped.
+        if let Ok(me) = std::fs::metadata("/proc/self").map(|m| m.uid())
+            && metadata.uid() != me
+        {
+            return Some(format!(
+                "{} belongs to another user (uid {})",
+                dir.display(),
+                metadata.uid()
+            ));
+        }
+    }
+    None
+}
+
+/// Makes `dir` (and missing parents) with mode 0700 where the system has modes.
+pub(crate) fn create_private_dir(dir: &Path) -> std::io::Result<()> {
+    let mut builder = std::fs::DirBuilder::new();
+    builder.recursive(true);
+    #[cfg(unix)]
+    std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+    builder.create(dir)
 }
 
 #[cfg(test)]
@@ -227,5 +328,71 @@ mod tests {
             recovered.message
         );
         assert!(!recovered.can_undo());
+    }
+
+    /// Issue "Nothing lost, nothing blocked": with neither HOME nor XDG_DATA_HOME the editor
+    /// fell back to `/tmp/hairloom`, shared by every user, where another user's
+    /// `recovery-origin.txt` decided where Save wrote.
+    #[test]
+    fn without_a_home_recovery_never_uses_a_folder_shared_by_all_users() {
+        use std::os::unix::fs::{MetadataExt as _, PermissionsExt as _};
+        let shared = std::env::temp_dir().join("hairloom");
+        let recovery = Recovery::location_from(|_| None);
+        assert_ne!(recovery.dir(), shared);
+        assert!(!recovery.dir().starts_with(&shared));
+        let note = recovery.note().expect("the status bar says why");
+        assert!(note.contains("neither HOME nor XDG_DATA_HOME"), "{note}");
+        let metadata = std::fs::metadata(recovery.dir()).expect("a session folder");
+        assert_eq!(metadata.permissions().mode() & 0o777, 0o700);
+        let me = std::fs::metadata("/proc/self").expect("/proc").uid();
+        assert_eq!(metadata.uid(), me);
+        // Another user's recovery files in the old shared place are never read.
+        assert!(recovery.pending().is_none());
+        let dir = recovery.dir().to_path_buf();
+        drop(recovery);
+        assert!(!dir.exists(), "the session folder goes with the editor");
+    }
+
+    #[test]
+    fn a_recovery_folder_of_another_user_is_not_used() {
+        let me = {
+            use std::os::unix::fs::MetadataExt as _;
+            std::fs::metadata("/proc/self").expect("/proc").uid()
+        };
+        let dir = tempfile::tempdir().expect("temp dir");
+        let theirs = dir.path().join("theirs");
+        std::fs::create_dir(&theirs).expect("folder");
+        std::fs::write(theirs.join(ORIGIN_FILE), "/etc/passwd\n").expect("plant");
+        std::fs::write(theirs.join(PROJECT_FILE), "{}").expect("plant");
+        if std::os::unix::fs::chown(&theirs, Some(me + 1), None).is_err() {
+            println!("skipped: only root can give a folder to another user here");
+            return;
+        }
+        let recovery = Recovery::location_from(|name| {
+            (name == RECOVERY_DIR_ENV).then(|| theirs.clone().into_os_string())
+        });
+        assert_ne!(recovery.dir(), theirs);
+        assert!(recovery.pending().is_none());
+        let note = recovery.note().expect("says why");
+        assert!(note.contains("belongs to another user"), "{note}");
+        // Our own folder (here: made fresh, 0700) is used as before.
+        let ours = dir.path().join("ours");
+        let recovery =
+            Recovery::location_from(|name| (name == "HOME").then(|| ours.clone().into_os_string()));
+        assert_eq!(recovery.dir(), ours.join(".local/share/hairloom"));
+        assert!(recovery.note().is_none());
+    }
+
+    /// A FIFO where the recovery note should be cannot block the start.
+    #[test]
+    fn a_fifo_recovery_note_does_not_block() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let recovery = Recovery::in_dir(dir.path());
+        recovery.write(&EditorState::sample()).expect("autosave");
+        crate::app::test_support::make_fifo(&recovery.origin_path());
+        let origin = crate::app::test_support::returns_promptly(move || {
+            recovery.pending().map(|p| p.origin)
+        });
+        assert_eq!(origin, Some(None), "the FIFO is not read as an origin");
     }
 }

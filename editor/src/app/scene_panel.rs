@@ -760,14 +760,39 @@ fn motion_ui(ui: &mut egui::Ui, state: &mut EditorState) {
             state.playback.reset();
         }
     });
-    // Scrubbing re-simulates from the start when it goes back, on this thread: a minute at
-    // most keeps a drag responsive.
+    // Scrubbing re-simulates from the start when it goes back; a seek longer than a frame
+    // runs on a worker with its progress and Cancel below.
     let end_s = (motion.duration_s() + 2.0).clamp(4.0, MAX_SCRUB_S);
-    let mut time_s = state.playback.time_s();
+    let mut time_s = state
+        .playback
+        .seeking
+        .as_ref()
+        .map_or(state.playback.time_s(), |job| job.time_s);
     let r = ui.add(egui::Slider::new(&mut time_s, 0.0..=end_s).text("Time s"));
     if r.changed() {
         state.playback.playing = false;
         state.seek_playback(time_s);
+    }
+    if let Some(job) = &state.playback.seeking {
+        let label = format!(
+            "simulating to {:.2} s: about {} left",
+            job.time_s,
+            hairloom_core::simulate::duration_text(job.seconds_left())
+        );
+        let fraction = job.fraction();
+        let mut cancel = false;
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::ProgressBar::new(fraction)
+                    .text(label)
+                    .desired_width(ui.available_width() - 70.0),
+            );
+            cancel = ui.button("Cancel").clicked();
+        });
+        if cancel {
+            state.playback.cancel_seek();
+            state.message = "seek cancelled: the motion stays where it was".into();
+        }
     }
     ui.label(
         egui::RichText::new(format!(

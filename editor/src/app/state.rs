@@ -182,10 +182,15 @@ impl EditorState {
         }
     }
 
-    /// Shows the motion at `time_s`.
+    /// Shows the motion at `time_s`; a long simulation runs on a worker, and the status bar
+    /// says what it will cost before it runs.
     pub fn seek_playback(&mut self, time_s: f64) {
-        self.playback
-            .seek(&self.project.document, self.revision, time_s);
+        if let Some(estimate) = self
+            .playback
+            .seek(&self.project.document, self.revision, time_s)
+        {
+            self.message = format!("{} (in the background)", estimate.describe(time_s));
+        }
     }
 
     /// The project's name as the user knows it: its file name, "untitled", or the sample's.

@@ -105,17 +105,21 @@ impl ViewMemory {
     /// The views stored in `file` (none when it is missing, too large or unreadable; invalid
     /// entries are skipped).
     pub fn load(file: PathBuf) -> Self {
-        let views = std::fs::metadata(&file)
-            .ok()
-            .filter(|m| m.len() <= Self::MAX_FILE_BYTES)
-            .and_then(|_| std::fs::read(&file).ok())
-            .and_then(|bytes| serde_json::from_slice::<Vec<serde_json::Value>>(&bytes).ok())
-            .unwrap_or_default()
-            .into_iter()
-            .filter_map(|entry| serde_json::from_value::<(PathBuf, SavedView)>(entry).ok())
-            .filter(|(_, view)| view.is_valid())
-            .take(Self::MAX)
-            .collect();
+        // The same rules as every input file: a FIFO cannot block the start, a link to a
+        // device is refused, and the cap holds while reading.
+        let views = hairloom_core::io::input_files::read_regular_file(
+            &file,
+            Self::MAX_FILE_BYTES,
+            "the remembered views",
+        )
+        .ok()
+        .and_then(|bytes| serde_json::from_slice::<Vec<serde_json::Value>>(&bytes).ok())
+        .unwrap_or_default()
+        .into_iter()
+        .filter_map(|entry| serde_json::from_value::<(PathBuf, SavedView)>(entry).ok())
+        .filter(|(_, view)| view.is_valid())
+        .take(Self::MAX)
+        .collect();
         Self { file, views }
     }
 
@@ -144,7 +148,7 @@ impl ViewMemory {
             return;
         };
         if let Some(dir) = self.file.parent() {
-            let _ = std::fs::create_dir_all(dir);
+            let _ = super::recovery::create_private_dir(dir);
         }
         let _ = hairloom_core::io::project::write_atomic(&self.file, &text, |_| {});
     }
@@ -228,7 +232,16 @@ mod tests {
         std::fs::write(&file, b"{{{{").expect("write");
         assert!(ViewMemory::load(file.clone()).views.is_empty());
         std::fs::write(&file, vec![b' '; 300 * 1024]).expect("write");
-        assert!(ViewMemory::load(file).views.is_empty());
+        assert!(ViewMemory::load(file.clone()).views.is_empty());
+        // A FIFO or a link to a device reads as no views at once (it blocked, or was read
+        // until memory ran out).
+        std::fs::remove_file(&file).expect("remove");
+        std::os::unix::fs::symlink("/dev/zero", &file).expect("link");
+        assert!(ViewMemory::load(file.clone()).views.is_empty());
+        crate::app::test_support::make_fifo(&file);
+        let views =
+            crate::app::test_support::returns_promptly(move || ViewMemory::load(file).views.len());
+        assert_eq!(views, 0);
         // A NaN view is never stored.
         let mut memory = ViewMemory::load(dir.path().join("other.json"));
         memory.remember(&a, view(f32::NAN));

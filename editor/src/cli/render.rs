@@ -104,7 +104,7 @@ pub fn posed_at(
         // Time 0 too: the body's first key may not be its modelled pose.
         Some(motion) => {
             let mut sim = hairloom_core::simulate::simulator(document, motion);
-            sim.seek(time_s);
+            hairloom_editor::progress::seek_with_progress(&mut sim, time_s);
             std::borrow::Cow::Owned(hairloom_core::simulate::posed_document(document, &sim))
         }
         None => std::borrow::Cow::Borrowed(document),

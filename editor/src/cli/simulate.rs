@@ -11,7 +11,7 @@ use anyhow::{Context, bail};
 use clap::ValueEnum;
 use glam::Vec3;
 use hairloom_core::io::alembic::{groom::Groom, groom_animation};
-use hairloom_core::io::strand_files::{ScalpMesh, UsdFrame, usda_animation};
+use hairloom_core::io::strand_files::{ScalpMesh, StrandExportSize, UsdFrame, usda_animation};
 use hairloom_core::model::motion::{Motion, Wind};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::simulate::{posed_document, simulator};
@@ -24,9 +24,6 @@ use super::render::{
 
 /// The most frames one command writes.
 pub const MAX_FRAMES: usize = 10_000;
-/// Strand points per bundle over all frames an animated USD may hold (with a few hundred
-/// bundles, some hundred million points: a few GB of text at most).
-pub const MAX_USDA_POINTS_PER_BUNDLE: f64 = 1e6;
 /// Vertices per strand in the animated USD: 2^3 + 1 (a sequence is many copies).
 pub const USDA_VERTICES_LOG2: u32 = 3;
 
@@ -116,18 +113,6 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         bail!("{frame_count} frames are more than the {MAX_FRAMES} one command writes");
     }
     let keep_strands = settings.usda || settings.abc;
-    if keep_strands {
-        // Every frame's strands are held until the file is written: bound them.
-        let points = frame_count as f64
-            * (settings.strands_per_bundle as f64)
-            * ((1u64 << USDA_VERTICES_LOG2) + 1) as f64;
-        if points > MAX_USDA_POINTS_PER_BUNDLE {
-            bail!(
-                "--usda / --abc: {frame_count} frames × {} strands per bundle is too much to hold; lower --strands-per-bundle, --fps or --seconds",
-                settings.strands_per_bundle
-            );
-        }
-    }
     if settings.no_render && !keep_strands {
         bail!("nothing to write: --no-render without --usda or --abc");
     }
@@ -143,6 +128,26 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         )
     })?;
     document.scene.motion = Some(motion.clone());
+    if keep_strands {
+        // Every frame's strands are held until the file is written: bound them all.
+        let one = StrandExportSize::of(
+            &document.hair_mesh,
+            settings.strands_per_bundle,
+            USDA_VERTICES_LOG2,
+        );
+        let frames = frame_count as u64;
+        StrandExportSize {
+            strands: one.strands.saturating_mul(frames),
+            points: one.points.saturating_mul(frames),
+            ..one
+        }
+        .check()
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "--usda / --abc over {frame_count} frames: {e}; lower --strands-per-bundle, --fps or --seconds"
+            )
+        })?;
+    }
     let direction = parse_view(&settings.view, &document.scene)?;
     let render_settings = RenderSettings {
         effects: settings.effects.clone(),
@@ -184,6 +189,11 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         motion.quality.substeps,
         motion.quality.iterations
     );
+    // What the whole sequence will cost, said before it runs (it prints frame by frame).
+    let estimate = hairloom_core::simulate::SimulationEstimate::measure(&sim, seconds);
+    if estimate.over_budget() {
+        eprintln!("{}", estimate.describe(seconds));
+    }
     let mut simulate_s = 0.0;
     let mut strand_frames = Vec::new();
     let mut grooms = Vec::new();
@@ -212,7 +222,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
                 settings.strands_per_bundle,
                 USDA_VERTICES_LOG2,
                 &mut |_| std::ops::ControlFlow::Continue(()),
-            )
+            )?
             .unwrap_or_default();
             if settings.abc {
                 grooms.push(Groom::new(&posed, &strands, STRAND_WIDTH_M));
