@@ -900,13 +900,18 @@ mod tests {
             };
             let files = runtime_bundle(&document, &options).expect("export");
             write_bundle_folder(&dir, &files, |_| {}).expect("write");
-            // Only the new bundle's files are left (the f32 textures went with the f16 export).
+            // Only the new bundle's files (and the export ledger) are left: the f32 textures
+            // went with the f16 export.
             let mut on_disk: Vec<String> = std::fs::read_dir(&dir)
                 .expect("list")
                 .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
                 .collect();
             on_disk.sort();
-            let mut written: Vec<String> = files.iter().map(|(n, _)| n.clone()).collect();
+            let mut written: Vec<String> = files
+                .iter()
+                .map(|(n, _)| n.clone())
+                .chain([EXPORT_LEDGER_FILE.to_string()])
+                .collect();
             written.sort();
             assert_eq!(on_disk, written);
             let loaded = load_runtime_bundle(&dir).expect("loads");
