@@ -5,6 +5,7 @@
 use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
+use hairloom_core::model::change::ChangeKind;
 use hairloom_editor::app::files::{DialogAnswer, ScriptedDialogs};
 use hairloom_editor::app::{EditorState, HairloomApp};
 
@@ -210,7 +211,12 @@ fn unsaved_work_is_offered_for_recovery_on_the_next_start() {
     let dir = tempfile::tempdir().expect("temp dir");
     // An earlier session with unsaved work (as autosave or quit leaves it).
     let mut earlier = EditorState::sample();
-    earlier.edit("wave").styling.global.wave.amplitude_m = 0.017;
+    earlier
+        .edit(ChangeKind::Restyle, "wave")
+        .styling
+        .global
+        .wave
+        .amplitude_m = 0.017;
     earlier.commit_edit();
     Recovery::in_dir(dir.path())
         .write(&earlier)
@@ -331,7 +337,12 @@ fn opening_with_unsaved_changes_asks_first_and_cancel_keeps_them() {
     let dir = tempfile::tempdir().expect("temp dir");
     let other = dir.path().join("other.hairloom");
     let mut other_state = EditorState::sample();
-    other_state.edit("curl").styling.global.curl.radius_m = 0.006;
+    other_state
+        .edit(ChangeKind::Restyle, "curl")
+        .styling
+        .global
+        .curl
+        .radius_m = 0.006;
     other_state.commit_edit();
     other_state.save_as(&other).expect("save");
     let mut harness = harness_with(
@@ -708,7 +719,7 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
     // Bundle 5 gets its own curl (a styling group), which Mirror carries over.
     {
         let state = &mut harness.state_mut().state;
-        let styling = &mut state.edit("New group").styling;
+        let styling = &mut state.edit(ChangeKind::Restyle, "New group").styling;
         let group = styling.new_group("wisp", &[5]);
         styling.groups[group].params.curl.radius_m = 0.004;
         styling.groups[group].params.curl.turns_per_m = 30.0;
@@ -1632,7 +1643,10 @@ fn the_styling_direction_gizmo_points_the_wave_twists_and_mirrors_the_curl() {
     // A curl to mirror (the sample's global parameters), as its own undo step.
     {
         let state = &mut harness.state_mut().state;
-        let global = &mut state.edit("set up a curl").styling.global;
+        let global = &mut state
+            .edit(ChangeKind::Restyle, "set up a curl")
+            .styling
+            .global;
         global.curl.radius_m = 0.004;
         global.curl.turns_per_m = 25.0;
         global.wave.amplitude_m = 0.01;
@@ -1772,7 +1786,10 @@ fn the_styling_direction_gizmo_points_the_wave_twists_and_mirrors_the_curl() {
     let grouped = handles_bundle(&harness);
     {
         let state = &mut harness.state_mut().state;
-        state.edit("group").styling.new_group("fringe", &[grouped]);
+        state
+            .edit(ChangeKind::Restyle, "group")
+            .styling
+            .new_group("fringe", &[grouped]);
         state.commit_edit();
         state.selection = [grouped, (grouped + 1) % bundles].into();
     }

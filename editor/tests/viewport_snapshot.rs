@@ -7,6 +7,7 @@ mod common;
 use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
+use hairloom_core::model::change::ChangeKind;
 use hairloom_editor::app::{EditorState, HairloomApp};
 
 /// Mean absolute channel difference allowed against the golden image (0-255 scale).
@@ -56,9 +57,14 @@ fn viewport_image(harness: &mut Harness<'static, HairloomApp>) -> image::RgbaIma
     rendered_viewport(harness)
 }
 
-/// The window rendered now (no UI frame run first; the paint callback does the viewport's
+/// The window rendered once the hair asked for is built (the builder works off the UI
+/// thread; one UI step hands its change to the paint callback, which does the viewport's
 /// pending work), cropped to the viewport.
 fn rendered_viewport(harness: &mut Harness<'static, HairloomApp>) -> image::RgbaImage {
+    if harness.state().viewport.is_building() {
+        harness.state().viewport.wait_for_builds();
+        harness.step();
+    }
     let rect = harness
         .state()
         .viewport
@@ -127,12 +133,12 @@ fn the_viewport_snapshot_matches_and_follows_the_styling() {
 
     // A styling slider changes the picture on the next frame, by rewriting the styling
     // buffers in place: no texture rebuild, no re-upload.
-    let before = harness.state().viewport.uploads;
+    let before = harness.state().viewport.uploads();
     harness
         .get_by_role_and_label(Role::Slider, "Curl radius")
         .set_value_accesskit(0.01);
     let curled = viewport_image(&mut harness);
-    let after = harness.state().viewport.uploads;
+    let after = harness.state().viewport.uploads();
     assert_eq!(
         after.full, before.full,
         "a styling edit re-uploaded the hair"
@@ -313,12 +319,12 @@ fn motion_is_simulated_and_uploaded_only_when_the_scene_has_it() {
         return;
     };
     // The sample's scene has no motion: frames pass, nothing steps, nothing is re-uploaded.
-    let uploads = harness.state().viewport.uploads;
+    let uploads = harness.state().viewport.uploads();
     for _ in 0..4 {
         harness.step();
     }
     assert_eq!(harness.state().state.playback.steps, 0);
-    assert_eq!(harness.state().viewport.uploads, uploads);
+    assert_eq!(harness.state().viewport.uploads(), uploads);
 
     harness.get_by_label("Scene").click();
     harness.run();
@@ -343,7 +349,7 @@ fn motion_is_simulated_and_uploaded_only_when_the_scene_has_it() {
 
     let still = rendered_viewport(&mut harness);
     harness.get_by_label("Play").click();
-    let before = harness.state().viewport.uploads;
+    let before = harness.state().viewport.uploads();
     for _ in 0..6 {
         harness.step();
     }
@@ -359,7 +365,7 @@ fn motion_is_simulated_and_uploaded_only_when_the_scene_has_it() {
     // The drawn hair follows the simulation: its textures were rewritten in place (same
     // layout, nothing allocated or re-uploaded whole), and the shown mesh moved while the
     // document (what is saved and undone) did not.
-    let after = harness.state().viewport.uploads;
+    let after = harness.state().viewport.uploads();
     assert!(after.shape > before.shape, "{before:?} -> {after:?}");
     assert_eq!(after.full, before.full, "motion re-uploaded the whole hair");
     let state = &harness.state().state;
@@ -388,7 +394,7 @@ fn the_styling_direction_gizmo_is_drawn_at_the_selected_roots() {
     harness.state_mut().viewport.settings.styling_gizmo = true;
     {
         let state = &mut harness.state_mut().state;
-        let global = &mut state.edit("curl").styling.global;
+        let global = &mut state.edit(ChangeKind::Restyle, "curl").styling.global;
         global.curl.radius_m = 0.004;
         global.curl.turns_per_m = 25.0;
         global.twist.turns_per_m = 4.0;

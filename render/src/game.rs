@@ -55,27 +55,23 @@
 //! buffer, and all draw the same picture (tested).
 
 use glam::{Mat4, Vec3};
-use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere, shadow_views};
-use hairloom_core::model::scene::{Coverage, Scene, SelfShadowing};
-use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
-use hairloom_core::runtime::gpu_types::StrandRun;
+use hairloom_core::model::scene::{Coverage, Scene};
+use hairloom_core::runtime::frame_plan::{FramePlan, LodSettings, plan_frame};
 use hairloom_core::runtime::hair::RuntimeHair;
 use hairloom_core::runtime::strand_gen::Filtering;
 
 use crate::device::GpuContext;
-use crate::preview::{default_strand_width_m, effects_bind_group, frame_views};
+use crate::frame::{
+    FrameCamera, FrameError, FrameInputs, FrameRecorder, FrameRenderers, HairSource, PreparedFrame,
+    check_effect_limits, prepare,
+};
+use crate::hair_asset::{AssetChange, HairAsset, HairAssetError};
+use crate::preview::default_strand_width_m;
 use crate::renderer::Targets;
-use crate::renderer::body_shadow::BodyShadowRenderer;
-use crate::renderer::hair_shadow::HairShadowRenderer;
-use crate::renderer::preview_body::{BodyRenderer, GpuBody, PreparedBody};
-use crate::renderer::preview_hair::{
-    HairRenderer, HairUniforms, MeshLod, PreparedHair, RibbonInput,
-};
-use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, effects_layout};
+use crate::renderer::scene_lighting::ActiveEffects;
 use crate::renderer::strand_gen::{
-    GenerationPath, GpuHair, StrandGenError, StrandGenRenderer, check_mesh_groups,
+    GenerationPath, StrandGenError, StrandGenRenderer, check_mesh_groups,
 };
-use crate::resources::Tracked;
 
 /// The game's targets: the formats and sample count of the pass [`GameHair::draw`] records
 /// into.
@@ -121,38 +117,22 @@ pub fn game_scene(scene: &Scene) -> Scene {
     scene
 }
 
-/// A runtime bundle on the game's GPU, drawn into the game's passes.
+/// A runtime bundle on the game's GPU, drawn into the game's passes by the frame builder
+/// ([`crate::frame`]) that draws the editor's preview.
 pub struct GameHair {
     context: GpuContext,
     generator: StrandGenRenderer,
-    gpu: GpuHair,
-    lighting: SceneLighting,
-    hair: HairRenderer,
-    body_renderer: BodyRenderer,
-    body: GpuBody,
+    /// The bundle's runtime data and its GPU side.
+    asset: HairAsset,
+    renderers: FrameRenderers,
     draw_body: bool,
-    hair_shadow: Option<HairShadowRenderer>,
-    body_shadow: Option<BodyShadowRenderer>,
     scene: Scene,
-    active: ActiveEffects,
-    effects_group: Option<wgpu::BindGroup>,
-    bounds: (Vec3, Vec3),
     strand_width_m: f32,
     lod: LodSettings,
     filtering: Filtering,
     vertex_count: u32,
+    /// One frame's GPU state between [`GameHair::prepare`] and [`GameHair::draw`].
     frame: Option<PreparedFrame>,
-}
-
-/// One frame's GPU state between [`GameHair::prepare`] and [`GameHair::draw`].
-struct PreparedFrame {
-    hair: PreparedHair,
-    body: PreparedBody,
-    /// The frame's one batch.
-    runs: Vec<StrandRun>,
-    _runs: wgpu::Buffer,
-    /// `None` when the ribbons generate their own vertices.
-    _scratch: Option<Tracked<wgpu::Buffer>>,
 }
 
 /// Why a bundle could not be put on the game's GPU.
@@ -160,10 +140,10 @@ struct PreparedFrame {
 pub enum GameHairError {
     #[error(transparent)]
     Generation(#[from] StrandGenError),
-    #[error("the bundle grows no hair")]
-    NoHair,
     #[error(transparent)]
-    EffectLimit(#[from] crate::preview::PreviewError),
+    Asset(#[from] HairAssetError),
+    #[error(transparent)]
+    EffectLimit(#[from] FrameError),
 }
 
 impl GameHair {
@@ -194,20 +174,12 @@ impl GameHair {
             path = GenerationPath::ComputePerStrand;
         }
         let generator = StrandGenRenderer::with_path(&context, path);
-        let gpu = generator.upload(&context, hair)?;
-        let bounds = hair.textures.hair_bounds().ok_or(GameHairError::NoHair)?;
+        let asset = HairAsset::upload(&context, &generator, hair.clone())?;
+        let bounds = asset.bounds();
         let mut this = Self {
-            lighting: SceneLighting::new(&context),
-            hair: HairRenderer::with_targets(&context, targets),
-            body_renderer: BodyRenderer::with_targets(&context, targets),
-            body: GpuBody::upload(&context, &hair.body),
+            renderers: FrameRenderers::new(&context, targets),
             draw_body: true,
-            hair_shadow: None,
-            body_shadow: None,
             scene: game_scene(&hair.scene),
-            active: ActiveEffects::none(),
-            effects_group: None,
-            bounds,
             strand_width_m: default_strand_width_m(bounds.0, bounds.1),
             lod: LodSettings {
                 alpha_strands: hair.lod.alpha_strands,
@@ -219,7 +191,7 @@ impl GameHair {
             vertex_count: (1u32 << max_log2) + 1,
             frame: None,
             generator,
-            gpu,
+            asset,
             context,
         };
         let scene = this.scene.clone();
@@ -232,63 +204,11 @@ impl GameHair {
     /// left out (see [`game_scene`]).
     pub fn set_lighting(&mut self, scene: &Scene) -> Result<(), GameHairError> {
         let scene = game_scene(scene);
-        let active = ActiveEffects::new(&scene, !self.body.is_empty());
-        crate::preview::check_effect_limits(&self.context.device.limits(), &active)
-            .map_err(GameHairError::EffectLimit)?;
-        let context = &self.context;
-        self.lighting.sync(context, &active, &scene.material);
-        let effects_layout = effects_layout(context, &active);
-        // Pipelines are made against the layouts, so new layouts mean new renderers.
-        let targets = self.hair.targets();
-        self.hair = HairRenderer::with_targets(context, targets);
-        self.body_renderer = BodyRenderer::with_targets(context, targets);
-        let scene_layout = &self.lighting.scene_layout;
-        let input = self.ribbon_input();
-        self.hair.ensure(
-            context,
-            &active,
-            scene_layout,
-            effects_layout.as_ref(),
-            input,
-        );
-        self.body_renderer.ensure(
-            context,
-            active.shader_key(),
-            scene_layout,
-            effects_layout.as_ref(),
-        );
-        let slots = active.shadow_slots;
-        self.hair_shadow = (active.opacity_maps != SelfShadowing::None && slots > 0).then(|| {
-            HairShadowRenderer::new(
-                context,
-                &self.hair,
-                scene_layout,
-                active.opacity_maps,
-                active.opacity_layers,
-                active.shadow_resolution,
-                slots,
-                input,
-            )
-        });
-        self.body_shadow = (active.body_shadows && slots > 0).then(|| {
-            BodyShadowRenderer::new(
-                context,
-                &self.body_renderer,
-                active.shadow_resolution,
-                slots,
-            )
-        });
-        self.effects_group = effects_layout.as_ref().map(|layout| {
-            effects_bind_group(
-                context,
-                layout,
-                self.hair_shadow.as_ref(),
-                self.body_shadow.as_ref(),
-                &self.lighting,
-            )
-        });
+        let active = ActiveEffects::new(&scene, !self.asset.body().is_empty());
+        check_effect_limits(&self.context.device.limits(), &active)?;
+        let input = self.generator.path().ribbon_input();
+        self.renderers.sync(&self.context, &active, &scene, input);
         self.scene = scene;
-        self.active = active;
         Ok(())
     }
 
@@ -308,8 +228,8 @@ impl GameHair {
         if path == GenerationPath::MeshShader {
             check_mesh_groups(
                 &self.context.device.limits(),
-                self.gpu.bundles.len(),
-                self.gpu.per_bundle,
+                self.asset.gpu().bundles.len(),
+                self.asset.gpu().per_bundle,
                 self.vertex_count,
             )?;
         }
@@ -324,8 +244,12 @@ impl GameHair {
         self.generator.path()
     }
 
-    fn ribbon_input(&self) -> RibbonInput {
-        self.generator.path().ribbon_input()
+    /// Takes a change of the bundle's hair (new styling at run time, or new runtime data) to
+    /// the GPU the way the editor does ([`HairAsset::apply`]).
+    pub fn apply(&mut self, change: AssetChange) -> Result<(), GameHairError> {
+        self.asset.apply(&self.context, &self.generator, change)?;
+        self.frame = None;
+        Ok(())
     }
 
     /// Whether [`Self::draw`] draws the bundle's body (on by default; a game that draws its
@@ -337,7 +261,7 @@ impl GameHair {
     /// Bytes the bundle keeps on the GPU (textures, placements, root samples, styling):
     /// what every frame and every copy drawn from it share.
     pub fn resident_bytes(&self) -> u64 {
-        self.gpu.bytes
+        self.asset.gpu().bytes
     }
 
     /// Level of detail and culling (the bundle's settings by default).
@@ -359,7 +283,7 @@ impl GameHair {
 
     /// The box around the hair (to frame a camera).
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.bounds
+        self.asset.bounds()
     }
 
     /// The scene being drawn.
@@ -379,18 +303,16 @@ impl GameHair {
         camera: &GameCamera,
     ) -> GameFrameStats {
         let context = &self.context;
-        let height_px = camera.viewport_height_px.max(1);
-        let lod_camera = LodCamera {
-            eye: camera.eye,
+        let camera = FrameCamera {
             view_projection: camera.view_projection,
+            eye: camera.eye,
             fov_y_rad: camera.fov_y_rad,
-            resolution_px: height_px as f32,
+            height_px: camera.viewport_height_px.max(1),
         };
         // One batch, so generation runs once before the pass: as many vertices as one
         // storage binding holds (16 B each) and one row of 64-wide workgroups reaches (one
         // invocation per vertex, or per strand of at least 2 vertices). Ribbons that generate
         // their own vertices have no scratch to fill, so no limit.
-        let input = self.ribbon_input();
         let limits = context.device.limits();
         let binding = limits.max_storage_buffer_binding_size / 16;
         let row = limits.max_compute_workgroups_per_dimension as u64 * 64;
@@ -400,10 +322,10 @@ impl GameHair {
             GenerationPath::VertexShader | GenerationPath::MeshShader => usize::MAX / 2,
         };
         let mut plan = plan_frame(
-            &self.gpu.bundles,
-            self.gpu.per_bundle,
+            &self.asset.gpu().bundles,
+            self.asset.gpu().per_bundle,
             self.vertex_count.saturating_sub(1).max(1).ilog2(),
-            &lod_camera,
+            &camera.lod(),
             &self.lod,
             binding_vertices,
         );
@@ -427,103 +349,30 @@ impl GameHair {
             stats.strands -= dropped;
             stats.vertices = FramePlan::batch_vertices(&plan.batches[0]);
         }
-        let runs = self.generator.upload_runs(context, &plan);
-        let scratch =
-            (input == RibbonInput::Buffer).then(|| self.generator.scratch(context, &plan));
-        stats.scratch_bytes = scratch.as_ref().map_or(0, |s| s.size());
-        let batch_runs = plan.batches.first().cloned().unwrap_or_default();
-        if let (Some(batch), Some(scratch)) = (plan.batches.first(), &scratch) {
-            self.generator.encode(
-                context,
-                encoder,
-                &self.gpu,
-                &runs,
-                0,
-                batch,
-                self.filtering,
-                scratch,
-                None,
-            );
-        }
-        let (centre, radius) = bounding_sphere(self.bounds.0, self.bounds.1);
-        let shadow_views = if self.active.shadow_slots > 0 {
-            shadow_views(&self.scene, centre, radius)
-        } else {
-            Vec::new()
-        };
-        let mean_forward = self
-            .lighting
-            .sync(context, &self.active, &self.scene.material);
-        let tables = self.lighting.dual_scattering.as_ref().map(|ds| &ds.tables);
-        let uniforms = SceneUniforms::new(
-            &self.scene,
-            &shadow_views,
-            tables,
-            mean_forward,
-            radius,
-            self.strand_width_m,
-        );
-        self.lighting.write(context, &uniforms);
-        let pixel_at_unit = 2.0 * (camera.fov_y_rad * 0.5).tan() / height_px as f32;
-        let (hair_views, body_views) = frame_views(
-            HairUniforms {
-                view_projection: camera.view_projection.to_cols_array_2d(),
-                eye: camera.eye.extend(1.0).to_array(),
-                width: [self.strand_width_m, pixel_at_unit, 0.0, 0.0],
-                batch: [0; 4],
-            },
-            &shadow_views,
-        );
-        let ranges = [[0, plan.batches.first().map_or(0, Vec::len) as u32]];
-        let hair = match &scratch {
-            Some(scratch) => self
-                .hair
-                .prepare(context, &hair_views, &ranges, scratch, &runs),
-            None => self.hair.prepare_generated(
-                context,
-                &hair_views,
-                &ranges,
-                &self.generator,
-                &self.gpu,
-                self.filtering,
-                &runs,
-                (input == RibbonInput::Mesh).then_some(MeshLod {
-                    camera: lod_camera,
-                    settings: self.lod,
-                    max_vertices_log2: self.vertex_count.saturating_sub(1).max(1).ilog2(),
-                }),
-            ),
-        };
-        let body = self.body_renderer.prepare(context, &body_views);
-        // Shadow passes, per shadow-casting light, into the shadow maps (not the game's
-        // targets): the body's depth, the first hair's depth, then the opacity layers.
-        for slot in 0..shadow_views.len() {
-            if let Some(body_shadow) = &self.body_shadow {
-                body_shadow.encode(encoder, &body, &self.body, slot);
-            }
-            if let Some(hair_shadow) = &self.hair_shadow {
-                if hair_shadow.kind == SelfShadowing::DeepOpacityMaps {
-                    hair_shadow.encode_depth(encoder, &hair, slot, 0, &batch_runs, true);
-                }
-                hair_shadow.encode_opacity(
-                    encoder,
-                    &hair,
-                    &self.lighting.scene_group,
-                    slot,
-                    0,
-                    &batch_runs,
-                    true,
-                );
-            }
-        }
-        self.frame = Some(PreparedFrame {
+        let hair = self.hair_source();
+        let inputs = FrameInputs {
             hair,
-            body,
-            runs: batch_runs,
-            _runs: runs,
-            _scratch: scratch,
-        });
+            body: self.asset.body(),
+            vertex_count: self.vertex_count,
+            strand_width_m: self.strand_width_m,
+            scene: &self.scene,
+            hair_bounds: self.asset.bounds(),
+            camera,
+        };
+        let frame = prepare(context, &self.renderers, &inputs, &plan);
+        stats.scratch_bytes = frame.scratch_bytes;
+        // Generation, then the shadow passes per shadow-casting light into the shadow maps
+        // (not the game's targets).
+        let mut recorder =
+            FrameRecorder::new(context, &self.renderers, &frame, self.asset.body(), &hair);
+        recorder.generate(encoder, 0);
+        recorder.shadow_views(encoder);
+        self.frame = Some(frame);
         stats
+    }
+
+    fn hair_source(&self) -> HairSource<'_> {
+        self.asset.source(&self.generator, self.filtering, self.lod)
     }
 
     /// Records the body (when on) and the lit hair into the game's pass, depth-tested
@@ -534,18 +383,13 @@ impl GameHair {
         let Some(frame) = &self.frame else {
             return;
         };
-        pass.set_bind_group(1, &self.lighting.scene_group, &[]);
-        if let Some(group) = &self.effects_group {
-            pass.set_bind_group(2, group, &[]);
-        }
-        if self.draw_body {
-            self.body_renderer.draw(pass, &frame.body, &self.body);
-        }
-        for pipeline in [self.hair.depth_pipeline(), self.hair.main_pipeline()]
-            .into_iter()
-            .flatten()
-        {
-            HairRenderer::draw_with(pass, pipeline, &frame.hair, 0, 0, &frame.runs);
-        }
+        FrameRecorder::new(
+            &self.context,
+            &self.renderers,
+            frame,
+            self.asset.body(),
+            &self.hair_source(),
+        )
+        .draw_into(pass, self.draw_body);
     }
 }

@@ -10,7 +10,9 @@
 //! stage has a CPU mirror in `hairloom_core::runtime` that tests compare against.
 
 pub mod device;
+pub mod frame;
 pub mod game;
+pub mod hair_asset;
 pub mod measure;
 pub mod preview;
 pub mod renderer;

@@ -17,23 +17,16 @@
 use std::sync::Mutex;
 
 use glam::{Mat4, Vec3};
-use hairloom_core::light::opacity_maps::ShadowView;
-use hairloom_core::light::scene_uniforms::{SceneUniforms, bounding_sphere, shadow_views};
-use hairloom_core::model::scene::{Scene, SelfShadowing};
-use hairloom_core::runtime::frame_plan::{FramePlan, LodCamera, LodSettings, plan_frame};
-use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::model::scene::Scene;
+use hairloom_core::runtime::frame_plan::{FramePlan, plan_frame};
 
 use crate::device::{GpuContext, PassTimer, submit_timed};
-use crate::renderer::body_shadow::BodyShadowRenderer;
-use crate::renderer::hair_shadow::HairShadowRenderer;
-use crate::renderer::oit_composite::OitRenderer;
-use crate::renderer::preview_body::{BodyRenderer, BodyUniforms, GpuBody};
-use crate::renderer::preview_hair::{HairRenderer, HairUniforms, MeshLod, RibbonInput};
-use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
-use crate::renderer::strand_gen::{
-    GenerationPath, GpuHair, StrandGenError, StrandGenRenderer, batch_vertex_limit,
-    check_mesh_groups,
-};
+use crate::frame::{FrameCamera, FrameInputs, FrameRecorder, FrameRenderers, Phase, prepare};
+pub use crate::frame::{FrameError as PreviewError, HairSource, check_effect_limits};
+use crate::renderer::Targets;
+use crate::renderer::preview_body::GpuBody;
+use crate::renderer::scene_lighting::ActiveEffects;
+use crate::renderer::strand_gen::batch_vertex_limit;
 use crate::view::View;
 
 /// A perspective camera looking at `target`.
@@ -73,27 +66,6 @@ impl Camera {
     }
 }
 
-/// Where the strand vertices of a frame come from.
-#[derive(Clone, Copy)]
-pub enum HairSource<'a> {
-    /// Strand-major vertices in memory (xyz, w = fraction along the strand), uploaded for
-    /// the frame: the CPU reference generator's output.
-    Vertices(&'a [[f32; 4]]),
-    /// Strand-major vertices already in a GPU storage buffer: the explicit-storage baseline.
-    Stored {
-        buffer: &'a wgpu::Buffer,
-        strand_count: usize,
-    },
-    /// Generated from the runtime textures in this frame, batch by batch, after the
-    /// bundle-level work (culling, strand and vertex LOD) planned the frame.
-    Generated {
-        generator: &'a StrandGenRenderer,
-        hair: &'a GpuHair,
-        filtering: Filtering,
-        lod: LodSettings,
-    },
-}
-
 /// What to draw.
 pub struct PreviewScene<'a> {
     /// The body, uploaded once per document.
@@ -110,118 +82,10 @@ pub struct PreviewScene<'a> {
     pub camera: Camera,
 }
 
-/// Everything a frame keeps between frames: the view's targets and one renderer per feature.
-/// The effect renderers exist only while the scene asks for their effect.
+/// What a preview keeps between frames: the view's targets and the frame's renderers.
 struct FrameState {
     view: Option<View>,
-    lighting: SceneLighting,
-    hair: HairRenderer,
-    body: BodyRenderer,
-    /// The group-2 layout of the lit shaders, for the effects that make it up.
-    effects_layout: Option<((SelfShadowing, bool, bool), Option<wgpu::BindGroupLayout>)>,
-    hair_shadow: Option<HairShadowRenderer>,
-    body_shadow: Option<BodyShadowRenderer>,
-    oit: Option<OitRenderer>,
-    lighting_sample_count: u32,
-}
-
-impl FrameState {
-    /// Makes what `active` needs and frees what it does not; returns the material's mean
-    /// forward transmittance per fibre.
-    fn sync(
-        &mut self,
-        context: &GpuContext,
-        active: &ActiveEffects,
-        scene: &Scene,
-        input: RibbonInput,
-    ) -> [f32; 3] {
-        let mean_forward = self.lighting.sync(context, active, &scene.material);
-        let layout_key = (
-            active.opacity_maps,
-            active.body_shadows,
-            active.dual_scattering,
-        );
-        if self
-            .effects_layout
-            .as_ref()
-            .is_none_or(|(key, _)| *key != layout_key)
-        {
-            self.effects_layout = Some((layout_key, effects_layout(context, active)));
-            // Pipelines made with the old layout go with it.
-            self.hair = HairRenderer::new(context, self.hair_sample_count());
-            self.body = BodyRenderer::new(context, self.hair_sample_count());
-        }
-        let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
-        self.hair.ensure(
-            context,
-            active,
-            &self.lighting.scene_layout,
-            effects_layout,
-            input,
-        );
-        self.body.ensure(
-            context,
-            active.shader_key(),
-            &self.lighting.scene_layout,
-            effects_layout,
-        );
-        let slots = active.shadow_slots;
-        if active.opacity_maps != SelfShadowing::None && slots > 0 {
-            let fits = self.hair_shadow.as_ref().is_some_and(|h| {
-                h.fits(
-                    active.opacity_maps,
-                    active.opacity_layers,
-                    active.shadow_resolution,
-                    slots,
-                    input,
-                )
-            });
-            if !fits {
-                self.hair_shadow = None;
-                self.hair_shadow = Some(HairShadowRenderer::new(
-                    context,
-                    &self.hair,
-                    &self.lighting.scene_layout,
-                    active.opacity_maps,
-                    active.opacity_layers,
-                    active.shadow_resolution,
-                    slots,
-                    input,
-                ));
-            }
-        } else {
-            self.hair_shadow = None;
-        }
-        if active.body_shadows && slots > 0 {
-            let fits = self
-                .body_shadow
-                .as_ref()
-                .is_some_and(|b| (b.resolution, b.slots) == (active.shadow_resolution, slots));
-            if !fits {
-                self.body_shadow = None;
-                self.body_shadow = Some(BodyShadowRenderer::new(
-                    context,
-                    &self.body,
-                    active.shadow_resolution,
-                    slots,
-                ));
-            }
-        } else {
-            self.body_shadow = None;
-        }
-        if active.width_oit {
-            if self.oit.is_none() {
-                self.oit = Some(OitRenderer::new(context, self.hair_sample_count()));
-            }
-        } else {
-            self.oit = None;
-        }
-        mean_forward
-    }
-
-    fn hair_sample_count(&self) -> u32 {
-        self.lighting_sample_count
-    }
+    renderers: FrameRenderers,
 }
 
 /// The frame of a picture: shadow passes for the scene's shadow-casting lights (when it asks
@@ -242,17 +106,17 @@ impl PreviewRenderer {
         Self {
             state: Mutex::new(FrameState {
                 view: None,
-                lighting: SceneLighting::new(context),
-                hair: HairRenderer::new(context, sample_count),
-                body: BodyRenderer::new(context, sample_count),
-                effects_layout: None,
-                hair_shadow: None,
-                body_shadow: None,
-                oit: None,
-                lighting_sample_count: sample_count,
+                renderers: FrameRenderers::new(context, Targets::view(sample_count)),
             }),
             sample_count,
         }
+    }
+
+    /// The renderers of the last frame, with the phases each takes part in: what a frame of
+    /// its scene records (an effect that is off has none).
+    pub fn participants(&self) -> Vec<(&'static str, &'static [Phase])> {
+        let state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        state.renderers.participants()
     }
 
     /// Renders `scene` into a `width × height` image following `plan` (from [`Self::plan`]
@@ -311,14 +175,14 @@ impl PreviewRenderer {
         })
     }
 
-    /// The camera as LOD sees it in a `width` × `height` frame of `scene`.
-    fn lod_camera(scene: &PreviewScene, width: u32, height: u32) -> LodCamera {
+    /// The camera as the frame sees it in a `width` × `height` frame of `scene`.
+    fn frame_camera(scene: &PreviewScene, width: u32, height: u32) -> FrameCamera {
         let (width, height) = (width.max(1), height.max(1));
-        LodCamera {
+        FrameCamera {
             eye: scene.camera.eye,
             view_projection: scene.camera.view_projection(width as f32 / height as f32),
             fov_y_rad: scene.camera.fov_y_rad,
-            resolution_px: height as f32,
+            height_px: height,
         }
     }
 
@@ -332,7 +196,7 @@ impl PreviewRenderer {
                     &hair.bundles,
                     hair.per_bundle,
                     max_log2,
-                    &Self::lod_camera(scene, width, height),
+                    &Self::frame_camera(scene, width, height).lod(),
                     lod,
                     batch_vertex_limit(scene.vertex_count),
                 )
@@ -358,8 +222,8 @@ impl PreviewRenderer {
         Ok(active)
     }
 
-    /// Records a frame into the kept view (see [`PreviewRenderer`]); the last pass resolves
-    /// MSAA.
+    /// Records a frame into the kept view (see [`PreviewRenderer`]) with the frame builder;
+    /// the last pass resolves MSAA.
     fn encode_frame(
         &self,
         context: &GpuContext,
@@ -369,484 +233,42 @@ impl PreviewRenderer {
         height: u32,
         timer: Option<&PassTimer>,
     ) -> Result<EncodedFrame, PreviewError> {
-        let device = &context.device;
         let active = self.active_effects(context, scene)?;
+        scene.hair.check(context, scene.vertex_count)?;
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         let state = &mut *state;
-        // Ribbons read their vertices from a buffer unless the generator makes them in the
-        // vertex shader.
-        let input = match &scene.hair {
-            HairSource::Generated {
-                generator, hair, ..
-            } => {
-                StrandGenRenderer::check_path(context, generator.path())
-                    .map_err(PreviewError::Generation)?;
-                if generator.path() == GenerationPath::MeshShader {
-                    check_mesh_groups(
-                        &device.limits(),
-                        hair.bundles.len(),
-                        hair.per_bundle,
-                        scene.vertex_count,
-                    )
-                    .map_err(PreviewError::Generation)?;
-                }
-                generator.path().ribbon_input()
-            }
-            _ => RibbonInput::Buffer,
-        };
-        let mean_forward = state.sync(context, &active, scene.lighting, input);
+        let renderers = &mut state.renderers;
+        renderers.sync(context, &active, scene.lighting, scene.hair.ribbon_input());
         View::ensure(&mut state.view, context, width, height, self.sample_count);
         let view = state.view.as_ref().expect("made above");
-        if let Some(oit) = &mut state.oit {
+        if let Some(oit) = &mut renderers.oit {
             oit.ensure_targets(context, view.width, view.height);
         }
-        let aspect = view.width as f32 / view.height as f32;
-        let view_projection = scene.camera.view_projection(aspect).to_cols_array_2d();
-        let camera_position = scene.camera.eye.extend(1.0).to_array();
-        // The scene as the shaders see it, with a view per shadow-casting light.
-        let (center, radius) = bounding_sphere(scene.hair_bounds.0, scene.hair_bounds.1);
-        let shadow_views: Vec<_> = if active.shadow_slots > 0 {
-            shadow_views(scene.lighting, center, radius)
-        } else {
-            Vec::new()
+        let inputs = FrameInputs {
+            hair: scene.hair,
+            body: scene.body,
+            vertex_count: scene.vertex_count,
+            strand_width_m: scene.strand_width_m,
+            scene: scene.lighting,
+            hair_bounds: scene.hair_bounds,
+            camera: Self::frame_camera(scene, view.width, view.height),
         };
-        let tables = state.lighting.dual_scattering.as_ref().map(|ds| &ds.tables);
-        let uniforms = SceneUniforms::new(
-            scene.lighting,
-            &shadow_views,
-            tables,
-            mean_forward,
-            radius,
-            scene.strand_width_m,
-        );
-        state.lighting.write(context, &uniforms);
-        let effects_group = state
-            .effects_layout
-            .as_ref()
-            .and_then(|(_, layout)| layout.as_ref())
-            .map(|layout| {
-                effects_bind_group(
-                    context,
-                    layout,
-                    state.hair_shadow.as_ref(),
-                    state.body_shadow.as_ref(),
-                    &state.lighting,
-                )
+        let frame = prepare(context, renderers, &inputs, plan);
+        let mut encoder = context
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("preview"),
             });
-        let generator = match &scene.hair {
-            HairSource::Generated {
-                generator,
-                hair,
-                filtering,
-                ..
-            } => {
-                generator
-                    .check_filtering(context, *filtering)
-                    .map_err(PreviewError::Generation)?;
-                Some((*generator, *hair, *filtering))
-            }
-            _ => None,
-        };
-        // Per-frame buffers (not kept, so not in the registry).
-        let storage = |label: &str, contents: &[u8]| {
-            wgpu::util::DeviceExt::create_buffer_init(
-                device,
-                &wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                },
-            )
-        };
-        let runs = match generator {
-            Some((generator, ..)) => generator.upload_runs(context, plan),
-            None => {
-                let mut runs: Vec<_> = plan.batches.iter().flatten().copied().collect();
-                if runs.is_empty() {
-                    runs.push(Default::default());
-                }
-                storage("preview_runs", bytemuck::cast_slice(&runs))
-            }
-        };
-        // Where the hair's vertices live: uploaded now, already stored, or a scratch buffer
-        // that each batch's generation overwrites.
-        let (owned, scratch);
-        let (strands, scratch_bytes): (&wgpu::Buffer, u64) = match &scene.hair {
-            HairSource::Vertices(vertices) => {
-                let placeholder = [[0.0f32; 4]];
-                let data = if vertices.is_empty() {
-                    &placeholder[..]
-                } else {
-                    vertices
-                };
-                owned = storage("preview_strands", bytemuck::cast_slice(data));
-                (&owned, 0)
-            }
-            HairSource::Stored { buffer, .. } => (buffer, 0),
-            // No scratch: the ribbons bind the textures instead.
-            HairSource::Generated { .. } if input != RibbonInput::Buffer => {
-                owned = storage("preview_no_strands", &[0; 16]);
-                (&owned, 0)
-            }
-            HairSource::Generated { generator, .. } => {
-                scratch = generator.scratch(context, plan);
-                (&scratch, scratch.size())
-            }
-        };
-        // Each batch's runs: `runs[first_run..][..batch.len()]`.
-        let ranges: Vec<[u32; 2]> = plan
-            .batches
-            .iter()
-            .scan(0u32, |first, batch| {
-                let range = [*first, batch.len() as u32];
-                *first += batch.len() as u32;
-                Some(range)
-            })
-            .collect();
-        // The hair's views: the camera, then each shadow-casting light (ribbons at least a
-        // texel wide there, and a pixel wide for the camera with width-based coverage).
-        let pixel_at_unit = 2.0 * (scene.camera.fov_y_rad * 0.5).tan() / view.height as f32;
-        let (hair_views, body_views) = frame_views(
-            HairUniforms {
-                view_projection,
-                eye: camera_position,
-                width: [
-                    scene.strand_width_m,
-                    pixel_at_unit,
-                    if active.width_oit { 1.0 } else { 0.0 },
-                    0.0,
-                ],
-                batch: [0; 4],
-            },
-            &shadow_views,
-        );
-        let prepared_hair = match generator {
-            Some((generator, gpu_hair, filtering)) if input != RibbonInput::Buffer => {
-                state.hair.prepare_generated(
-                    context,
-                    &hair_views,
-                    &ranges,
-                    generator,
-                    gpu_hair,
-                    filtering,
-                    &runs,
-                    (input == RibbonInput::Mesh).then(|| MeshLod {
-                        camera: Self::lod_camera(scene, width, height),
-                        settings: match &scene.hair {
-                            HairSource::Generated { lod, .. } => *lod,
-                            _ => LodSettings::default(),
-                        },
-                        max_vertices_log2: scene.vertex_count.saturating_sub(1).max(1).ilog2(),
-                    }),
-                )
-            }
-            _ => state
-                .hair
-                .prepare(context, &hair_views, &ranges, strands, &runs),
-        };
-        let prepared_body = state.body.prepare(context, &body_views);
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("preview"),
-        });
-        // Generation: once when the plan is one batch (every pass then reads the same
-        // vertices), else again before each pass that draws a batch.
-        let single_batch = plan.batches.len() == 1;
-        let mut generated = false;
-        let mut generate = |encoder: &mut wgpu::CommandEncoder, index: usize| {
-            let Some((generator, gpu_hair, filtering)) = generator else {
-                return;
-            };
-            if (single_batch && generated) || input != RibbonInput::Buffer {
-                return;
-            }
-            generated = true;
-            generator.encode(
-                context,
-                encoder,
-                gpu_hair,
-                &runs,
-                ranges[index][0] as usize,
-                &plan.batches[index],
-                filtering,
-                strands,
-                timer.and_then(|t| t.compute_pass()),
-            );
-        };
-        let no_runs = Vec::new();
-        let batch_runs = |index: usize| plan.batches.get(index).unwrap_or(&no_runs);
-        let batch_count = plan.batches.len();
-        // 1. Shadow passes, per shadow-casting light.
-        for slot in 0..active.shadow_slots as usize {
-            if let Some(body_shadow) = &state.body_shadow {
-                body_shadow.encode(&mut encoder, &prepared_body, scene.body, slot);
-            }
-            if let Some(hair_shadow) = &state.hair_shadow {
-                if hair_shadow.kind == SelfShadowing::DeepOpacityMaps {
-                    for index in 0..batch_count.max(1) {
-                        if index < batch_count {
-                            generate(&mut encoder, index);
-                        }
-                        hair_shadow.encode_depth(
-                            &mut encoder,
-                            &prepared_hair,
-                            slot,
-                            index,
-                            batch_runs(index),
-                            index == 0,
-                        );
-                    }
-                }
-                for index in 0..batch_count.max(1) {
-                    if index < batch_count {
-                        generate(&mut encoder, index);
-                    }
-                    hair_shadow.encode_opacity(
-                        &mut encoder,
-                        &prepared_hair,
-                        &state.lighting.scene_group,
-                        slot,
-                        index,
-                        batch_runs(index),
-                        index == 0,
-                    );
-                }
-            }
-        }
-        // 2. The colour passes: the body (clearing), then each batch's ribbons; the last of
-        // them (or the OIT composite after them) resolves MSAA.
-        let (target, resolve) = view.attachments();
-        let background = scene.lighting.background;
-        let oit = state.oit.as_ref();
-        let pass_count = 1 + 2 * batch_count.max(1) + usize::from(oit.is_some());
-        let mut pass_index = 0;
-        let depth_view = view.depth();
-        let mut begin_pass = |encoder: &mut wgpu::CommandEncoder| {
-            let (first, last) = (pass_index == 0, pass_index + 1 == pass_count);
-            pass_index += 1;
-            encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("preview"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: target,
-                        depth_slice: None,
-                        resolve_target: if last { resolve } else { None },
-                        ops: wgpu::Operations {
-                            load: if first {
-                                wgpu::LoadOp::Clear(wgpu::Color {
-                                    r: background[0] as f64,
-                                    g: background[1] as f64,
-                                    b: background[2] as f64,
-                                    a: 1.0,
-                                })
-                            } else {
-                                wgpu::LoadOp::Load
-                            },
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: depth_view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: if first {
-                                wgpu::LoadOp::Clear(1.0)
-                            } else {
-                                wgpu::LoadOp::Load
-                            },
-                            store: if last {
-                                wgpu::StoreOp::Discard
-                            } else {
-                                wgpu::StoreOp::Store
-                            },
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: timer.and_then(|t| t.render_pass()),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                })
-                // Each pass ends (drops) before the next is begun; wgpu checks this at run time.
-                .forget_lifetime()
-        };
-        let bind_lighting = |pass: &mut wgpu::RenderPass<'_>| {
-            pass.set_bind_group(1, &state.lighting.scene_group, &[]);
-            if let Some(group) = &effects_group {
-                pass.set_bind_group(2, group, &[]);
-            }
-        };
-        {
-            let mut pass = begin_pass(&mut encoder);
-            bind_lighting(&mut pass);
-            state.body.draw(&mut pass, &prepared_body, scene.body);
-        }
-        // Every batch's depth first (a later batch may hide an earlier one), then the lit
-        // ribbons where they are nearest: each visible sample is shaded once.
-        for pipeline in [state.hair.depth_pipeline(), state.hair.main_pipeline()] {
-            for index in 0..batch_count {
-                generate(&mut encoder, index);
-                let mut pass = begin_pass(&mut encoder);
-                bind_lighting(&mut pass);
-                if let Some(pipeline) = pipeline {
-                    HairRenderer::draw_with(
-                        &mut pass,
-                        pipeline,
-                        &prepared_hair,
-                        0,
-                        index,
-                        batch_runs(index),
-                    );
-                }
-            }
-            if batch_count == 0 {
-                // Nothing to draw: the pass still runs (it resolves when it is the last).
-                drop(begin_pass(&mut encoder));
-            }
-        }
-        // 3. Width-based coverage: the thin strands' weighted blended transparency, then its
-        // composite over the opaque picture.
-        if let (Some(oit), Some(pipeline)) = (oit, state.hair.oit_pipeline()) {
-            for index in 0..batch_count.max(1) {
-                if index < batch_count {
-                    generate(&mut encoder, index);
-                }
-                let Some(attachments) = oit.attachments(index == 0) else {
-                    break;
-                };
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("preview_hair_oit"),
-                    color_attachments: &attachments,
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: depth_view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: timer.and_then(|t| t.render_pass()),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                bind_lighting(&mut pass);
-                if index < batch_count {
-                    HairRenderer::draw_with(
-                        &mut pass,
-                        pipeline,
-                        &prepared_hair,
-                        0,
-                        index,
-                        batch_runs(index),
-                    );
-                }
-            }
-            let mut pass = begin_pass(&mut encoder);
-            oit.draw(&mut pass);
-        }
+        let mut recorder =
+            FrameRecorder::new(context, renderers, &frame, scene.body, &scene.hair).timed(timer);
+        recorder.shadow_views(&mut encoder);
+        recorder.view(&mut encoder, view, scene.lighting.background);
         Ok(EncodedFrame {
             encoder,
             color: view.color().clone(),
-            scratch_bytes,
+            scratch_bytes: frame.scratch_bytes,
         })
     }
-}
-
-/// The views a frame draws the hair and the body from: `camera`, then each shadow-casting
-/// light of `shadow_views` (ribbons at least a shadow texel wide there), in the order the
-/// renderers index them (view `slot + 1` is light `slot`).
-pub(crate) fn frame_views(
-    camera: HairUniforms,
-    shadow_views: &[ShadowView],
-) -> (Vec<HairUniforms>, Vec<BodyUniforms>) {
-    let strand_width_m = camera.width[0];
-    let mut hair_views = vec![camera];
-    let mut body_views = vec![BodyUniforms {
-        view_projection: camera.view_projection,
-        camera_position: camera.eye,
-    }];
-    for (slot, light_view) in shadow_views.iter().enumerate() {
-        let view_projection = light_view.view_projection.to_cols_array_2d();
-        hair_views.push(HairUniforms {
-            view_projection,
-            eye: light_view
-                .eye
-                .extend(if light_view.perspective { 1.0 } else { 0.0 })
-                .to_array(),
-            width: [strand_width_m, light_view.texel_size, 1.0, 0.0],
-            batch: [0, 0, slot as u32, 0],
-        });
-        body_views.push(BodyUniforms {
-            view_projection,
-            camera_position: light_view.eye.extend(1.0).to_array(),
-        });
-    }
-    (hair_views, body_views)
-}
-
-/// The group-2 bind group of the lit shaders from the effect renderers that exist (the
-/// preview's frame and the game runtime's).
-pub(crate) fn effects_bind_group(
-    context: &GpuContext,
-    layout: &wgpu::BindGroupLayout,
-    hair_shadow: Option<&HairShadowRenderer>,
-    body_shadow: Option<&BodyShadowRenderer>,
-    lighting: &SceneLighting,
-) -> wgpu::BindGroup {
-    let mut entries = Vec::new();
-    let view = |binding, view| wgpu::BindGroupEntry {
-        binding,
-        resource: wgpu::BindingResource::TextureView(view),
-    };
-    if let Some(hair_shadow) = hair_shadow {
-        entries.push(view(binding::OPACITY_LAYERS, &hair_shadow.opacity_view));
-        if let Some(first_hair) = hair_shadow.first_hair_view() {
-            entries.push(view(binding::FIRST_HAIR_DEPTH, first_hair));
-        }
-    }
-    if let Some(body_shadow) = body_shadow {
-        entries.push(view(binding::BODY_DEPTH, &body_shadow.array_view));
-        entries.push(wgpu::BindGroupEntry {
-            binding: binding::BODY_DEPTH_SAMPLER,
-            resource: wgpu::BindingResource::Sampler(&lighting.depth_sampler),
-        });
-    }
-    if let Some(ds) = &lighting.dual_scattering {
-        entries.push(wgpu::BindGroupEntry {
-            binding: binding::TABLE_SAMPLER,
-            resource: wgpu::BindingResource::Sampler(&lighting.table_sampler),
-        });
-        entries.push(view(binding::DS_PROFILE, &ds.profile_view));
-        entries.push(view(binding::DS_LOBES, &ds.lobes_view));
-    }
-    context
-        .device
-        .create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("effects"),
-            layout,
-            entries: &entries,
-        })
-}
-
-/// Refuses effect resources the adapter cannot hold, naming the scene's field and the limit.
-pub fn check_effect_limits(
-    limits: &wgpu::Limits,
-    active: &ActiveEffects,
-) -> Result<(), PreviewError> {
-    if active.shadow_slots == 0 {
-        return Ok(());
-    }
-    if active.shadow_resolution > limits.max_texture_dimension_2d {
-        return Err(PreviewError::EffectLimit(format!(
-            "scene.effects.shadow_resolution: {} texels is above this adapter's max_texture_dimension_2d of {}",
-            active.shadow_resolution, limits.max_texture_dimension_2d
-        )));
-    }
-    let layers = active.shadow_slots * (active.opacity_layers / 4).max(1);
-    if layers > limits.max_texture_array_layers {
-        return Err(PreviewError::EffectLimit(format!(
-            "scene.effects.opacity_layers: {} layers for {} lights need {layers} texture layers, above this adapter's max_texture_array_layers of {}",
-            active.opacity_layers, active.shadow_slots, limits.max_texture_array_layers
-        )));
-    }
-    Ok(())
 }
 
 struct EncodedFrame {
@@ -882,18 +304,6 @@ fn stored_plan(strand_count: usize, vertex_count: u32) -> FramePlan {
         },
         culled_bundles: 0,
     }
-}
-
-/// Why a frame could not be drawn.
-#[derive(Debug, thiserror::Error)]
-pub enum PreviewError {
-    #[error(transparent)]
-    Generation(StrandGenError),
-    #[error("reading the frame back failed: {0}")]
-    Readback(String),
-    /// An effect's resource would exceed what the adapter allows; nothing was made.
-    #[error("{0}")]
-    EffectLimit(String),
 }
 
 /// The picture of a document: its scene's lights, material and effects, strands a little

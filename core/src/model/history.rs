@@ -15,6 +15,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::model::change::ChangeKind;
 use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::{Bundle, Column, VertexRef, WMode};
 use crate::model::scene::Scene;
@@ -358,6 +359,22 @@ impl Command {
     }
 }
 
+/// One step undone or redone: its label, and what it asks of the hair asset.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Step {
+    pub label: String,
+    pub kind: ChangeKind,
+}
+
+impl Step {
+    fn of(command: &Command) -> Self {
+        Self {
+            label: command.label().to_string(),
+            kind: command.change_kind(),
+        }
+    }
+}
+
 /// The undo and redo stacks. Saved in project files.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct History {
@@ -408,7 +425,7 @@ impl History {
     }
 
     /// Undoes the last step; `Ok(None)` when there is nothing to undo.
-    pub fn undo(&mut self, document: &mut Document) -> Result<Option<String>, HistoryMismatch> {
+    pub fn undo(&mut self, document: &mut Document) -> Result<Option<Step>, HistoryMismatch> {
         let Some(command) = self.undo.pop() else {
             return Ok(None);
         };
@@ -416,13 +433,13 @@ impl History {
             self.undo.push(command);
             return Err(error);
         }
-        let label = command.label().to_string();
+        let step = Step::of(&command);
         self.redo.push(command);
-        Ok(Some(label))
+        Ok(Some(step))
     }
 
     /// Redoes the last undone step; `Ok(None)` when there is nothing to redo.
-    pub fn redo(&mut self, document: &mut Document) -> Result<Option<String>, HistoryMismatch> {
+    pub fn redo(&mut self, document: &mut Document) -> Result<Option<Step>, HistoryMismatch> {
         let Some(command) = self.redo.pop() else {
             return Ok(None);
         };
@@ -430,24 +447,30 @@ impl History {
             self.redo.push(command);
             return Err(error);
         }
-        let label = command.label().to_string();
+        let step = Step::of(&command);
         self.undo.push(command);
-        Ok(Some(label))
+        Ok(Some(step))
     }
 
-    /// Undoes or redoes until `undo.len() == position` (the history panel's "jump here").
+    /// Undoes or redoes until `undo.len() == position` (the history panel's "jump here");
+    /// returns what the steps taken ask of the hair asset together.
     pub fn jump_to(
         &mut self,
         document: &mut Document,
         position: usize,
-    ) -> Result<(), HistoryMismatch> {
+    ) -> Result<ChangeKind, HistoryMismatch> {
+        let mut kind = ChangeKind::Scene;
         while self.undo.len() > position {
-            self.undo(document)?;
+            if let Some(step) = self.undo(document)? {
+                kind = kind.and(step.kind);
+            }
         }
         while self.undo.len() < position && !self.redo.is_empty() {
-            self.redo(document)?;
+            if let Some(step) = self.redo(document)? {
+                kind = kind.and(step.kind);
+            }
         }
-        Ok(())
+        Ok(kind)
     }
 
     /// Checks that the whole history replays on `document`: undoing every step and redoing
@@ -496,19 +519,22 @@ fn prefix(error: HistoryMismatch, what: &str) -> HistoryMismatch {
     }
 }
 
-/// A drag or other multi-step gesture that becomes one undo step.
+/// A drag or other multi-step gesture that becomes one undo step, with the kind of change it
+/// makes (what the hair asset redoes while it runs).
 #[derive(Clone, Debug)]
 pub struct Transaction {
     start: Document,
     label: String,
+    kind: ChangeKind,
 }
 
 impl Transaction {
-    /// Starts a transaction on the current document.
-    pub fn begin(document: &Document, label: impl Into<String>) -> Self {
+    /// Starts a transaction on the current document that makes changes of `kind`.
+    pub fn begin(document: &Document, label: impl Into<String>, kind: ChangeKind) -> Self {
         Self {
             start: document.clone(),
             label: label.into(),
+            kind,
         }
     }
 
@@ -521,10 +547,29 @@ impl Transaction {
         &self.label
     }
 
+    /// The kind of change the gesture makes.
+    pub fn kind(&self) -> ChangeKind {
+        self.kind
+    }
+
+    /// The gesture goes on with a change of `kind` too.
+    pub fn widen(&mut self, kind: ChangeKind) {
+        self.kind = self.kind.and(kind);
+    }
+
     /// Ends the gesture: one history entry, or none if the document is unchanged.
     pub fn commit(self, history: &mut History, document: &Document) -> bool {
         match Command::record(self.label, &self.start, document) {
             Some(command) => {
+                // The kind said while the gesture ran decided what the asset redid: the
+                // history's own diff must not ask for more.
+                debug_assert!(
+                    command.change_kind() <= self.kind,
+                    "{}: declared {:?}, its diff is {:?}",
+                    command.label(),
+                    self.kind,
+                    command.change_kind()
+                );
                 history.push(command);
                 true
             }

@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 
 use glam::DVec2;
 use hairloom_core::edit;
+use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::mesh::WMode;
 use hairloom_core::runtime::atlas::{Atlas, build_atlas};
 use hairloom_core::runtime::textures::MAX_REGION_SIDE;
@@ -129,7 +130,7 @@ impl LayoutPanel {
                 let start = state.edit_start().hair_mesh.clone();
                 match edit::set_corner_uvs(&start, &changes) {
                     Ok(outcome) => {
-                        state.edit("Move uv").hair_mesh = outcome.mesh;
+                        state.edit(ChangeKind::Reshape, "Move uv").hair_mesh = outcome.mesh;
                         state.message = format!(
                             "uv ({:.4}, {:.4}) to ({:.4}, {:.4})",
                             drag.start_uv.x, drag.start_uv.y, target.x, target.y
@@ -262,7 +263,9 @@ impl LayoutPanel {
                     };
                     let start = state.edit_start().hair_mesh.clone();
                     match edit::set_w(&start, vertex, value) {
-                        Ok(outcome) => state.edit("set w").hair_mesh = outcome.mesh,
+                        Ok(outcome) => {
+                            state.edit(ChangeKind::Reshape, "set w").hair_mesh = outcome.mesh
+                        }
                         Err(error) => state.message = format!("set w: {error}"),
                     }
                 }

@@ -245,6 +245,7 @@ pub(crate) fn create_private_dir(dir: &Path) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hairloom_core::model::change::ChangeKind;
 
     #[test]
     fn write_pending_load_and_discard() {
@@ -252,7 +253,12 @@ mod tests {
         let recovery = Recovery::in_dir(dir.path().join("nested"));
         assert!(recovery.pending().is_none());
         let mut state = EditorState::sample();
-        state.edit("curl").styling.global.curl.radius_m = 0.003;
+        state
+            .edit(ChangeKind::Restyle, "curl")
+            .styling
+            .global
+            .curl
+            .radius_m = 0.003;
         state.commit_edit();
         recovery.write(&state).expect("autosave");
         let pending = recovery.pending().expect("pending");
@@ -275,10 +281,15 @@ mod tests {
         let dir = tempfile::tempdir().expect("temp dir");
         let recovery = Recovery::in_dir(dir.path());
         let mut state = EditorState::sample();
-        state.edit("curl").styling.global.curl.radius_m = 0.003;
+        state
+            .edit(ChangeKind::Restyle, "curl")
+            .styling
+            .global
+            .curl
+            .radius_m = 0.003;
         state.commit_edit();
         // The gesture is still open when the autosave runs.
-        if let Some(p) = state.edit("Move").hair_mesh.columns[25]
+        if let Some(p) = state.edit(ChangeKind::Reshape, "Move").hair_mesh.columns[25]
             .positions
             .last_mut()
         {
@@ -305,7 +316,12 @@ mod tests {
         let dir = tempfile::tempdir().expect("temp dir");
         let recovery = Recovery::in_dir(dir.path());
         let mut state = EditorState::sample();
-        state.edit("curl").styling.global.curl.radius_m = 0.003;
+        state
+            .edit(ChangeKind::Restyle, "curl")
+            .styling
+            .global
+            .curl
+            .radius_m = 0.003;
         state.commit_edit();
         recovery.write(&state).expect("autosave");
         // The old bug's file: the document moved on without its history step.

@@ -4,6 +4,7 @@
 //! (a drag is one step), validated with the field named; the viewport draws it on the next
 //! frame.
 
+use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::motion::Motion;
 use hairloom_core::model::scene::{
     Coverage, Effects, FIBRE_OFFSET_CHOICES, HairMaterial, Light, LightSource, MAX_LIGHTS,
@@ -31,7 +32,7 @@ fn edit_scene(
 ) {
     if response.changed() {
         let before = state.document().scene.clone();
-        let document = state.edit(label);
+        let document = state.edit(ChangeKind::Scene, label);
         change(&mut document.scene);
         if let Err(error) = document.scene.validate() {
             document.scene = before;
@@ -626,7 +627,11 @@ fn lights_ui(ui: &mut egui::Ui, state: &mut EditorState) {
             });
     }
     if let Some(i) = remove {
-        state.edit("Scene: remove light").scene.lights.remove(i);
+        state
+            .edit(ChangeKind::Scene, "Scene: remove light")
+            .scene
+            .lights
+            .remove(i);
         state.commit_edit();
     }
     ui.horizontal(|ui| {
@@ -636,7 +641,7 @@ fn lights_ui(ui: &mut egui::Ui, state: &mut EditorState) {
         {
             let n = lights.len() + 1;
             state
-                .edit("Scene: add light")
+                .edit(ChangeKind::Scene, "Scene: add light")
                 .scene
                 .lights
                 .push(Light::directional(
@@ -652,7 +657,10 @@ fn lights_ui(ui: &mut egui::Ui, state: &mut EditorState) {
             .on_hover_text("key, fill and rim lights")
             .clicked()
         {
-            state.edit("Scene: default lights").scene.lights = Scene::default().lights;
+            state
+                .edit(ChangeKind::Scene, "Scene: default lights")
+                .scene
+                .lights = Scene::default().lights;
             state.commit_edit();
         }
     });
@@ -697,7 +705,10 @@ fn environment_ui(ui: &mut egui::Ui, state: &mut EditorState) {
     );
     edit_scene(state, &r, "Scene: exposure", |s| s.exposure = exposure);
     if ui.button("Reset effects to the defaults").clicked() {
-        state.edit("Scene: default effects").scene.effects = Effects::default();
+        state
+            .edit(ChangeKind::Scene, "Scene: default effects")
+            .scene
+            .effects = Effects::default();
         state.commit_edit();
     }
 }
@@ -813,13 +824,23 @@ fn motion_ui(ui: &mut egui::Ui, state: &mut EditorState) {
     ui.horizontal(|ui| {
         if ui.button("Head turn").clicked() {
             let keys = Motion::head_turn(0.3, 0.6, 70.0).head_animation;
-            if let Some(motion) = state.edit("Scene: head turn").scene.motion.as_mut() {
+            if let Some(motion) = state
+                .edit(ChangeKind::Scene, "Scene: head turn")
+                .scene
+                .motion
+                .as_mut()
+            {
                 motion.head_animation = keys;
             }
             state.commit_edit();
         }
         if ui.button("Still head").clicked() {
-            if let Some(motion) = state.edit("Scene: still head").scene.motion.as_mut() {
+            if let Some(motion) = state
+                .edit(ChangeKind::Scene, "Scene: still head")
+                .scene
+                .motion
+                .as_mut()
+            {
                 motion.head_animation.clear();
             }
             state.commit_edit();

@@ -11,6 +11,7 @@ use std::collections::BTreeSet;
 use hairloom_core::edit::select;
 use hairloom_core::edit::{EditError, EditOutcome};
 use hairloom_core::io::project::{self, Project};
+use hairloom_core::model::change::{ChangeKind, ChangeLog};
 use hairloom_core::model::document::Document;
 use hairloom_core::model::history::Transaction;
 use hairloom_core::{HairMesh, Topology, VertexRef};
@@ -82,6 +83,8 @@ pub struct EditorState {
     /// Changes whenever the document changes (the viewport rebuilds its GPU data). Unique
     /// across states, so a state replacing another (opened, recovered) never reuses one.
     pub revision: u64,
+    /// The kind of change that made each revision (what the viewport's hair asset redoes).
+    changes: ChangeLog,
     /// The last message for the status bar (errors included).
     pub message: String,
     /// Selected bundles: view state, never saved and never in the history.
@@ -97,12 +100,14 @@ pub struct EditorState {
 
 impl EditorState {
     pub(super) fn from_project(project: Project, path: Option<PathBuf>, message: String) -> Self {
+        let revision = next_revision();
         Self {
             saved: project.document.clone(),
             project,
             path,
             edit: None,
-            revision: next_revision(),
+            revision,
+            changes: ChangeLog::starting_at(revision),
             message,
             selection: BTreeSet::new(),
             vertex_selection: BTreeSet::new(),
@@ -133,7 +138,7 @@ impl EditorState {
     /// one undo step.
     pub fn import_scalp(&mut self, imported: Document, summary: &str) {
         self.commit_edit();
-        let document = self.edit("Import scalp");
+        let document = self.edit(ChangeKind::Rebuild, "Import scalp");
         document.name = imported.name;
         document.source = imported.source;
         document.hair_mesh = imported.hair_mesh;
@@ -229,13 +234,29 @@ impl EditorState {
         self.message = message;
     }
 
-    /// Starts an edit (one undo step) unless one is running; returns the document to change.
-    pub fn edit(&mut self, label: &str) -> &mut Document {
-        if self.edit.is_none() {
-            self.edit = Some(Transaction::begin(&self.project.document, label));
+    /// Starts an edit (one undo step) making changes of `kind` unless one is running (which
+    /// then goes on with changes of `kind` too); returns the document to change.
+    pub fn edit(&mut self, kind: ChangeKind, label: &str) -> &mut Document {
+        match &mut self.edit {
+            Some(edit) => edit.widen(kind),
+            None => self.edit = Some(Transaction::begin(&self.project.document, label, kind)),
         }
-        self.revision = next_revision();
+        self.bump_revision(kind);
         &mut self.project.document
+    }
+
+    /// A new revision, made by a change of `kind`.
+    fn bump_revision(&mut self, kind: ChangeKind) {
+        self.revision = next_revision();
+        self.changes.record(self.revision, kind);
+    }
+
+    /// What changed in the document since `revision`: `None` when nothing did.
+    pub fn change_since(&self, revision: u64) -> Option<ChangeKind> {
+        if revision == self.revision {
+            return None;
+        }
+        self.changes.since(revision)
     }
 
     /// The project as a consistent, loadable whole, without disturbing a running edit: an
@@ -267,8 +288,9 @@ impl EditorState {
     /// Abandons the running edit and restores the document as it was before it.
     pub fn cancel_edit(&mut self) {
         if let Some(edit) = self.edit.take() {
+            let kind = edit.kind();
             edit.cancel(&mut self.project.document);
-            self.revision = next_revision();
+            self.bump_revision(kind);
         }
     }
 
@@ -394,7 +416,8 @@ impl EditorState {
                 if outcome.mesh.columns.len() < self.project.document.hair_mesh.columns.len() {
                     self.vertex_selection.clear();
                 }
-                self.edit(label).hair_mesh = outcome.mesh;
+                // One-shot mesh edits (extrude, split, merge…) may change topology.
+                self.edit(ChangeKind::Rebuild, label).hair_mesh = outcome.mesh;
                 self.commit_edit();
                 self.message = format!(
                     "{label}: {} bundle(s) changed",
@@ -420,7 +443,7 @@ impl EditorState {
     pub fn undo(&mut self) {
         self.commit_edit();
         match self.project.history.undo(&mut self.project.document) {
-            Ok(Some(label)) => self.changed(format!("undid {label}")),
+            Ok(Some(step)) => self.changed(format!("undid {}", step.label), step.kind),
             Ok(None) => self.message = "nothing to undo".into(),
             Err(error) => self.message = format!("undo failed: {error}"),
         }
@@ -429,7 +452,7 @@ impl EditorState {
     pub fn redo(&mut self) {
         self.commit_edit();
         match self.project.history.redo(&mut self.project.document) {
-            Ok(Some(label)) => self.changed(format!("redid {label}")),
+            Ok(Some(step)) => self.changed(format!("redid {}", step.label), step.kind),
             Ok(None) => self.message = "nothing to redo".into(),
             Err(error) => self.message = format!("redo failed: {error}"),
         }
@@ -443,13 +466,13 @@ impl EditorState {
             .history
             .jump_to(&mut self.project.document, position)
         {
-            Ok(()) => self.changed(format!("history step {position}")),
+            Ok(kind) => self.changed(format!("history step {position}"), kind),
             Err(error) => self.message = format!("history jump failed: {error}"),
         }
     }
 
-    fn changed(&mut self, message: String) {
-        self.revision = next_revision();
+    fn changed(&mut self, message: String, kind: ChangeKind) {
+        self.bump_revision(kind);
         self.message = message;
     }
 
@@ -488,7 +511,12 @@ mod tests {
         let mut state = EditorState::sample();
         let original = state.document().clone();
         for step in 1..=5 {
-            state.edit("curl").styling.global.curl.radius_m = 0.001 * step as f64;
+            state
+                .edit(ChangeKind::Restyle, "curl")
+                .styling
+                .global
+                .curl
+                .radius_m = 0.001 * step as f64;
         }
         state.commit_edit();
         assert!(state.is_dirty());
@@ -505,7 +533,12 @@ mod tests {
         let dir = tempfile::tempdir().expect("temp dir");
         let mut state = EditorState::sample();
         assert!(state.save().is_err(), "the sample needs Save As");
-        state.edit("wave").styling.global.wave.amplitude_m = 0.02;
+        state
+            .edit(ChangeKind::Restyle, "wave")
+            .styling
+            .global
+            .wave
+            .amplitude_m = 0.02;
         state.commit_edit();
         let path = dir.path().join("styled.hairloom");
         state.save_as(&path).expect("save");

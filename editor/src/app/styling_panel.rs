@@ -2,6 +2,7 @@
 //! double-click), for the global parameters or one styling group. A slider drag is one undo
 //! step; keyboard and typed changes commit at once.
 
+use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::styling::StylingParams;
 
 use super::state::EditorState;
@@ -193,7 +194,8 @@ impl StylingPanel {
                                     .clamping(egui::SliderClamping::Never),
                             );
                             if response.changed() && value.is_finite() {
-                                let document = state.edit(&format!("set {label}"));
+                                let document =
+                                    state.edit(ChangeKind::Restyle, &format!("set {label}"));
                                 *field(params_mut(document, group)) = value;
                                 if let Err(error) = document.styling.validate() {
                                     // Out of range (typed): put the old value back.
@@ -212,7 +214,7 @@ impl StylingPanel {
                     .add(egui::DragValue::new(&mut seed))
                     .labelled_by(label.id);
                 if response.changed() {
-                    params_mut(state.edit("set seed"), group).seed = seed;
+                    params_mut(state.edit(ChangeKind::Restyle, "set seed"), group).seed = seed;
                 }
                 commit_when_done(state, &response);
             });
@@ -230,7 +232,7 @@ impl StylingPanel {
                 .add_enabled(has_selection, egui::Button::new("New group from selection"))
                 .clicked()
             {
-                let styling = &mut state.edit("New styling group").styling;
+                let styling = &mut state.edit(ChangeKind::Restyle, "New styling group").styling;
                 let name = format!("{}", styling.groups.len() + 1);
                 self.group = Some(styling.new_group(name, &selection));
                 state.commit_edit();
@@ -241,7 +243,7 @@ impl StylingPanel {
                     .clicked()
             {
                 let result = state
-                    .edit("Assign to group")
+                    .edit(ChangeKind::Restyle, "Assign to group")
                     .styling
                     .assign(&selection, Some(g));
                 state.commit_edit();
@@ -254,7 +256,7 @@ impl StylingPanel {
                 .clicked()
             {
                 let _ = state
-                    .edit("Back to global")
+                    .edit(ChangeKind::Restyle, "Back to global")
                     .styling
                     .assign(&selection, None);
                 state.commit_edit();
@@ -277,7 +279,8 @@ impl StylingPanel {
             if let Some(copied) = &self.copied
                 && ui.button("Paste parameters").clicked()
             {
-                *params_mut(state.edit("Paste styling"), self.group) = copied.clone();
+                *params_mut(state.edit(ChangeKind::Restyle, "Paste styling"), self.group) =
+                    copied.clone();
                 state.commit_edit();
             }
         });

@@ -2,6 +2,7 @@
 //! remove / restore, subdivide, split / merge. Each tool is one undo step; errors go to the status bar.
 
 use hairloom_core::edit::{self, ExtrudeDirection};
+use hairloom_core::model::change::ChangeKind;
 
 use super::gizmo::GizmoKind;
 use super::state::{DragTool, EditorState, SelectMode};
@@ -305,7 +306,7 @@ impl ToolsPanel {
                     Ok((outcome, pairs)) => {
                         let styling =
                             edit::mirror_styling(&document.styling, &outcome.mesh, &pairs);
-                        let edited = state.edit("Mirror shape");
+                        let edited = state.edit(ChangeKind::Rebuild, "Mirror shape");
                         edited.hair_mesh = outcome.mesh;
                         edited.styling = styling;
                         state.commit_edit();

@@ -661,13 +661,14 @@ fn edit_latency(
     runs: usize,
     out: Option<&std::path::Path>,
 ) -> anyhow::Result<()> {
+    use hairloom_core::model::change::ChangeKind;
     use hairloom_core::runtime::frame_plan::LodSettings;
     use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
-    use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-    use hairloom_render::renderer::preview_body::GpuBody;
-    use hairloom_render::renderer::strand_gen::{GpuHair, StrandGenRenderer};
+    use hairloom_render::hair_asset::{AssetChange, HairAsset};
+    use hairloom_render::preview::{Camera, PreviewRenderer};
+    use hairloom_render::renderer::strand_gen::StrandGenRenderer;
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = super::render::parse_size(size)?;
     let mut document = hairloom_core::io::project::load(&path)?.document;
@@ -682,12 +683,14 @@ fn edit_latency(
         ..RuntimeOptions::default()
     };
     let vertex_count = (1u32 << super::render::PREVIEW_VERTICES_LOG2) + 1;
-    let mut hair = RuntimeHair::from_document(&document, &options);
-    let mut gpu = generator.upload(&context, &hair)?;
-    let bounds = hair
-        .textures
-        .hair_bounds()
-        .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
+    // The viewport's asset: every edit below is a change of its kind taken to the GPU by
+    // `HairAsset::apply`, as the viewport's paint callback does.
+    let mut asset = HairAsset::upload(
+        &context,
+        &generator,
+        RuntimeHair::from_document(&document, &options),
+    )?;
+    let bounds = asset.bounds();
     let pad = (bounds.1 - bounds.0) * 0.05;
     let camera = Camera::framing(
         bounds.0 - pad,
@@ -696,20 +699,18 @@ fn edit_latency(
     );
     // The frame of `lighting` at `width × height` (the viewport's full picture with the
     // document's scene; an interactive frame without effects and smaller).
-    let frame_of = |gpu: &GpuHair,
-                    body: &GpuBody,
+    let frame_of = |asset: &HairAsset,
                     lighting: &hairloom_core::model::scene::Scene,
                     quality: FrameQuality|
      -> anyhow::Result<Vec<u8>> {
         let [width, height] = quality.size([width, height]);
         let scene = hairloom_render::preview::default_scene(
-            body,
-            HairSource::Generated {
-                generator: &generator,
-                hair: gpu,
-                filtering: Filtering::Exact,
-                lod: quality.lod(LodSettings::default()),
-            },
+            asset.body(),
+            asset.source(
+                &generator,
+                Filtering::Exact,
+                quality.lod(LodSettings::default()),
+            ),
             vertex_count,
             bounds,
             camera,
@@ -719,12 +720,8 @@ fn edit_latency(
         Ok(preview.render(&context, &scene, &plan, width, height)?)
     };
     let full_scene = document.scene.clone();
-    let frame = |gpu: &GpuHair, body: &GpuBody| {
-        frame_of(gpu, body, &full_scene, FrameQuality::Full).map(|_| ())
-    };
-    // The body is uploaded once per document, as the viewport does.
-    let body = GpuBody::upload(&context, &hair.body);
-    frame(&gpu, &body)?; // warm-up: pipelines, first allocations
+    let frame = |asset: &HairAsset| frame_of(asset, &full_scene, FrameQuality::Full).map(|_| ());
+    frame(&asset)?; // warm-up: pipelines, first allocations
     let timed = |mut step: Box<dyn FnMut(usize) -> anyhow::Result<()> + '_>| {
         let mut samples = Vec::with_capacity(runs);
         for run in 0..runs {
@@ -748,21 +745,27 @@ fn edit_latency(
         let to_pixels = timed(Box::new(|run| step(run, true)))?;
         anyhow::Ok([to_gpu, to_pixels])
     };
-    let frame_only = timed(Box::new(|_| frame(&gpu, &body)))?;
+    // Takes `document`'s change of `kind` to the asset; says what the asset did.
+    let apply = |asset: &mut HairAsset,
+                 document: &hairloom_core::Document,
+                 kind: ChangeKind|
+     -> anyhow::Result<ChangeKind> {
+        let change = AssetChange::build(document, kind, &options)
+            .ok_or_else(|| anyhow::anyhow!("a {kind:?} leaves the asset alone"))?;
+        Ok(asset.apply(&context, &generator, change)?)
+    };
+    let frame_only = timed(Box::new(|_| frame(&asset)))?;
     let curl = |run: usize| 0.002 + 0.0001 * run as f64;
     let mut styled = document.clone();
     let rebuild = timed_both(Box::new(|run, draw| {
         styled.styling.global.curl.radius_m = curl(run);
-        let hair = RuntimeHair::from_document(&styled, &options);
-        let gpu = generator.upload(&context, &hair)?;
-        let body = GpuBody::upload(&context, &hair.body);
-        if draw { frame(&gpu, &body) } else { idle() }
+        apply(&mut asset, &styled, ChangeKind::Rebuild)?;
+        if draw { frame(&asset) } else { idle() }
     }))?;
     let in_place = timed_both(Box::new(|run, draw| {
         document.styling.global.curl.radius_m = curl(run);
-        hair.set_styling(&document.styling);
-        generator.update_styling(&context, &mut gpu, &hair);
-        if draw { frame(&gpu, &body) } else { idle() }
+        apply(&mut asset, &document, ChangeKind::Restyle)?;
+        if draw { frame(&asset) } else { idle() }
     }))?;
     let topology = Topology::build(&document.hair_mesh);
     let vertex = document
@@ -779,6 +782,7 @@ fn edit_latency(
         })
         .ok_or_else(|| anyhow::anyhow!("no exterior tip vertex to drag"))?;
     let mut dragged = document.clone();
+    let mut drag_in_place = true;
     let drag = timed_both(Box::new(|run, draw| {
         let outcome = transform_vertices(
             &document.hair_mesh,
@@ -789,10 +793,10 @@ fn edit_latency(
             0.0,
         )?;
         dragged.hair_mesh = outcome.mesh;
-        // A mesh edit leaves the body alone: it stays uploaded.
-        let hair = RuntimeHair::from_document(&dragged, &options);
-        let gpu = generator.upload(&context, &hair)?;
-        if draw { frame(&gpu, &body) } else { idle() }
+        // A drag is a reshape: the runtime data is made again and its textures rewritten in
+        // place (the body stays uploaded).
+        drag_in_place &= apply(&mut asset, &dragged, ChangeKind::Reshape)? == ChangeKind::Reshape;
+        if draw { frame(&asset) } else { idle() }
     }))?;
     println!(
         "edit-to-frame latency, {} ({} strands per bundle, {width}x{height}); {}; adapter {}",
@@ -829,7 +833,15 @@ fn edit_latency(
         in_place,
         true,
     );
-    row("vertex drag, edit + rebuild + re-upload", drag, true);
+    row(
+        if drag_in_place {
+            "vertex drag, edit + runtime data, textures in place"
+        } else {
+            "vertex drag, edit + runtime data + re-upload"
+        },
+        drag,
+        true,
+    );
     row("frame alone (no edit)", [0.0, frame_only], false);
 
     // While the artist drags the slider the viewport draws interactive frames (see
@@ -851,9 +863,8 @@ fn edit_latency(
     let mut slider_tick = |quality: FrameQuality, lighting| {
         tick += 1;
         document.styling.global.curl.radius_m = curl(tick);
-        hair.set_styling(&document.styling);
-        generator.update_styling(&context, &mut gpu, &hair);
-        frame_of(&gpu, &body, lighting, quality)
+        apply(&mut asset, &document, ChangeKind::Restyle)?;
+        frame_of(&asset, lighting, quality)
     };
     let mut full_ms = 0.0;
     for (name, quality, lighting) in [

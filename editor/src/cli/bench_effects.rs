@@ -10,9 +10,9 @@ use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::{GpuContext, describe};
+use hairloom_render::hair_asset::HairAsset;
 use hairloom_render::measure::{effect_configurations, effect_costs};
-use hairloom_render::preview::{Camera, HairSource, default_scene};
-use hairloom_render::renderer::preview_body::GpuBody;
+use hairloom_render::preview::{Camera, default_scene};
 use hairloom_render::renderer::strand_gen::StrandGenRenderer;
 
 pub fn run(
@@ -26,7 +26,6 @@ pub fn run(
     let document = hairloom_core::io::project::load(&path)?.document;
     let context = GpuContext::new_headless()?;
     let generator = StrandGenRenderer::new(&context);
-    let body = GpuBody::upload(&context, &document.body);
     println!(
         "Effects on demand: frame time and GPU memory of each effect, {width}x{height}: {}",
         path.display()
@@ -48,31 +47,30 @@ pub fn run(
     let bundles = document.hair_mesh.bundles.len().max(1);
     for &count in strands {
         let per_bundle = count.div_ceil(bundles).clamp(1, 4096) as u32;
-        let hair = RuntimeHair::from_document(
-            &document,
-            &RuntimeOptions {
-                strands_per_bundle: per_bundle,
-                ..RuntimeOptions::default()
-            },
-        );
-        let gpu_hair = generator.upload(&context, &hair)?;
-        let (lo, hi) = hair
-            .textures
-            .hair_bounds()
-            .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
+        let asset = HairAsset::upload(
+            &context,
+            &generator,
+            RuntimeHair::from_document(
+                &document,
+                &RuntimeOptions {
+                    strands_per_bundle: per_bundle,
+                    ..RuntimeOptions::default()
+                },
+            ),
+        )?;
+        let (lo, hi) = asset.bounds();
         let pad = (hi - lo) * 0.05;
         let camera = Camera::framing(lo - pad, hi + pad, glam::Vec3::new(0.75, 0.25, 1.0));
         let scene = default_scene(
-            &body,
-            HairSource::Generated {
-                generator: &generator,
-                hair: &gpu_hair,
-                filtering: Filtering::Exact,
-                lod: LodSettings {
+            asset.body(),
+            asset.source(
+                &generator,
+                Filtering::Exact,
+                LodSettings {
                     enabled: false,
                     ..LodSettings::default()
                 },
-            },
+            ),
             17,
             (lo, hi),
             camera,
@@ -90,7 +88,7 @@ pub fn run(
         for cost in &costs {
             println!(
                 "{:>8} {:<28} {:>10.1} {:>10.1} {:>7.2}× {:>11.2} {:>11}",
-                gpu_hair.root_count,
+                asset.gpu().root_count,
                 cost.name,
                 cost.frame_ms,
                 cost.frame_ms - base_ms,

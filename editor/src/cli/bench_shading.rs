@@ -21,10 +21,8 @@ use hairloom_core::runtime::hair::{DEFAULT_SAMPLE_SEED, RuntimeHair, RuntimeOpti
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::strands::reference::{StrandOptions, generate_parallel};
 use hairloom_render::device::{GpuContext, describe};
-use hairloom_render::preview::{
-    Camera, HairSource, PreviewRenderer, default_scene, default_strand_width_m,
-};
-use hairloom_render::renderer::preview_body::GpuBody;
+use hairloom_render::hair_asset::HairAsset;
+use hairloom_render::preview::{Camera, PreviewRenderer, default_scene, default_strand_width_m};
 use hairloom_render::renderer::strand_gen::StrandGenRenderer;
 
 /// The framings: name and the fraction of the picture's height the hair (its box's largest
@@ -131,19 +129,19 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
         let path = hairloom_core::samples::default_sample_path()
             .with_file_name(format!("{name}.hairloom"));
         let document = hairloom_core::io::project::load(&path)?.document;
-        let hair = RuntimeHair::from_document(
-            &document,
-            &RuntimeOptions {
-                strands_per_bundle: settings.strands_per_bundle,
-                ..RuntimeOptions::default()
-            },
-        );
-        let gpu_hair = generator.upload(&context, &hair)?;
-        let body = GpuBody::upload(&context, &hair.body);
-        let (lo, hi) = hair
-            .textures
-            .hair_bounds()
-            .ok_or_else(|| anyhow::anyhow!("{name}: no bundle grows hair"))?;
+        let asset = HairAsset::upload(
+            &context,
+            &generator,
+            RuntimeHair::from_document(
+                &document,
+                &RuntimeOptions {
+                    strands_per_bundle: settings.strands_per_bundle,
+                    ..RuntimeOptions::default()
+                },
+            ),
+        )
+        .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        let (lo, hi) = asset.bounds();
         let width_m = default_strand_width_m(lo, hi);
         let fibres = reference_fibres(&document, settings.strands_per_bundle, width_m as f64);
         // The framings size the hair by its largest side.
@@ -181,13 +179,8 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
                     ..document.scene.clone()
                 };
                 let scene = default_scene(
-                    &body,
-                    HairSource::Generated {
-                        generator: &generator,
-                        hair: &gpu_hair,
-                        filtering: Filtering::Exact,
-                        lod: LodSettings::default(),
-                    },
+                    asset.body(),
+                    asset.source(&generator, Filtering::Exact, LodSettings::default()),
                     17,
                     (lo, hi),
                     camera,

@@ -9,14 +9,15 @@ use std::path::Path;
 use anyhow::{Context, bail};
 use glam::Vec3;
 use hairloom_core::io::runtime_bundle::load_runtime_bundle;
+use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::scene::Scene;
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{DEFAULT_STRANDS_PER_BUNDLE, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::runtime::textures::Precision;
 use hairloom_render::device::{GpuContext, describe};
-use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
-use hairloom_render::renderer::preview_body::GpuBody;
+use hairloom_render::hair_asset::{AssetChange, HairAsset};
+use hairloom_render::preview::{Camera, PreviewRenderer, default_scene};
 use hairloom_render::renderer::strand_gen::{GenerationPath, StrandGenRenderer};
 
 /// The longest simulated time a command accepts (`--time`, `--seconds`): bounded work.
@@ -140,11 +141,13 @@ pub fn load_hair(path: &Path, settings: &RenderSettings) -> anyhow::Result<Runti
     }
 }
 
-/// The GPU renderers of a headless picture, made once and reused for every frame of a
-/// sequence (`hairloom simulate`).
+/// The GPU renderers of a headless picture and the hair asset they draw, made once and reused
+/// for every frame of a sequence (`hairloom simulate`: each posed frame moves the asset's
+/// textures in place).
 pub struct HeadlessRenderer {
     generator: StrandGenRenderer,
     preview: PreviewRenderer,
+    asset: Option<HairAsset>,
 }
 
 impl HeadlessRenderer {
@@ -152,40 +155,49 @@ impl HeadlessRenderer {
         Self {
             generator: StrandGenRenderer::with_path(context, generation),
             preview: PreviewRenderer::new(context),
+            asset: None,
         }
     }
 
-    /// Draws `hair` seen from `direction` with a camera framing the box `frame`; returns
-    /// RGBA8 pixels and a one-line description.
+    /// Takes `hair`, a change of `kind` from what was shown before, to the GPU; returns what
+    /// was done (a reshape whose texture layout changed is a rebuild).
+    pub fn show(
+        &mut self,
+        context: &GpuContext,
+        hair: RuntimeHair,
+        kind: ChangeKind,
+    ) -> anyhow::Result<ChangeKind> {
+        let change = AssetChange::Hair {
+            hair: Box::new(hair),
+            kind,
+        };
+        HairAsset::apply_to(&mut self.asset, context, &self.generator, change)
+            .context("nothing to render")
+    }
+
+    /// Draws the shown hair seen from `direction` with a camera framing the box `frame`;
+    /// returns RGBA8 pixels and a one-line description.
     pub fn draw(
         &self,
         context: &GpuContext,
-        hair: &RuntimeHair,
         (width, height): (u32, u32),
         frame: (Vec3, Vec3),
         direction: Vec3,
         settings: &RenderSettings,
     ) -> anyhow::Result<(Vec<u8>, String)> {
-        let (vertices_log2, filtering) = (settings.vertices_log2, settings.filtering);
-        let gpu_hair = self.generator.upload(context, hair)?;
-        let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
-        let hair_bounds = hair
-            .textures
-            .hair_bounds()
-            .context("nothing to render: no bundle grows hair")?;
+        let asset = self
+            .asset
+            .as_ref()
+            .context("nothing to render: no hair shown")?;
+        let hair = asset.hair();
+        let vertex_count = (1u32 << settings.vertices_log2.min(8)) + 1;
         let camera = Camera::framing(frame.0, frame.1, direction);
-        let body = GpuBody::upload(context, &hair.body);
         let lighting = scene_for(hair, settings)?;
         let scene = default_scene(
-            &body,
-            HairSource::Generated {
-                generator: &self.generator,
-                hair: &gpu_hair,
-                filtering,
-                lod: settings.lod,
-            },
+            asset.body(),
+            asset.source(&self.generator, settings.filtering, settings.lod),
             vertex_count,
-            hair_bounds,
+            asset.bounds(),
             camera,
             &lighting,
         );
@@ -196,10 +208,10 @@ impl HeadlessRenderer {
         let summary = format!(
             "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), effects: {}, {}× MSAA, on {}",
             plan.strands,
-            gpu_hair.root_count,
+            asset.gpu().root_count,
             plan.vertices,
             if settings.lod.enabled { "on" } else { "off" },
-            filtering,
+            settings.filtering,
             hair.textures.precision,
             if names.is_empty() {
                 "none (Kajiya-Kay)".to_string()
@@ -227,20 +239,16 @@ pub fn still_frame(hair: &RuntimeHair) -> anyhow::Result<(Vec3, Vec3)> {
 /// Draws `hair` seen from `direction`; returns RGBA8 pixels and a one-line description.
 pub fn render_pixels(
     context: &GpuContext,
-    hair: &RuntimeHair,
+    hair: RuntimeHair,
     width: u32,
     height: u32,
     direction: Vec3,
     settings: &RenderSettings,
 ) -> anyhow::Result<(Vec<u8>, String)> {
-    HeadlessRenderer::new(context, settings.generation).draw(
-        context,
-        hair,
-        (width, height),
-        still_frame(hair)?,
-        direction,
-        settings,
-    )
+    let frame = still_frame(&hair)?;
+    let mut renderer = HeadlessRenderer::new(context, settings.generation);
+    renderer.show(context, hair, ChangeKind::Rebuild)?;
+    renderer.draw(context, (width, height), frame, direction, settings)
 }
 
 /// RGBA8 pixels as a PNG file, written atomically.
@@ -275,7 +283,7 @@ pub fn run(input: &Path, out: &Path, settings: &RenderSettings) -> anyhow::Resul
     let direction = parse_view(&settings.view, &hair.scene)?;
     scene_for(&hair, settings)?;
     let context = GpuContext::new_headless()?;
-    let (pixels, summary) = render_pixels(&context, &hair, width, height, direction, settings)?;
+    let (pixels, summary) = render_pixels(&context, hair, width, height, direction, settings)?;
     write_png(out, &pixels, width, height)?;
     println!("{}: {summary}", out.display());
     Ok(())

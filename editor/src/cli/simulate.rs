@@ -12,6 +12,7 @@ use clap::ValueEnum;
 use glam::Vec3;
 use hairloom_core::io::alembic::{groom::Groom, groom_animation};
 use hairloom_core::io::strand_files::{ScalpMesh, StrandExportSize, UsdFrame, usda_animation};
+use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::motion::{Motion, Wind};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::simulate::{posed_document, simulator};
@@ -170,7 +171,7 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
     let (centre, reach) = ((lo + hi) * 0.5, (hi - lo).length() * 0.3);
     let frame = (centre - Vec3::splat(reach), centre + Vec3::splat(reach));
 
-    let gpu = if !settings.no_render {
+    let mut gpu = if !settings.no_render {
         let context = GpuContext::new_headless()?;
         let renderer = HeadlessRenderer::new(&context, render_settings.generation);
         println!("adapter: {}", describe(&context.adapter_info));
@@ -203,16 +204,16 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         sim.seek(time_s);
         simulate_s += before.elapsed().as_secs_f64();
         let posed = posed_document(&document, &sim);
-        if let Some((context, renderer)) = &gpu {
-            let hair = RuntimeHair::from_document(&posed, &options);
-            let (pixels, _) = renderer.draw(
-                context,
-                &hair,
-                (width, height),
-                frame,
-                direction,
-                &render_settings,
-            )?;
+        if let Some((context, renderer)) = &mut gpu {
+            // The first frame uploads the asset; later poses move its textures in place.
+            let kind = if i == 0 {
+                ChangeKind::Rebuild
+            } else {
+                ChangeKind::Reshape
+            };
+            renderer.show(context, RuntimeHair::from_document(&posed, &options), kind)?;
+            let (pixels, _) =
+                renderer.draw(context, (width, height), frame, direction, &render_settings)?;
             let path = settings.out.join(format!("frame_{i:04}.png"));
             write_png(&path, &pixels, width, height)?;
         }

@@ -2,6 +2,7 @@
 //! thread with the viewport's device: the Scene panel shows the numbers beside the switches.
 
 use super::*;
+use hairloom_render::hair_asset::HairAsset;
 use hairloom_render::measure::{EffectCost, effect_costs, toggled_effects};
 
 /// What an effect-cost measurement gives: the scene's frame first, then the frame with each
@@ -32,29 +33,24 @@ impl Viewport {
         let ctx = ctx.clone();
         std::thread::spawn(move || {
             let result = (|| -> anyhow::Result<Vec<EffectCost>> {
-                let hair = RuntimeHair::from_document(
-                    &document,
-                    &RuntimeOptions {
-                        precision: settings.precision,
-                        strands_per_bundle: settings.strands_per_bundle,
-                        ..RuntimeOptions::default()
-                    },
-                );
-                let bounds = hair
-                    .textures
-                    .hair_bounds()
-                    .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
-                let gpu_hair = generator.upload(&context, &hair)?;
-                let body = GpuBody::upload(&context, &hair.body);
+                // On this worker thread, never the UI's: the document's own asset.
+                let asset = HairAsset::upload(
+                    &context,
+                    &generator,
+                    RuntimeHair::from_document(
+                        &document,
+                        &RuntimeOptions {
+                            precision: settings.precision,
+                            strands_per_bundle: settings.strands_per_bundle,
+                            ..RuntimeOptions::default()
+                        },
+                    ),
+                )?;
+                let bounds = asset.bounds();
                 let (lo, hi) = camera_bounds.unwrap_or(bounds);
                 let scene = default_scene(
-                    &body,
-                    HairSource::Generated {
-                        generator: &generator,
-                        hair: &gpu_hair,
-                        filtering: settings.filtering,
-                        lod: settings.lod,
-                    },
+                    asset.body(),
+                    asset.source(&generator, settings.filtering, settings.lod),
                     17,
                     bounds,
                     orbit.camera(lo, hi),

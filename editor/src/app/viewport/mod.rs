@@ -38,20 +38,21 @@ use eframe::egui_wgpu;
 use glam::{DVec3, Vec3};
 use hairloom_core::edit::select::{self, Region};
 use hairloom_core::edit::{self, VertexTransform};
+use hairloom_core::model::change::ChangeKind;
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::runtime::textures::Precision;
 use hairloom_core::{Topology, VertexRef};
 use hairloom_render::device::{GpuContext, describe};
-use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-use hairloom_render::renderer::strand_gen::{GpuHair, StrandGenRenderer};
+use hairloom_render::hair_asset::AssetBuilder;
+use hairloom_render::preview::{Camera, PreviewRenderer};
+use hairloom_render::renderer::strand_gen::StrandGenRenderer;
 
 use super::gizmo::{GizmoAdapter, GizmoStep};
 use super::state::{DragTool, EditorState, SelectMode};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_render::measure::{AccuracyRow, measure_accuracy};
 use hairloom_render::preview::default_scene;
-use hairloom_render::renderer::preview_body::GpuBody;
 
 /// Storage buffers per shader stage the generation and preview pipelines bind.
 const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
@@ -152,17 +153,18 @@ pub struct Viewport {
     gpu: Option<Arc<egui::mutex::RwLock<egui_wgpu::Renderer>>>,
     /// What the panel hands to its paint callback and what the callback reports back.
     shared: paint::CallbackShared,
-    /// The hair last sent to the GPU (its mesh and body, to tell a styling-only edit), and
-    /// its box; `None` when no bundle grows hair.
-    hair_shown: Option<paint::ShownHair>,
+    /// Builds the hair's changes off the UI thread (only with a GPU).
+    builder: Option<AssetBuilder>,
+    /// What the builder was last asked for.
+    requested: Option<paint::RequestedAsset>,
+    /// The box of the last built hair: `Some(None)` when no bundle grows hair, `None` before
+    /// the first is built.
+    hair_bounds: Option<Option<(Vec3, Vec3)>>,
     /// A lost device or a GPU error the device reported outside any error scope: shown in
     /// the viewport instead of panicking (wgpu's default).
     device_problem: Arc<std::sync::Mutex<Option<String>>>,
     pub orbit: Orbit,
     pub settings: ViewSettings,
-    uploaded: Option<(u64, ViewSettings)>,
-    /// How often the hair went to the GPU, whole or restyled (tests count them).
-    pub uploads: UploadCounts,
     drawn: Option<DrawnKey>,
     /// The last full frame's time.
     full_frame_ms: Option<f64>,
@@ -283,16 +285,17 @@ impl Viewport {
                 .insert(paint::ViewportGpu::new(context, state.target_format));
             state.renderer.clone()
         });
+        let builder = gpu.is_some().then(AssetBuilder::new);
         Self {
             adapter,
             gpu,
             shared: paint::CallbackShared::default(),
-            hair_shown: None,
+            builder,
+            requested: None,
+            hair_bounds: None,
             device_problem,
             orbit: Orbit::default(),
             settings: ViewSettings::default(),
-            uploaded: None,
-            uploads: UploadCounts::default(),
             drawn: None,
             full_frame_ms: None,
             last_change: None,

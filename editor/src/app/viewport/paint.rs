@@ -8,7 +8,7 @@
 use super::*;
 use eframe::egui_wgpu::{CallbackResources, CallbackTrait, ScreenDescriptor};
 use hairloom_core::model::scene::Scene;
-use hairloom_core::model::styling::StylingSet;
+use hairloom_render::hair_asset::{AssetBuilder, AssetChange, HairAsset};
 use hairloom_render::renderer::strand_gen::GenerationPath;
 use hairloom_render::renderer::viewport_blit::ViewportBlitRenderer;
 
@@ -19,19 +19,10 @@ pub(super) struct ViewportGpu {
     pub(super) generator: Arc<StrandGenRenderer>,
     preview: PreviewRenderer,
     blit: ViewportBlitRenderer,
-    hair: Option<GpuSideHair>,
+    /// The shown document's hair on the GPU, changed only through [`HairAsset::apply`].
+    hair: Option<HairAsset>,
     /// The last rendered picture (the preview's kept colour target) and its blit binding.
     picture: Option<(wgpu::Texture, wgpu::BindGroup)>,
-}
-
-/// The hair on the GPU, with the asset it came from (its styling is rewritten in place).
-struct GpuSideHair {
-    gpu: GpuHair,
-    hair: RuntimeHair,
-    /// The body, uploaded with the hair (not per frame).
-    body: GpuBody,
-    /// The hair's box (strand width follows its size).
-    bounds: (Vec3, Vec3),
 }
 
 impl ViewportGpu {
@@ -52,58 +43,26 @@ impl ViewportGpu {
         }
     }
 
-    /// Takes a new asset: rewritten into the GPU textures in place when only the hair mesh
-    /// moved, uploaded afresh otherwise.
-    fn replace_hair(&mut self, replacement: Replacement, shared: &CallbackShared) {
-        let Replacement {
-            hair,
-            bounds,
-            reshape,
-        } = replacement;
-        if reshape
-            && let Some(uploaded) = self.hair.as_mut()
-            && self
-                .generator
-                .update_shape(&self.context, &mut uploaded.gpu, &hair)
-        {
-            // A head animation moves the body with the hair.
-            if uploaded.hair.body != hair.body {
-                uploaded.body = GpuBody::upload(&self.context, &hair.body);
-            }
-            uploaded.hair = *hair;
-            uploaded.bounds = bounds;
-            return;
-        }
-        let upload = self.generator.upload(&self.context, &hair);
-        let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
-        match upload {
-            Ok(gpu) => {
-                report.upload_error = None;
-                self.hair = Some(GpuSideHair {
-                    gpu,
-                    body: GpuBody::upload(&self.context, &hair.body),
-                    hair: *hair,
-                    bounds,
-                });
-            }
-            Err(error) => {
-                // Above the adapter's limits nothing is uploaded and the viewport says
-                // which limit; the document is untouched (undo the edit, or save it).
-                report.upload_error = Some(format!("cannot draw this hair: {error}"));
-                self.hair = None;
-            }
-        }
-    }
-
-    /// Does what the panel asked for, in order: a new asset or a restyle, then a frame.
+    /// Does what the panel asked for, in order: the asset's change, then a frame.
     fn apply(&mut self, work: PendingWork, shared: &CallbackShared, ctx: &egui::Context) {
-        if let Some(replacement) = work.full {
-            self.replace_hair(replacement, shared);
-        }
-        if let (Some(styling), Some(uploaded)) = (work.restyle, self.hair.as_mut()) {
-            uploaded.hair.set_styling(&styling);
-            self.generator
-                .update_styling(&self.context, &mut uploaded.gpu, &uploaded.hair);
+        if let Some(change) = work.change {
+            let applied =
+                HairAsset::apply_to(&mut self.hair, &self.context, &self.generator, change);
+            let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
+            match applied {
+                Ok(kind) => {
+                    report.upload_error = None;
+                    match kind {
+                        ChangeKind::Scene => {}
+                        ChangeKind::Restyle => report.uploads.styling += 1,
+                        ChangeKind::Reshape => report.uploads.shape += 1,
+                        ChangeKind::Rebuild => report.uploads.full += 1,
+                    }
+                }
+                // Above the adapter's limits nothing is uploaded and the viewport says which
+                // limit; the document is untouched (undo the edit, or save it).
+                Err(error) => report.upload_error = Some(format!("cannot draw this hair: {error}")),
+            }
         }
         let Some(frame) = work.frame else {
             return;
@@ -112,15 +71,10 @@ impl ViewportGpu {
             return;
         };
         let scene = default_scene(
-            &hair.body,
-            HairSource::Generated {
-                generator: &self.generator,
-                hair: &hair.gpu,
-                filtering: frame.filtering,
-                lod: frame.lod,
-            },
+            hair.body(),
+            hair.source(&self.generator, frame.filtering, frame.lod),
             17,
-            hair.bounds,
+            hair.bounds(),
             frame.camera,
             &frame.lighting,
         );
@@ -162,45 +116,20 @@ impl ViewportGpu {
     }
 }
 
-/// What the panel handed over and the callback has not done yet. Only the newest of each
-/// kind matters: a new asset supersedes older ones and any restyle before it.
+/// What the panel handed over and the callback has not done yet: the asset's changes, folded
+/// into one, and the newest frame.
 #[derive(Default)]
 pub(super) struct PendingWork {
-    /// A new asset and its hair's box.
-    full: Option<Replacement>,
-    /// New styling for the asset on the GPU.
-    restyle: Option<StylingSet>,
+    change: Option<AssetChange>,
     frame: Option<FrameRequest>,
 }
 
-/// A new asset for the GPU.
-struct Replacement {
-    hair: Box<RuntimeHair>,
-    /// The hair's box.
-    bounds: (Vec3, Vec3),
-    /// Only the hair mesh's positions changed since the asset on the GPU: its textures can
-    /// be rewritten in place.
-    reshape: bool,
-}
-
 impl PendingWork {
-    fn upload(&mut self, hair: RuntimeHair, bounds: (Vec3, Vec3), reshape: bool) {
-        // A reshape of an asset that has not reached the GPU yet is still a new asset.
-        let reshape = reshape && self.full.as_ref().is_none_or(|pending| pending.reshape);
-        self.full = Some(Replacement {
-            hair: Box::new(hair),
-            bounds,
-            reshape,
+    fn change(&mut self, change: AssetChange) {
+        self.change = Some(match self.change.take() {
+            Some(earlier) => earlier.then(change),
+            None => change,
         });
-        self.restyle = None;
-    }
-
-    fn restyle(&mut self, styling: &StylingSet) {
-        match self.full.as_mut() {
-            // Not uploaded yet: upload it restyled.
-            Some(pending) => pending.hair.set_styling(styling),
-            None => self.restyle = Some(styling.clone()),
-        }
     }
 }
 
@@ -223,6 +152,8 @@ pub(super) struct FrameReport {
     pub(super) error: Option<String>,
     /// The hair is above the adapter's limits.
     pub(super) upload_error: Option<String>,
+    /// How often the asset changed on the GPU, by kind.
+    pub(super) uploads: UploadCounts,
 }
 
 /// Shared between the panel and its paint callbacks.
@@ -384,72 +315,7 @@ impl Viewport {
         ];
         let quality = self.frame_quality(ui, state, full_size, settings);
         let size = quality.size(full_size);
-        let key = (state.shown_revision(), settings);
-        if self.uploaded != Some(key) {
-            let document = state.shown_document();
-            let mut pending = self
-                .shared
-                .pending
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
-            // A styling-only change (same hair mesh, body and view settings) rewrites the
-            // styling buffers in place: no texture rebuild, no re-upload.
-            let restyle = match (&self.hair_shown, self.uploaded) {
-                (Some(shown), Some((_, uploaded_settings)))
-                    if uploaded_settings == settings
-                        && shown.mesh == document.hair_mesh
-                        && shown.body == document.body =>
-                {
-                    pending.restyle(&document.styling);
-                    true
-                }
-                _ => false,
-            };
-            if restyle {
-                self.uploads.styling += 1;
-            } else {
-                // Same bundles, columns of the same lengths and settings: only positions
-                // moved (the body too, with a head animation), and the GPU textures are
-                // rewritten in place.
-                let reshape = match (&self.hair_shown, self.uploaded) {
-                    (Some(shown), Some((_, uploaded_settings))) => {
-                        uploaded_settings == settings
-                            && shown.mesh.bundles == document.hair_mesh.bundles
-                            && shown.mesh.columns.len() == document.hair_mesh.columns.len()
-                            && shown
-                                .mesh
-                                .columns
-                                .iter()
-                                .zip(&document.hair_mesh.columns)
-                                .all(|(a, b)| a.positions.len() == b.positions.len())
-                    }
-                    _ => false,
-                };
-                let hair = RuntimeHair::from_document(
-                    document,
-                    &RuntimeOptions {
-                        precision: self.settings.precision,
-                        strands_per_bundle: self.settings.strands_per_bundle,
-                        ..RuntimeOptions::default()
-                    },
-                );
-                self.hair_shown = hair.textures.hair_bounds().map(|bounds| ShownHair {
-                    mesh: document.hair_mesh.clone(),
-                    body: document.body.clone(),
-                    bounds,
-                });
-                if let Some(shown) = &self.hair_shown {
-                    pending.upload(hair, shown.bounds, reshape);
-                }
-                if reshape {
-                    self.uploads.shape += 1;
-                } else {
-                    self.uploads.full += 1;
-                }
-            }
-            self.uploaded = Some(key);
-            self.drawn = None;
-        }
+        self.request_asset_change(ui.ctx(), state, settings);
         let drawn = DrawnKey {
             revision: state.shown_revision(),
             settings,
@@ -458,12 +324,12 @@ impl Viewport {
             quality,
         };
         if self.drawn != Some(drawn) {
-            if let Some(shown) = &self.hair_shown {
+            if let Some(Some(bounds)) = self.hair_bounds {
                 if !self.framed_from_hair {
-                    self.camera_bounds = Some(shown.bounds);
+                    self.camera_bounds = Some(bounds);
                     self.framed_from_hair = true;
                 }
-                let (lo, hi) = self.camera_bounds.unwrap_or(shown.bounds);
+                let (lo, hi) = self.camera_bounds.unwrap_or(bounds);
                 let document_scene = &state.document().scene;
                 let lighting = match quality {
                     FrameQuality::Full => document_scene.clone(),
@@ -489,10 +355,14 @@ impl Viewport {
             self.drawn = Some(drawn);
         }
         // No hair first: an older upload or frame error is about hair no longer shown.
-        self.error = match (&self.hair_shown, &report.upload_error, &report.error) {
-            (None, _, _) => Some("no bundle grows hair".into()),
-            (Some(_), Some(error), _) | (Some(_), None, Some(error)) => Some(error.clone()),
-            (Some(_), None, None) => None,
+        self.error = match (self.hair_bounds, &report.upload_error, &report.error) {
+            (Some(None), _, _) => Some("no bundle grows hair".into()),
+            // Not built yet: nothing to say.
+            (None, _, _) => None,
+            (Some(Some(_)), Some(error), _) | (Some(Some(_)), None, Some(error)) => {
+                Some(error.clone())
+            }
+            (Some(Some(_)), None, None) => None,
         };
         ui.painter().add(egui_wgpu::Callback::new_paint_callback(
             rect,
@@ -536,10 +406,99 @@ impl Viewport {
     }
 }
 
-/// What the panel last sent to the GPU, on the CPU: a later change that leaves the mesh and
-/// body alone is styling only.
-pub(super) struct ShownHair {
-    mesh: hairloom_core::HairMesh,
-    body: hairloom_core::model::document::BodyMesh,
-    pub(super) bounds: (Vec3, Vec3),
+/// What the asset was last asked to show: the document's revision and the shown one (they
+/// differ while a motion poses the hair), and the settings the runtime data is built with.
+#[derive(Clone, Copy, PartialEq)]
+pub(super) struct RequestedAsset {
+    revision: u64,
+    shown_revision: u64,
+    precision: hairloom_core::runtime::textures::Precision,
+    strands_per_bundle: u32,
+}
+
+impl Viewport {
+    /// Asks the builder for what changed since the asset was last asked for — the change
+    /// kind comes from the editor's history ([`EditorState::change_since`]); the runtime data
+    /// is built on the builder's thread — and hands finished changes to the paint callback.
+    fn request_asset_change(
+        &mut self,
+        ctx: &egui::Context,
+        state: &EditorState,
+        settings: ViewSettings,
+    ) {
+        let Some(builder) = &self.builder else {
+            return;
+        };
+        let now = RequestedAsset {
+            revision: state.revision,
+            shown_revision: state.shown_revision(),
+            precision: settings.precision,
+            strands_per_bundle: settings.strands_per_bundle,
+        };
+        let kind = match self.requested {
+            None => Some(ChangeKind::Rebuild),
+            Some(then) if then == now => None,
+            Some(then)
+                if (then.precision, then.strands_per_bundle)
+                    != (now.precision, now.strands_per_bundle) =>
+            {
+                Some(ChangeKind::Rebuild)
+            }
+            Some(then) => {
+                // A motion's pose moves the hair mesh and the body, nothing else.
+                let posed_then = then.shown_revision != then.revision;
+                let posed_now = now.shown_revision != now.revision;
+                let pose = (now.shown_revision != then.shown_revision && (posed_then || posed_now))
+                    .then_some(ChangeKind::Reshape);
+                match (state.change_since(then.revision), pose) {
+                    (Some(a), Some(b)) => Some(a.and(b)),
+                    (a, b) => a.or(b),
+                }
+            }
+        };
+        if let Some(kind) = kind {
+            builder.request(
+                Arc::new(state.shown_document().clone()),
+                kind,
+                RuntimeOptions {
+                    precision: settings.precision,
+                    strands_per_bundle: settings.strands_per_bundle,
+                    ..RuntimeOptions::default()
+                },
+            );
+        }
+        self.requested = Some(now);
+        if let Some(change) = builder.poll() {
+            if let AssetChange::Hair { hair, .. } = &change {
+                self.hair_bounds = Some(hair.textures.hair_bounds());
+            }
+            self.shared
+                .pending
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .change(change);
+            self.drawn = None;
+        }
+        if builder.busy() {
+            // Come back for the built change without holding the UI.
+            ctx.request_repaint_after(std::time::Duration::from_millis(8));
+        }
+    }
+
+    /// Whether a change of the hair is being built off the UI thread.
+    pub fn is_building(&self) -> bool {
+        self.builder.as_ref().is_some_and(AssetBuilder::busy)
+    }
+
+    /// Blocks until the changes asked for are built (tests: the next frame then shows them).
+    pub fn wait_for_builds(&self) {
+        if let Some(builder) = &self.builder {
+            builder.wait();
+        }
+    }
+
+    /// How often the hair's asset changed on the GPU, by kind.
+    pub fn uploads(&self) -> UploadCounts {
+        self.report().uploads
+    }
 }

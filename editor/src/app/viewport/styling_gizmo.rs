@@ -20,6 +20,7 @@ use glam::DVec3;
 use hairloom_core::edit::styling_direction::{
     StylingAxes, shared_group, solve_in_basis, styling_axes, wave_direction_rad,
 };
+use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::styling::StylingParams;
 
 use super::Viewport;
@@ -561,7 +562,7 @@ fn apply_drag(
         Some(current) if *current != params => {}
         _ => return,
     }
-    let document = state.edit(drag.handle.label());
+    let document = state.edit(ChangeKind::Restyle, drag.handle.label());
     match placed.group {
         Some(g) => document.styling.groups[g].params = params,
         None => document.styling.global = params,

@@ -14,6 +14,14 @@ pub enum TransformKind {
 }
 
 impl TransformKind {
+    /// What the gesture asks of the hair asset: moved vertices reshape, a new layer rebuilds.
+    pub(super) fn change(self) -> ChangeKind {
+        match self {
+            Self::Move | Self::Rotate | Self::Scale => ChangeKind::Reshape,
+            Self::Extrude => ChangeKind::Rebuild,
+        }
+    }
+
     pub(super) fn label(self) -> &'static str {
         match self {
             Self::Move => "Move",
@@ -141,7 +149,7 @@ pub(super) fn preview_transform(
     );
     match moved {
         Ok(outcome) => {
-            state.edit(kind.label()).hair_mesh = outcome.mesh;
+            state.edit(kind.change(), kind.label()).hair_mesh = outcome.mesh;
             state.message = describe_transform(kind, axis, state.tool.z_up, transform)
                 + &format!(", soft radius {:.3} m", state.tool.soft_radius_m);
         }
@@ -515,7 +523,9 @@ impl Viewport {
                 );
                 match extruded {
                     Ok(outcome) => {
-                        state.edit(active.kind.label()).hair_mesh = outcome.mesh;
+                        state
+                            .edit(active.kind.change(), active.kind.label())
+                            .hair_mesh = outcome.mesh;
                         state.message = format!("Extrude: {distance:.4} m");
                     }
                     Err(error) => state.message = format!("Extrude: {error}"),

@@ -1,0 +1,281 @@
+//! The renderers a frame is made of, kept between frames: the ones every frame has (scene
+//! lighting, hair ribbons, body) and the effect renderers, which exist only while the scene's
+//! effects name them.
+
+use hairloom_core::model::scene::{Scene, SelfShadowing};
+
+use super::{FrameRenderer, Phase};
+use crate::device::GpuContext;
+use crate::renderer::Targets;
+use crate::renderer::body_shadow::BodyShadowRenderer;
+use crate::renderer::hair_shadow::HairShadowRenderer;
+use crate::renderer::oit_composite::OitRenderer;
+use crate::renderer::preview_body::BodyRenderer;
+use crate::renderer::preview_hair::{HairRenderer, RibbonInput};
+use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
+
+/// Which group-2 layout the lit shaders were made against.
+type EffectsLayoutKey = (SelfShadowing, bool, bool);
+
+/// One renderer per feature, made for the targets they draw into.
+pub struct FrameRenderers {
+    pub(crate) lighting: SceneLighting,
+    pub(crate) hair: HairRenderer,
+    pub(crate) body: BodyRenderer,
+    /// The group-2 layout of the lit shaders, for the effects that make it up.
+    effects_layout: Option<(EffectsLayoutKey, Option<wgpu::BindGroupLayout>)>,
+    pub(crate) hair_shadow: Option<HairShadowRenderer>,
+    pub(crate) body_shadow: Option<BodyShadowRenderer>,
+    pub(crate) oit: Option<OitRenderer>,
+    targets: Targets,
+    /// What the last [`Self::sync`] made them for.
+    pub(crate) active: ActiveEffects,
+    /// The material's mean forward transmittance per fibre (shadows use it).
+    pub(crate) mean_forward: [f32; 3],
+}
+
+impl FrameRenderers {
+    /// The renderers every frame has, for `targets`; effects come with [`Self::sync`].
+    pub fn new(context: &GpuContext, targets: Targets) -> Self {
+        Self {
+            lighting: SceneLighting::new(context),
+            hair: HairRenderer::with_targets(context, targets),
+            body: BodyRenderer::with_targets(context, targets),
+            effects_layout: None,
+            hair_shadow: None,
+            body_shadow: None,
+            oit: None,
+            targets,
+            active: ActiveEffects::none(),
+            mean_forward: [1.0; 3],
+        }
+    }
+
+    pub fn targets(&self) -> Targets {
+        self.targets
+    }
+
+    /// Makes what `active` needs for `scene` with ribbons fed by `input`, and frees what it
+    /// does not. Cheap when nothing changed.
+    pub fn sync(
+        &mut self,
+        context: &GpuContext,
+        active: &ActiveEffects,
+        scene: &Scene,
+        input: RibbonInput,
+    ) {
+        self.mean_forward = self.lighting.sync(context, active, &scene.material);
+        let layout_key = (
+            active.opacity_maps,
+            active.body_shadows,
+            active.dual_scattering,
+        );
+        if self
+            .effects_layout
+            .as_ref()
+            .is_none_or(|(key, _)| *key != layout_key)
+        {
+            self.effects_layout = Some((layout_key, effects_layout(context, active)));
+            // Pipelines made with the old layout go with it.
+            self.hair = HairRenderer::with_targets(context, self.targets);
+            self.body = BodyRenderer::with_targets(context, self.targets);
+        }
+        let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
+        self.hair.ensure(
+            context,
+            active,
+            &self.lighting.scene_layout,
+            effects_layout,
+            input,
+        );
+        self.body.ensure(
+            context,
+            active.shader_key(),
+            &self.lighting.scene_layout,
+            effects_layout,
+        );
+        let slots = active.shadow_slots;
+        self.hair_shadow = if active.opacity_maps != SelfShadowing::None && slots > 0 {
+            match self.hair_shadow.take() {
+                Some(kept)
+                    if kept.fits(
+                        active.opacity_maps,
+                        active.opacity_layers,
+                        active.shadow_resolution,
+                        slots,
+                        input,
+                    ) =>
+                {
+                    Some(kept)
+                }
+                // The old maps are freed before the new ones are made.
+                _ => Some(HairShadowRenderer::new(
+                    context,
+                    &self.hair,
+                    &self.lighting.scene_layout,
+                    active.opacity_maps,
+                    active.opacity_layers,
+                    active.shadow_resolution,
+                    slots,
+                    input,
+                )),
+            }
+        } else {
+            None
+        };
+        self.body_shadow = if active.body_shadows && slots > 0 {
+            match self.body_shadow.take() {
+                Some(kept)
+                    if (kept.resolution, kept.slots) == (active.shadow_resolution, slots) =>
+                {
+                    Some(kept)
+                }
+                _ => Some(BodyShadowRenderer::new(
+                    context,
+                    &self.body,
+                    active.shadow_resolution,
+                    slots,
+                )),
+            }
+        } else {
+            None
+        };
+        self.oit = if active.width_oit {
+            self.oit
+                .take()
+                .or_else(|| Some(OitRenderer::new(context, self.targets.sample_count)))
+        } else {
+            None
+        };
+        self.active = *active;
+    }
+
+    fn effects_layout(&self) -> Option<&wgpu::BindGroupLayout> {
+        self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref())
+    }
+
+    /// The group-2 bind group of the lit shaders over the effect renderers that exist;
+    /// `None` when the shaders take no group 2.
+    pub(crate) fn effects_group(&self, context: &GpuContext) -> Option<wgpu::BindGroup> {
+        let layout = self.effects_layout()?;
+        let mut entries = Vec::new();
+        let view = |binding, view| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(view),
+        };
+        if let Some(hair_shadow) = &self.hair_shadow {
+            entries.push(view(binding::OPACITY_LAYERS, &hair_shadow.opacity_view));
+            if let Some(first_hair) = hair_shadow.first_hair_view() {
+                entries.push(view(binding::FIRST_HAIR_DEPTH, first_hair));
+            }
+        }
+        if let Some(body_shadow) = &self.body_shadow {
+            entries.push(view(binding::BODY_DEPTH, &body_shadow.array_view));
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding::BODY_DEPTH_SAMPLER,
+                resource: wgpu::BindingResource::Sampler(&self.lighting.depth_sampler),
+            });
+        }
+        if let Some(ds) = &self.lighting.dual_scattering {
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding::TABLE_SAMPLER,
+                resource: wgpu::BindingResource::Sampler(&self.lighting.table_sampler),
+            });
+            entries.push(view(binding::DS_PROFILE, &ds.profile_view));
+            entries.push(view(binding::DS_LOBES, &ds.lobes_view));
+        }
+        Some(
+            context
+                .device
+                .create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("effects"),
+                    layout,
+                    entries: &entries,
+                }),
+        )
+    }
+
+    /// Every renderer that exists now, with the phases it takes part in, in the order they
+    /// were made (what a frame of the last synced scene records).
+    pub fn participants(&self) -> Vec<(&'static str, &'static [Phase])> {
+        let mut all: Vec<&dyn FrameRenderer> = vec![&self.lighting, &self.body, &self.hair];
+        if let Some(r) = &self.hair_shadow {
+            all.push(r);
+        }
+        if let Some(r) = &self.body_shadow {
+            all.push(r);
+        }
+        if let Some(r) = &self.oit {
+            all.push(r);
+        }
+        all.iter().map(|r| (r.name(), r.phases())).collect()
+    }
+
+    /// The phases a frame records now, in order.
+    pub fn phases(&self) -> Vec<Phase> {
+        let named: Vec<Phase> = self
+            .participants()
+            .iter()
+            .flat_map(|(_, phases)| phases.iter().copied())
+            .collect();
+        Phase::ORDER
+            .into_iter()
+            .filter(|phase| named.contains(phase))
+            .collect()
+    }
+}
+
+impl FrameRenderer for SceneLighting {
+    fn name(&self) -> &'static str {
+        "scene lighting"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        // Its uniforms and tables are read by every lit pass; it records none of its own.
+        &[]
+    }
+}
+
+impl FrameRenderer for BodyRenderer {
+    fn name(&self) -> &'static str {
+        "body"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::Opaque]
+    }
+}
+
+impl FrameRenderer for HairRenderer {
+    fn name(&self) -> &'static str {
+        "hair ribbons"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::DepthPrePass, Phase::Lit]
+    }
+}
+
+impl FrameRenderer for HairShadowRenderer {
+    fn name(&self) -> &'static str {
+        "hair shadows"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::ShadowViews]
+    }
+}
+
+impl FrameRenderer for BodyShadowRenderer {
+    fn name(&self) -> &'static str {
+        "body shadows"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::ShadowViews]
+    }
+}
+
+impl FrameRenderer for OitRenderer {
+    fn name(&self) -> &'static str {
+        "width coverage"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::Coverage, Phase::Composite]
+    }
+}

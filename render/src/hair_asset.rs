@@ -1,0 +1,376 @@
+//! One hair asset: a document's runtime data ([`RuntimeHair`]) and its GPU side together,
+//! changed one way. What changed in the document comes as a [`ChangeKind`], worked out in
+//! core from the undo history's diff; the CPU side of the change is built off the UI thread
+//! ([`AssetBuilder`]), then [`HairAsset::apply`] takes it to the GPU: a restyle rewrites the
+//! styling buffers, a reshape the textures in place (where their layout allows), a rebuild
+//! uploads afresh. The editor's viewport, the CLI's renders, the game runtime and the benches
+//! all hold their hair this way.
+//!
+//! A curl tick thus walks editor → document → change kind → asset change → GPU buffer →
+//! shader, one way.
+
+use std::sync::{Arc, Condvar, Mutex};
+
+use glam::Vec3;
+use hairloom_core::model::change::ChangeKind;
+use hairloom_core::model::document::Document;
+use hairloom_core::model::styling::StylingSet;
+use hairloom_core::runtime::frame_plan::LodSettings;
+use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::strand_gen::Filtering;
+
+use crate::device::GpuContext;
+use crate::frame::HairSource;
+use crate::renderer::preview_body::GpuBody;
+use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer};
+
+/// Why an asset could not be put on the GPU.
+#[derive(Debug, thiserror::Error)]
+pub enum HairAssetError {
+    #[error("no bundle grows hair")]
+    NoHair,
+    #[error(transparent)]
+    Upload(#[from] StrandGenError),
+    #[error("a {0:?} needs an asset on the GPU first")]
+    NothingToChange(ChangeKind),
+}
+
+/// The CPU side of a change, ready for the GPU.
+pub enum AssetChange {
+    /// New styling for the asset on the GPU.
+    Restyle(StylingSet),
+    /// The runtime data made again: taken in place when only positions moved
+    /// ([`ChangeKind::Reshape`]), uploaded afresh otherwise.
+    Hair {
+        hair: Box<RuntimeHair>,
+        kind: ChangeKind,
+    },
+}
+
+impl AssetChange {
+    /// Builds what a change of `kind` to `document` needs (the runtime data for a reshape or
+    /// a rebuild: the costly part, for a worker thread); `None` for a scene change, which
+    /// leaves the asset alone.
+    pub fn build(document: &Document, kind: ChangeKind, options: &RuntimeOptions) -> Option<Self> {
+        match kind {
+            ChangeKind::Scene => None,
+            ChangeKind::Restyle => Some(AssetChange::Restyle(document.styling.clone())),
+            ChangeKind::Reshape | ChangeKind::Rebuild => Some(AssetChange::Hair {
+                hair: Box::new(RuntimeHair::from_document(document, options)),
+                kind,
+            }),
+        }
+    }
+
+    pub fn kind(&self) -> ChangeKind {
+        match self {
+            AssetChange::Restyle(_) => ChangeKind::Restyle,
+            AssetChange::Hair { kind, .. } => *kind,
+        }
+    }
+
+    /// This change followed by `later`, as one change.
+    pub fn then(self, later: AssetChange) -> AssetChange {
+        let kind = self.kind().and(later.kind());
+        match (self, later) {
+            (_, AssetChange::Hair { hair, .. }) => AssetChange::Hair { hair, kind },
+            (AssetChange::Hair { mut hair, .. }, AssetChange::Restyle(styling)) => {
+                hair.set_styling(&styling);
+                AssetChange::Hair { hair, kind }
+            }
+            (AssetChange::Restyle(_), restyle) => restyle,
+        }
+    }
+}
+
+/// A runtime asset on the GPU: its textures, samples and styling, its body, and the box
+/// around its hair.
+pub struct HairAsset {
+    hair: RuntimeHair,
+    gpu: GpuHair,
+    body: GpuBody,
+    bounds: (Vec3, Vec3),
+}
+
+impl HairAsset {
+    /// Uploads `hair` with `generator`'s layouts.
+    pub fn upload(
+        context: &GpuContext,
+        generator: &StrandGenRenderer,
+        hair: RuntimeHair,
+    ) -> Result<Self, HairAssetError> {
+        let bounds = hair.textures.hair_bounds().ok_or(HairAssetError::NoHair)?;
+        let gpu = generator.upload(context, &hair)?;
+        Ok(Self {
+            body: GpuBody::upload(context, &hair.body),
+            hair,
+            gpu,
+            bounds,
+        })
+    }
+
+    /// Takes `change` to the GPU; returns what was done: a reshape whose texture layout
+    /// changed is uploaded afresh (a rebuild). On an error the asset is as it was.
+    pub fn apply(
+        &mut self,
+        context: &GpuContext,
+        generator: &StrandGenRenderer,
+        change: AssetChange,
+    ) -> Result<ChangeKind, HairAssetError> {
+        match change {
+            AssetChange::Restyle(styling) => {
+                self.hair.set_styling(&styling);
+                generator.update_styling(context, &mut self.gpu, &self.hair);
+                Ok(ChangeKind::Restyle)
+            }
+            AssetChange::Hair { hair, kind } => {
+                if kind <= ChangeKind::Reshape
+                    && let Some(bounds) = hair.textures.hair_bounds()
+                    && generator.update_shape(context, &mut self.gpu, &hair)
+                {
+                    // A head animation moves the body with the hair.
+                    if self.hair.body != hair.body {
+                        self.body = GpuBody::upload(context, &hair.body);
+                    }
+                    self.hair = *hair;
+                    self.bounds = bounds;
+                    return Ok(ChangeKind::Reshape);
+                }
+                *self = HairAsset::upload(context, generator, *hair)?;
+                Ok(ChangeKind::Rebuild)
+            }
+        }
+    }
+
+    /// [`Self::apply`] for a holder that may have no asset yet (made by the change); on an
+    /// error the holder is left empty, so nothing stale is drawn.
+    pub fn apply_to(
+        asset: &mut Option<HairAsset>,
+        context: &GpuContext,
+        generator: &StrandGenRenderer,
+        change: AssetChange,
+    ) -> Result<ChangeKind, HairAssetError> {
+        let result = match (asset.as_mut(), change) {
+            (Some(current), change) => current.apply(context, generator, change),
+            (None, AssetChange::Hair { hair, .. }) => HairAsset::upload(context, generator, *hair)
+                .map(|made| {
+                    *asset = Some(made);
+                    ChangeKind::Rebuild
+                }),
+            (None, AssetChange::Restyle(_)) => {
+                Err(HairAssetError::NothingToChange(ChangeKind::Restyle))
+            }
+        };
+        if result.is_err() {
+            *asset = None;
+        }
+        result
+    }
+
+    pub fn hair(&self) -> &RuntimeHair {
+        &self.hair
+    }
+
+    pub fn gpu(&self) -> &GpuHair {
+        &self.gpu
+    }
+
+    pub fn body(&self) -> &GpuBody {
+        &self.body
+    }
+
+    /// The box around the hair.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    /// The asset as a frame's hair, generated by `generator`.
+    pub fn source<'a>(
+        &'a self,
+        generator: &'a StrandGenRenderer,
+        filtering: Filtering,
+        lod: LodSettings,
+    ) -> HairSource<'a> {
+        HairSource::Generated {
+            generator,
+            hair: &self.gpu,
+            filtering,
+            lod,
+        }
+    }
+}
+
+/// Builds asset changes on a worker thread, newest first: requests that arrive while one is
+/// being built are folded into one ([`ChangeKind::and`], the newest document), and finished
+/// changes wait, folded likewise ([`AssetChange::then`]), until [`Self::poll`] takes them.
+pub struct AssetBuilder {
+    shared: Arc<(Mutex<BuilderState>, Condvar)>,
+    worker: Option<std::thread::JoinHandle<()>>,
+}
+
+struct Request {
+    document: Arc<Document>,
+    kind: ChangeKind,
+    options: RuntimeOptions,
+}
+
+#[derive(Default)]
+struct BuilderState {
+    request: Option<Request>,
+    building: bool,
+    done: Option<AssetChange>,
+    shutdown: bool,
+}
+
+impl Default for AssetBuilder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl AssetBuilder {
+    pub fn new() -> Self {
+        let shared = Arc::new((Mutex::new(BuilderState::default()), Condvar::new()));
+        let worker_shared = Arc::clone(&shared);
+        let worker = std::thread::Builder::new()
+            .name("hair-asset-builder".into())
+            .spawn(move || build_loop(&worker_shared))
+            .expect("spawning the asset builder thread");
+        Self {
+            shared,
+            worker: Some(worker),
+        }
+    }
+
+    fn state(&self) -> std::sync::MutexGuard<'_, BuilderState> {
+        self.shared.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Asks for the change of `kind` that made `document` (relative to the last request).
+    pub fn request(&self, document: Arc<Document>, kind: ChangeKind, options: RuntimeOptions) {
+        if kind == ChangeKind::Scene {
+            return;
+        }
+        let mut state = self.state();
+        let kind = state
+            .request
+            .as_ref()
+            .map_or(kind, |pending| pending.kind.and(kind));
+        state.request = Some(Request {
+            document,
+            kind,
+            options,
+        });
+        self.shared.1.notify_all();
+    }
+
+    /// The changes finished since the last poll, as one.
+    pub fn poll(&self) -> Option<AssetChange> {
+        self.state().done.take()
+    }
+
+    /// Whether a change is requested, being built, or waiting to be polled.
+    pub fn busy(&self) -> bool {
+        let state = self.state();
+        state.request.is_some() || state.building || state.done.is_some()
+    }
+
+    /// Blocks until every requested change is built (tests and one-shot renders).
+    pub fn wait(&self) {
+        let mut state = self.state();
+        while state.request.is_some() || state.building {
+            state = self.shared.1.wait(state).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+}
+
+impl Drop for AssetBuilder {
+    fn drop(&mut self) {
+        self.state().shutdown = true;
+        self.shared.1.notify_all();
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join();
+        }
+    }
+}
+
+fn build_loop(shared: &(Mutex<BuilderState>, Condvar)) {
+    let (lock, wake) = shared;
+    let mut state = lock.lock().unwrap_or_else(|e| e.into_inner());
+    loop {
+        if state.shutdown {
+            return;
+        }
+        let Some(request) = state.request.take() else {
+            state = wake.wait(state).unwrap_or_else(|e| e.into_inner());
+            continue;
+        };
+        state.building = true;
+        drop(state);
+        let built = AssetChange::build(&request.document, request.kind, &request.options);
+        state = lock.lock().unwrap_or_else(|e| e.into_inner());
+        state.building = false;
+        if let Some(built) = built {
+            state.done = Some(match state.done.take() {
+                Some(earlier) => earlier.then(built),
+                None => built,
+            });
+        }
+        wake.notify_all();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hairloom_core::samples::{grid_scalp, straight_layers};
+
+    fn document() -> Document {
+        let scalp = grid_scalp(2, 2, |x, y| glam::DVec3::new(x, y, 0.0));
+        Document::new("grid", straight_layers(scalp, 3, glam::DVec3::Z * 0.01))
+    }
+
+    #[test]
+    fn requests_fold_into_the_newest_document_and_the_largest_kind() {
+        let builder = AssetBuilder::new();
+        let options = RuntimeOptions::default();
+        let mut document = document();
+        builder.request(
+            Arc::new(document.clone()),
+            ChangeKind::Rebuild,
+            options.clone(),
+        );
+        builder.wait();
+        let first = builder.poll().expect("built");
+        assert_eq!(first.kind(), ChangeKind::Rebuild);
+        assert!(builder.poll().is_none());
+        // A drag, then a curl tick: one reshape carrying the new styling.
+        document.hair_mesh.columns[1].positions[2].x += 0.01;
+        builder.request(
+            Arc::new(document.clone()),
+            ChangeKind::Reshape,
+            options.clone(),
+        );
+        document.styling.global.curl.radius_m = 0.004;
+        builder.request(
+            Arc::new(document.clone()),
+            ChangeKind::Restyle,
+            options.clone(),
+        );
+        builder.wait();
+        let folded = builder.poll().expect("built");
+        assert_eq!(folded.kind(), ChangeKind::Reshape);
+        let AssetChange::Hair { hair, .. } = folded else {
+            panic!("a reshape carries the runtime data");
+        };
+        assert_eq!(hair.styling, document.styling);
+        let moved = RuntimeHair::from_document(&document, &options);
+        assert_eq!(
+            hair.textures.hair_mesh.texels,
+            moved.textures.hair_mesh.texels
+        );
+        // A scene change asks nothing.
+        builder.request(Arc::new(document), ChangeKind::Scene, options);
+        assert!(!builder.busy());
+    }
+}
