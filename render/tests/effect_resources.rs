@@ -12,6 +12,7 @@ use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::headless_for_test;
+use hairloom_render::frame::Phase;
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::preview_body::GpuBody;
 use hairloom_render::renderer::strand_gen::StrandGenRenderer;
@@ -67,6 +68,21 @@ fn expected(effects: &Effects) -> BTreeSet<&'static str> {
         labels.extend(WIDTH_OIT);
     }
     labels
+}
+
+/// The frame builder's renderers `effects` must have (the lighting, body and hair always).
+fn expected_renderers(effects: &Effects) -> BTreeSet<&'static str> {
+    let mut names = BTreeSet::from(["scene lighting", "body", "hair ribbons"]);
+    if effects.self_shadowing != SelfShadowing::None {
+        names.insert("hair shadows");
+    }
+    if effects.body_shadows {
+        names.insert("body shadows");
+    }
+    if effects.coverage == Coverage::WidthOit {
+        names.insert("width coverage");
+    }
+    names
 }
 
 #[test]
@@ -171,6 +187,37 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
         ] {
             assert!(live.contains_key(label), "{label} missing: {live:?}");
         }
+        // The frame builder's renderers are exactly the scene's, and a frame records only
+        // the phases they name, in order.
+        let renderers: BTreeSet<&str> = renderer
+            .participants()
+            .iter()
+            .map(|(name, _)| *name)
+            .collect();
+        assert_eq!(
+            renderers,
+            expected_renderers(&effects),
+            "effects {:?}",
+            effects.names()
+        );
+        let phases: Vec<Phase> = Phase::ORDER
+            .into_iter()
+            .filter(|phase| {
+                renderer
+                    .participants()
+                    .iter()
+                    .any(|(_, named)| named.contains(phase))
+            })
+            .collect();
+        let mut wanted = Vec::new();
+        if effects.self_shadowing != SelfShadowing::None || effects.body_shadows {
+            wanted.push(Phase::ShadowViews);
+        }
+        wanted.extend([Phase::Opaque, Phase::DepthPrePass, Phase::Lit]);
+        if effects.coverage == Coverage::WidthOit {
+            wanted.extend([Phase::Coverage, Phase::Composite]);
+        }
+        assert_eq!(phases, wanted, "effects {:?}", effects.names());
         bytes_by_scene.push(context.resources.live_bytes());
     }
     // All effects with 16 layers hold more than none; back to none frees it all again.

@@ -9,6 +9,7 @@ use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::headless_for_test;
 use hairloom_render::game::{GameCamera, GameFrameStats, GameHair, game_scene};
+use hairloom_render::hair_asset::AssetChange;
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::Targets;
 use hairloom_render::renderer::preview_body::GpuBody;
@@ -225,4 +226,74 @@ fn game_runtime_draws_what_the_preview_draws() {
     game.set_draw_body(false);
     let (_, hair_only) = draw(&context, &mut game, &view, &game_camera, background);
     assert!(mean_abs_difference(&hair_only, &drawn) > 1.0);
+}
+
+/// A game that restyles its hair at run time (a curl that grows, say) takes the change the
+/// way the editor does: the styling buffers are rewritten in place — no byte more on the
+/// GPU — and the frame shows exactly what a bundle exported with that styling shows.
+#[test]
+fn a_restyle_reaches_the_game_in_place_and_matches_a_fresh_bundle() {
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/samples/head_short_straight.hairloom");
+    let mut document = hairloom_core::io::project::load(&path)
+        .expect("sample")
+        .document;
+    let options = RuntimeOptions {
+        strands_per_bundle: 8,
+        ..RuntimeOptions::default()
+    };
+    let hair = RuntimeHair::from_document(&document, &options);
+    let (lo, hi) = hair.textures.hair_bounds().expect("hair");
+    let camera = Camera::framing(lo, hi, Vec3::new(0.75, 0.25, 1.0));
+    let game_camera = GameCamera {
+        view_projection: camera.view_projection(1.0),
+        eye: camera.eye,
+        fov_y_rad: camera.fov_y_rad,
+        viewport_height_px: SIZE,
+    };
+    let sample_count = PreviewRenderer::new(&context).sample_count;
+    let view = View::new(&context, SIZE, SIZE, sample_count);
+    let game_of = |hair: &RuntimeHair| {
+        let mut game = GameHair::new(
+            &context.adapter,
+            &context.device,
+            &context.queue,
+            hair,
+            Targets::view(sample_count),
+        )
+        .expect("the bundle loads");
+        game.set_vertices_log2(VERTICES_LOG2);
+        game.set_generation(GenerationPath::ComputePerStrand)
+            .expect("compute per strand");
+        game
+    };
+    let background = wgpu::Color::BLACK;
+    let mut game = game_of(&hair);
+    let (_, straight) = draw(&context, &mut game, &view, &game_camera, background);
+    let resident = game.resident_bytes();
+
+    let curl = &mut document.styling.global.curl;
+    curl.radius_m = 0.01;
+    curl.turns_per_m = 60.0;
+    game.apply(AssetChange::Restyle(document.styling.clone()))
+        .expect("a restyle");
+    let (_, curled) = draw(&context, &mut game, &view, &game_camera, background);
+    assert_eq!(game.resident_bytes(), resident, "a restyle allocated");
+    let change = mean_abs_difference(&straight, &curled);
+    eprintln!("game restyle: the picture changed by {change:.3} per channel");
+    assert!(
+        change > 0.5,
+        "the curl changed the picture by only {change:.3}"
+    );
+
+    let mut fresh = game_of(&RuntimeHair::from_document(&document, &options));
+    let (_, expected) = draw(&context, &mut fresh, &view, &game_camera, background);
+    assert!(
+        expected == curled,
+        "restyled in place vs made afresh: mean difference {:.3}",
+        mean_abs_difference(&expected, &curled)
+    );
 }

@@ -15,7 +15,7 @@ use hairloom_core::runtime::strand_gen::{Filtering, StrandGen};
 use hairloom_core::runtime::textures::Precision;
 use hairloom_render::device::{headless_for_test, read_buffer};
 use hairloom_render::renderer::preview_hair::{HairUniforms, RibbonInput};
-use hairloom_render::renderer::scene_lighting::{ShaderKey, hair_shader};
+use hairloom_render::renderer::shader_composer::{ShaderKey, hair_shader};
 use hairloom_render::renderer::strand_gen::{
     GENERATED_BINDING_OFFSET, GenerationPath, StrandGenRenderer,
 };

@@ -24,7 +24,7 @@ fn wgsl_files(dir: &Path) -> Vec<(String, String)> {
 fn embedded() -> Vec<(String, String)> {
     use hairloom_core::model::scene::SelfShadowing;
     use hairloom_render::renderer::oit_composite::oit_composite_shader;
-    use hairloom_render::renderer::scene_lighting::{
+    use hairloom_render::renderer::shader_composer::{
         RibbonInput, ShaderKey, body_shader, hair_shader, hair_shadow_shader,
     };
     let inputs = [
@@ -122,12 +122,12 @@ fn gpu_structs_match_their_wgsl() {
     use hairloom_render::renderer::preview_hair::{HairUniforms, default_hair_shader};
     use hairloom_render::renderer::strand_gen::SHADER_SOURCE;
     let hair_shader = default_hair_shader();
-    let body_shader = hairloom_render::renderer::scene_lighting::body_shader(
-        &hairloom_render::renderer::scene_lighting::ShaderKey::all()[0],
+    let body_shader = hairloom_render::renderer::shader_composer::body_shader(
+        &hairloom_render::renderer::shader_composer::ShaderKey::all()[0],
     );
-    let mesh_shader = hairloom_render::renderer::scene_lighting::hair_shader(
-        &hairloom_render::renderer::scene_lighting::ShaderKey::all()[0],
-        hairloom_render::renderer::scene_lighting::RibbonInput::Mesh,
+    let mesh_shader = hairloom_render::renderer::shader_composer::hair_shader(
+        &hairloom_render::renderer::shader_composer::ShaderKey::all()[0],
+        hairloom_render::renderer::shader_composer::RibbonInput::Mesh,
     );
     let (hair, body, mesh) = (
         hair_shader.as_str(),
@@ -170,7 +170,7 @@ fn gpu_structs_match_their_wgsl() {
 #[test]
 fn mesh_shader_groups_fit_nvidia_limits() {
     use hairloom_core::model::scene::SelfShadowing;
-    use hairloom_render::renderer::scene_lighting::{
+    use hairloom_render::renderer::shader_composer::{
         RibbonInput, ShaderKey, hair_shader, hair_shadow_shader,
     };
     let mut sources: Vec<(String, String)> = ShaderKey::all()

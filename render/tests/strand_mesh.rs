@@ -208,7 +208,7 @@ fn task_shader_lod_matches_the_frame_plan() {
     use hairloom_core::runtime::frame_plan::bundle_lod;
     use hairloom_core::runtime::gpu_types::{BundleLodGpu, LodParams, StrandRun};
     use hairloom_render::device::read_buffer;
-    use hairloom_render::renderer::scene_lighting::STRAND_LOD;
+    use hairloom_render::renderer::shader_composer::STRAND_LOD;
     use hairloom_render::renderer::strand_gen::SHADER_SOURCE;
     use wgpu::util::DeviceExt;
     let Some(context) = headless_for_test(module_path!()) else {

@@ -200,9 +200,11 @@ mod tests {
         assert_eq!(
             kind(|d| {
                 let column = &mut d.hair_mesh.columns[3];
-                let tip = *column.positions.last().unwrap();
+                let tip = *column.positions.last().expect("a column has a root");
                 column.positions.push(tip);
-                column.w.push(*column.w.last().unwrap() + 0.01);
+                column
+                    .w
+                    .push(*column.w.last().expect("a column has w") + 0.01);
             }),
             ChangeKind::Rebuild
         );
@@ -226,8 +228,8 @@ mod tests {
         let group = Command::Group {
             label: "both".into(),
             children: vec![
-                Command::record("restyle", &before, &restyled).unwrap(),
-                Command::record("remove", &restyled, &removed).unwrap(),
+                Command::record("restyle", &before, &restyled).expect("a restyle differs"),
+                Command::record("remove", &restyled, &removed).expect("a removal differs"),
             ],
         };
         assert_eq!(group.change_kind(), ChangeKind::Rebuild);

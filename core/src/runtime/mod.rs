@@ -9,6 +9,7 @@ pub mod hair;
 pub mod half;
 pub mod preview_hair;
 pub mod strand_gen;
+pub mod strand_mesh;
 pub mod textures;
 
 #[cfg(test)]

@@ -408,7 +408,7 @@ fn gpu(
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
-    use hairloom_render::renderer::scene_lighting::RibbonInput;
+    use hairloom_render::renderer::shader_composer::RibbonInput;
     use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = super::render::parse_size(size)?;

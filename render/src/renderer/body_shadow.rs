@@ -5,7 +5,7 @@
 
 use crate::device::GpuContext;
 use crate::renderer::preview_body::{BODY_VERTEX_LAYOUT, BodyRenderer, GpuBody, PreparedBody};
-use crate::renderer::scene_lighting::{ShaderKey, body_shader};
+use crate::renderer::shader_composer::{ShaderKey, body_shader};
 use crate::renderer::{PipelineSpec, pipeline};
 use crate::resources::Tracked;
 use hairloom_core::model::scene::{SelfShadowing, Shading};

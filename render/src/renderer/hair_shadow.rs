@@ -14,7 +14,8 @@ use hairloom_core::runtime::gpu_types::StrandRun;
 use crate::device::GpuContext;
 use crate::renderer::body_shadow::{depth_array, shadow_depth_state};
 use crate::renderer::preview_hair::{HairRenderer, PreparedHair, RibbonInput};
-use crate::renderer::scene_lighting::{first_hair_depth_entry, hair_shadow_shader};
+use crate::renderer::scene_lighting::first_hair_depth_entry;
+use crate::renderer::shader_composer::hair_shadow_shader;
 use crate::renderer::{PipelineSpec, ribbon_pipeline};
 use crate::resources::Tracked;
 

@@ -22,6 +22,7 @@ pub mod oit_composite;
 pub mod preview_body;
 pub mod preview_hair;
 pub mod scene_lighting;
+pub mod shader_composer;
 pub mod strand_gen;
 pub mod viewport_blit;
 
@@ -119,14 +120,14 @@ pub(crate) fn pipeline(context: &GpuContext, spec: &PipelineSpec) -> Tracked<wgp
 }
 
 /// [`pipeline`] for a pass that draws ribbons from `input`: mesh-shader ribbons
-/// ([`scene_lighting::RibbonInput::Mesh`]) take the source's task and mesh entry points
+/// ([`shader_composer::RibbonInput::Mesh`]) take the source's task and mesh entry points
 /// (`ts_main`, `ms_main` of `strand_mesh.wgsl`) in place of its vertex shader.
 pub(crate) fn ribbon_pipeline(
     context: &GpuContext,
     spec: &PipelineSpec,
-    input: scene_lighting::RibbonInput,
+    input: shader_composer::RibbonInput,
 ) -> Tracked<wgpu::RenderPipeline> {
-    if input != scene_lighting::RibbonInput::Mesh {
+    if input != shader_composer::RibbonInput::Mesh {
         return pipeline(context, spec);
     }
     let (module, layout) = module_and_layout(context, spec);

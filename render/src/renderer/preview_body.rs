@@ -6,7 +6,7 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::device::GpuContext;
-use crate::renderer::scene_lighting::{ShaderKey, body_shader};
+use crate::renderer::shader_composer::{ShaderKey, body_shader};
 use crate::renderer::{
     PipelineSpec, Targets, pipeline, uniform_entry, view_color_target, view_depth,
 };

@@ -1,7 +1,7 @@
 //! Hair ribbons (`shaders/preview_hair.wgsl`, with `shared/ribbon.wgsl`): every strand
 //! segment a viewer-facing quad with eq. 5-6 tangents (CPU mirror:
 //! `hairloom_core::runtime::preview_hair`), lit by the scene through the modules its effects
-//! name ([`crate::renderer::scene_lighting::hair_shader`]). The same draw bindings (group 0)
+//! name ([`crate::renderer::shader_composer::hair_shader`]). The same draw bindings (group 0)
 //! serve the shadow passes ([`crate::renderer::hair_shadow`]): one uniform buffer holds every
 //! view (the camera, then each shadow-casting light) of every batch of a frame.
 
@@ -14,8 +14,9 @@ use hairloom_core::runtime::strand_gen::Filtering;
 use wgpu::util::DeviceExt;
 
 use crate::device::GpuContext;
-pub use crate::renderer::scene_lighting::RibbonInput;
-use crate::renderer::scene_lighting::{ActiveEffects, ShaderKey, hair_shader};
+use crate::renderer::scene_lighting::ActiveEffects;
+pub use crate::renderer::shader_composer::RibbonInput;
+use crate::renderer::shader_composer::{ShaderKey, hair_shader};
 use crate::renderer::strand_gen::{
     GENERATED_BINDING_OFFSET, GpuHair, StrandGenRenderer, mesh_shaders_available,
     source_layout_entries,
