@@ -453,3 +453,41 @@ fn the_styling_direction_gizmo_is_drawn_at_the_selected_roots() {
         );
     }
 }
+
+/// Opening another project frames the camera on *its* hair, built off the UI thread: never on
+/// the hair of the document shown before, whose build may still be arriving.
+#[test]
+fn opening_a_project_frames_the_camera_on_its_own_hair() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    viewport_image(&mut harness);
+    let before = harness.state().viewport.camera_bounds();
+    assert!(before.is_some(), "the sample was framed");
+    let path = root().join("assets/samples/head_long_straight.hairloom");
+    harness
+        .state_mut()
+        .request(hairloom_editor::app::AfterConfirm::Open(path.clone()));
+    let image = viewport_image(&mut harness);
+    assert!(harness.state().viewport.error().is_none());
+    let settings = harness.state().viewport.settings;
+    let document = hairloom_core::io::project::load(&path)
+        .expect("sample")
+        .document;
+    let expected = hairloom_core::runtime::hair::RuntimeHair::from_document(
+        &document,
+        &hairloom_core::runtime::hair::RuntimeOptions {
+            precision: settings.precision,
+            strands_per_bundle: settings.strands_per_bundle,
+            ..Default::default()
+        },
+    )
+    .textures
+    .hair_bounds();
+    assert_eq!(harness.state().viewport.camera_bounds(), expected);
+    assert_ne!(before, expected, "the samples differ in size");
+    let background = image.get_pixel(2, 2).0;
+    assert!(
+        common::drawn_pixels(&image, background) > (image.width() * image.height()) as usize / 10
+    );
+}

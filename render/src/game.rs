@@ -246,10 +246,26 @@ impl GameHair {
 
     /// Takes a change of the bundle's hair (new styling at run time, or new runtime data) to
     /// the GPU the way the editor does ([`HairAsset::apply`]).
+    /// A rebuild is checked as [`Self::new`] checks a bundle (the mesh path's workgroup
+    /// limits), and refused with the asset left as it was; the strand width and the effects
+    /// that depend on the body follow the new hair.
     pub fn apply(&mut self, change: AssetChange) -> Result<(), GameHairError> {
+        if let AssetChange::Hair { hair, .. } = &change
+            && self.generator.path() == GenerationPath::MeshShader
+        {
+            check_mesh_groups(
+                &self.context.device.limits(),
+                hair.textures.atlas.blocks.len(),
+                hair.strands_per_bundle,
+                self.vertex_count,
+            )?;
+        }
         self.asset.apply(&self.context, &self.generator, change)?;
         self.frame = None;
-        Ok(())
+        let (lo, hi) = self.asset.bounds();
+        self.strand_width_m = default_strand_width_m(lo, hi);
+        let scene = self.scene.clone();
+        self.set_lighting(&scene)
     }
 
     /// Whether [`Self::draw`] draws the bundle's body (on by default; a game that draws its

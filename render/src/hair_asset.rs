@@ -31,8 +31,6 @@ pub enum HairAssetError {
     NoHair,
     #[error(transparent)]
     Upload(#[from] StrandGenError),
-    #[error("a {0:?} needs an asset on the GPU first")]
-    NothingToChange(ChangeKind),
 }
 
 /// The CPU side of a change, ready for the GPU.
@@ -143,7 +141,8 @@ impl HairAsset {
     }
 
     /// [`Self::apply`] for a holder that may have no asset yet (made by the change); on an
-    /// error the holder is left empty, so nothing stale is drawn.
+    /// error the holder is left empty, so nothing stale is drawn. A restyle of an empty
+    /// holder (its upload failed) changes nothing: [`ChangeKind::Scene`].
     pub fn apply_to(
         asset: &mut Option<HairAsset>,
         context: &GpuContext,
@@ -157,9 +156,7 @@ impl HairAsset {
                     *asset = Some(made);
                     ChangeKind::Rebuild
                 }),
-            (None, AssetChange::Restyle(_)) => {
-                Err(HairAssetError::NothingToChange(ChangeKind::Restyle))
-            }
+            (None, AssetChange::Restyle(_)) => Ok(ChangeKind::Scene),
         };
         if result.is_err() {
             *asset = None;
@@ -200,9 +197,11 @@ impl HairAsset {
     }
 }
 
-/// Builds asset changes on a worker thread, newest first: requests that arrive while one is
-/// being built are folded into one ([`ChangeKind::and`], the newest document), and finished
-/// changes wait, folded likewise ([`AssetChange::then`]), until [`Self::poll`] takes them.
+/// Builds asset changes on a worker thread, in the order asked: requests that arrive while
+/// one is being built are folded into one ([`ChangeKind::and`], the newest document), and
+/// finished changes wait, folded likewise ([`AssetChange::then`]), until [`Self::poll`] takes
+/// them with the serial of the newest request they hold. A build that panics (a bug) is
+/// reported by [`Self::take_failure`] and the builder goes on with the next request.
 pub struct AssetBuilder {
     shared: Arc<(Mutex<BuilderState>, Condvar)>,
     worker: Option<std::thread::JoinHandle<()>>,
@@ -212,13 +211,22 @@ struct Request {
     document: Arc<Document>,
     kind: ChangeKind,
     options: RuntimeOptions,
+    serial: u64,
+}
+
+/// A finished change and the serial of the newest request it holds ([`AssetBuilder::request`]).
+pub struct Built {
+    pub change: AssetChange,
+    pub serial: u64,
 }
 
 #[derive(Default)]
 struct BuilderState {
+    last_serial: u64,
     request: Option<Request>,
     building: bool,
-    done: Option<AssetChange>,
+    done: Option<Built>,
+    failure: Option<String>,
     shutdown: bool,
 }
 
@@ -246,27 +254,42 @@ impl AssetBuilder {
         self.shared.0.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Asks for the change of `kind` that made `document` (relative to the last request).
-    pub fn request(&self, document: Arc<Document>, kind: ChangeKind, options: RuntimeOptions) {
+    /// Asks for the change of `kind` that made `document` (relative to the last request);
+    /// returns the request's serial (`None` for a scene change: nothing to build).
+    pub fn request(
+        &self,
+        document: Arc<Document>,
+        kind: ChangeKind,
+        options: RuntimeOptions,
+    ) -> Option<u64> {
         if kind == ChangeKind::Scene {
-            return;
+            return None;
         }
         let mut state = self.state();
         let kind = state
             .request
             .as_ref()
             .map_or(kind, |pending| pending.kind.and(kind));
+        state.last_serial += 1;
+        let serial = state.last_serial;
         state.request = Some(Request {
             document,
             kind,
             options,
+            serial,
         });
         self.shared.1.notify_all();
+        Some(serial)
     }
 
     /// The changes finished since the last poll, as one.
-    pub fn poll(&self) -> Option<AssetChange> {
+    pub fn poll(&self) -> Option<Built> {
         self.state().done.take()
+    }
+
+    /// Why the last build failed, once (a panic in the runtime data's construction).
+    pub fn take_failure(&self) -> Option<String> {
+        self.state().failure.take()
     }
 
     /// Whether a change is requested, being built, or waiting to be polled.
@@ -307,14 +330,33 @@ fn build_loop(shared: &(Mutex<BuilderState>, Condvar)) {
         };
         state.building = true;
         drop(state);
-        let built = AssetChange::build(&request.document, request.kind, &request.options);
+        // A panic here is a bug in building the runtime data: say so and keep serving, so
+        // neither the UI nor a waiting caller hangs on it.
+        let built = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            AssetChange::build(&request.document, request.kind, &request.options)
+        }));
         state = lock.lock().unwrap_or_else(|e| e.into_inner());
         state.building = false;
-        if let Some(built) = built {
-            state.done = Some(match state.done.take() {
-                Some(earlier) => earlier.then(built),
-                None => built,
-            });
+        match built {
+            Ok(Some(change)) => {
+                let change = match state.done.take() {
+                    Some(earlier) => earlier.change.then(change),
+                    None => change,
+                };
+                state.done = Some(Built {
+                    change,
+                    serial: request.serial,
+                });
+            }
+            Ok(None) => {}
+            Err(panic) => {
+                let message = panic
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "a panic without a message".into());
+                state.failure = Some(format!("building the hair failed: {message}"));
+            }
         }
         wake.notify_all();
     }
@@ -335,14 +377,15 @@ mod tests {
         let builder = AssetBuilder::new();
         let options = RuntimeOptions::default();
         let mut document = document();
-        builder.request(
+        let first_serial = builder.request(
             Arc::new(document.clone()),
             ChangeKind::Rebuild,
             options.clone(),
         );
         builder.wait();
         let first = builder.poll().expect("built");
-        assert_eq!(first.kind(), ChangeKind::Rebuild);
+        assert_eq!(Some(first.serial), first_serial);
+        assert_eq!(first.change.kind(), ChangeKind::Rebuild);
         assert!(builder.poll().is_none());
         // A drag, then a curl tick: one reshape carrying the new styling.
         document.hair_mesh.columns[1].positions[2].x += 0.01;
@@ -352,15 +395,19 @@ mod tests {
             options.clone(),
         );
         document.styling.global.curl.radius_m = 0.004;
-        builder.request(
+        let last_serial = builder.request(
             Arc::new(document.clone()),
             ChangeKind::Restyle,
             options.clone(),
         );
         builder.wait();
         let folded = builder.poll().expect("built");
-        assert_eq!(folded.kind(), ChangeKind::Reshape);
-        let AssetChange::Hair { hair, .. } = folded else {
+        // It holds the newest request: a caller knows no older document is still to come.
+        assert_eq!(Some(folded.serial), last_serial);
+        assert!(last_serial > first_serial);
+        assert_eq!(folded.change.kind(), ChangeKind::Reshape);
+        assert!(builder.take_failure().is_none());
+        let AssetChange::Hair { hair, .. } = folded.change else {
             panic!("a reshape carries the runtime data");
         };
         assert_eq!(hair.styling, document.styling);
@@ -370,7 +417,10 @@ mod tests {
             moved.textures.hair_mesh.texels
         );
         // A scene change asks nothing.
-        builder.request(Arc::new(document), ChangeKind::Scene, options);
+        assert_eq!(
+            builder.request(Arc::new(document), ChangeKind::Scene, options),
+            None
+        );
         assert!(!builder.busy());
     }
 }

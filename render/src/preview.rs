@@ -129,7 +129,7 @@ impl PreviewRenderer {
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, PreviewError> {
-        let frame = self.encode_frame(context, scene, plan, width, height, None)?;
+        let frame = self.record_frame(context, scene, plan, width, height, None)?;
         View::read_back(context, &frame.color, frame.encoder).map_err(PreviewError::Readback)
     }
 
@@ -144,7 +144,7 @@ impl PreviewRenderer {
         width: u32,
         height: u32,
     ) -> Result<wgpu::Texture, PreviewError> {
-        let frame = self.encode_frame(context, scene, plan, width, height, None)?;
+        let frame = self.record_frame(context, scene, plan, width, height, None)?;
         context.queue.submit([frame.encoder.finish()]);
         Ok(frame.color)
     }
@@ -163,7 +163,7 @@ impl PreviewRenderer {
         // Generation and up to five passes (two per shadow-casting light) per batch.
         let passes = 8 + 16 * (plan.batches.len() + 1);
         let timer = PassTimer::new(context, passes);
-        let frame = self.encode_frame(context, scene, &plan, width, height, timer.as_ref())?;
+        let frame = self.record_frame(context, scene, &plan, width, height, timer.as_ref())?;
         let (wall_ms, gpu_ms) =
             submit_timed(context, frame.encoder, timer).map_err(PreviewError::Readback)?;
         Ok(FrameTiming {
@@ -224,7 +224,7 @@ impl PreviewRenderer {
 
     /// Records a frame into the kept view (see [`PreviewRenderer`]) with the frame builder;
     /// the last pass resolves MSAA.
-    fn encode_frame(
+    fn record_frame(
         &self,
         context: &GpuContext,
         scene: &PreviewScene,

@@ -467,7 +467,11 @@ impl EditorState {
             .jump_to(&mut self.project.document, position)
         {
             Ok(kind) => self.changed(format!("history step {position}"), kind),
-            Err(error) => self.message = format!("history jump failed: {error}"),
+            Err(error) => {
+                // The steps before the failing one were applied: the hair is made again.
+                self.bump_revision(ChangeKind::Rebuild);
+                self.message = format!("history jump failed: {error}");
+            }
         }
     }
 

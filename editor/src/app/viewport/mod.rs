@@ -160,6 +160,9 @@ pub struct Viewport {
     /// The box of the last built hair: `Some(None)` when no bundle grows hair, `None` before
     /// the first is built.
     hair_bounds: Option<Option<(Vec3, Vec3)>>,
+    /// The serial of the first build request since the last reframe: older builds (of the
+    /// document shown before) never set `hair_bounds`; `None` until that request is made.
+    frame_from_serial: Option<u64>,
     /// A lost device or a GPU error the device reported outside any error scope: shown in
     /// the viewport instead of panicking (wgpu's default).
     device_problem: Arc<std::sync::Mutex<Option<String>>>,
@@ -293,6 +296,7 @@ impl Viewport {
             builder,
             requested: None,
             hair_bounds: None,
+            frame_from_serial: None,
             device_problem,
             orbit: Orbit::default(),
             settings: ViewSettings::default(),
@@ -330,6 +334,10 @@ impl Viewport {
         self.camera_bounds = None;
         self.framed_from_hair = false;
         self.orbit = Orbit::default();
+        // The hair is built afresh for the new document, and only that build frames.
+        self.hair_bounds = None;
+        self.requested = None;
+        self.frame_from_serial = None;
     }
 
     /// The box the camera frames, once framed.

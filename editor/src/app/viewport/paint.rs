@@ -50,6 +50,9 @@ impl ViewportGpu {
                 HairAsset::apply_to(&mut self.hair, &self.context, &self.generator, change);
             let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
             match applied {
+                // Nothing changed (a restyle of hair that could not be uploaded): the
+                // upload's error stands.
+                Ok(ChangeKind::Scene) => {}
                 Ok(kind) => {
                     report.upload_error = None;
                     match kind {
@@ -457,7 +460,7 @@ impl Viewport {
             }
         };
         if let Some(kind) = kind {
-            builder.request(
+            let serial = builder.request(
                 Arc::new(state.shown_document().clone()),
                 kind,
                 RuntimeOptions {
@@ -466,17 +469,34 @@ impl Viewport {
                     ..RuntimeOptions::default()
                 },
             );
+            // The first request after a reframe is the first whose hair may frame.
+            if let (None, Some(serial)) = (self.frame_from_serial, serial) {
+                self.frame_from_serial = Some(serial);
+            }
         }
         self.requested = Some(now);
-        if let Some(change) = builder.poll() {
-            if let AssetChange::Hair { hair, .. } = &change {
+        if let Some(failure) = builder.take_failure() {
+            self.shared
+                .report
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .upload_error = Some(failure);
+        }
+        if let Some(built) = builder.poll() {
+            // Hair built for the document shown before a reframe (open, recover, import)
+            // goes to the GPU, but neither frames the camera nor is framed: the newer build
+            // follows.
+            let current = self
+                .frame_from_serial
+                .is_some_and(|first| built.serial >= first);
+            if let (AssetChange::Hair { hair, .. }, true) = (&built.change, current) {
                 self.hair_bounds = Some(hair.textures.hair_bounds());
             }
             self.shared
                 .pending
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
-                .change(change);
+                .change(built.change);
             self.drawn = None;
         }
         if builder.busy() {
