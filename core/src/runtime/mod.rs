@@ -11,6 +11,7 @@ pub mod preview_hair;
 pub mod strand_gen;
 pub mod strand_mesh;
 pub mod textures;
+pub mod thick_hair;
 
 #[cfg(test)]
 pub(crate) mod test_meshes {
