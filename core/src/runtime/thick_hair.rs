@@ -146,6 +146,35 @@ pub fn build_bundle_hierarchy(strands: &[Vec<DVec3>]) -> Result<BundleHierarchy,
     Ok(BundleHierarchy { levels })
 }
 
+/// Every bundle's hierarchy for `hair` as the runtime draws it at full detail
+/// (`vertex_count` control points per strand, styling included), in atlas block order;
+/// strand indices count a bundle's grown strands in the GPU's root order.
+pub fn build_hierarchy(
+    hair: &crate::runtime::hair::RuntimeHair,
+    vertex_count: usize,
+) -> Result<Vec<BundleHierarchy>, ThickHairError> {
+    let strands = crate::runtime::strand_gen::runtime_strands(
+        hair,
+        vertex_count,
+        crate::runtime::strand_gen::Filtering::Exact,
+    );
+    let mut by_block: Vec<Vec<Vec<DVec3>>> = Vec::new();
+    let mut last_bundle = None;
+    for strand in strands {
+        if last_bundle != Some(strand.bundle) {
+            by_block.push(Vec::new());
+            last_bundle = Some(strand.bundle);
+        }
+        if let Some(block) = by_block.last_mut() {
+            block.push(strand.points);
+        }
+    }
+    by_block
+        .iter()
+        .map(|strands| build_bundle_hierarchy(strands))
+        .collect()
+}
+
 fn check_strands(strands: &[Vec<DVec3>]) -> Result<(), ThickHairError> {
     let Some(first) = strands.first() else {
         return Ok(());
@@ -559,6 +588,80 @@ mod tests {
         let error = top.corner_fit_error_m(&strands);
         assert!(error < 0.5, "corner centre off by {error}");
         assert!(top.sections[0].major.length() > 2.0);
+    }
+
+    /// A thick hair follows the hair mesh as its corner strands do: after the mesh bends,
+    /// the centre its four corner strands give is as close to a fresh PCA fit of the moved
+    /// members as it was before the bend — no refit is needed per frame.
+    #[test]
+    fn a_hierarchy_follows_a_bent_hair_mesh_through_its_corner_strands() {
+        use crate::model::document::Document;
+        use crate::runtime::hair::{RuntimeHair, RuntimeOptions};
+        use crate::runtime::strand_gen::{Filtering, runtime_strands};
+        use crate::samples::{grid_scalp, straight_layers};
+        let scalp = grid_scalp(2, 2, |x, y| DVec3::new(x * 0.02, y * 0.02, 0.0));
+        let mut document = Document::new("grid", straight_layers(scalp, 4, DVec3::Z * 0.02));
+        let options = RuntimeOptions {
+            strands_per_bundle: 64,
+            ..RuntimeOptions::default()
+        };
+        let n = 9;
+        let points = |document: &Document| -> Vec<Vec<DVec3>> {
+            let hair = RuntimeHair::from_document(document, &options);
+            runtime_strands(&hair, n, Filtering::Exact)
+                .into_iter()
+                .map(|s| s.points)
+                .collect()
+        };
+        let modelled = points(&document);
+        let hierarchies =
+            build_hierarchy(&RuntimeHair::from_document(&document, &options), n).expect("builds");
+        assert!(!hierarchies.is_empty());
+        // Bend every column sideways, more toward the tips.
+        for column in &mut document.hair_mesh.columns {
+            for (k, p) in column.positions.iter_mut().enumerate() {
+                p.x += 0.004 * (k * k) as f64;
+            }
+        }
+        let bent = points(&document);
+        assert_eq!(bent.len(), modelled.len());
+        let corner_miss = |top: &ThickHair, block: &[Vec<DVec3>], k: usize| {
+            let members: Vec<DVec3> = top.members.iter().map(|&i| block[i as usize][k]).collect();
+            let tangent = top
+                .members
+                .iter()
+                .map(|&i| strand_tangents(&block[i as usize])[k])
+                .sum::<DVec3>();
+            let refit = fit_cross_section(&members, tangent);
+            let corners = top.corners.map(|c| block[c as usize][k]);
+            (CrossSection::from_corners(corners, refit.tangent).centre - refit.centre).length()
+        };
+        let mut first = 0;
+        let mut moved_m = 0.0f64;
+        for hierarchy in &hierarchies {
+            let count = hierarchy.levels[0].len();
+            let range = first..first + count;
+            first += count;
+            let top = hierarchy
+                .levels
+                .last()
+                .and_then(|l| l.first())
+                .expect("a top hair");
+            let size = top.sections[0].major.length().max(1e-6);
+            for k in 0..n {
+                let before = corner_miss(top, &modelled[range.clone()], k);
+                let after = corner_miss(top, &bent[range.clone()], k);
+                assert!(
+                    after <= before + 0.05 * size,
+                    "control point {k}: the corners miss by {after} m after the bend, {before} m before (hair {size} m)"
+                );
+                moved_m = moved_m.max((bent[range.start][k] - modelled[range.start][k]).length());
+            }
+        }
+        assert!(
+            moved_m > 0.01,
+            "the bend moved the strands by only {moved_m} m"
+        );
     }
 
     #[test]
