@@ -107,6 +107,21 @@ impl HairAsset {
         })
     }
 
+    /// Builds `document`'s runtime data with `options` and uploads it (the costly part: not
+    /// on a UI thread).
+    pub fn from_document(
+        context: &GpuContext,
+        generator: &StrandGenRenderer,
+        document: &Document,
+        options: &RuntimeOptions,
+    ) -> Result<Self, HairAssetError> {
+        Self::upload(
+            context,
+            generator,
+            RuntimeHair::from_document(document, options),
+        )
+    }
+
     /// Takes `change` to the GPU; returns what was done: a reshape whose texture layout
     /// changed is uploaded afresh (a rebuild). On an error the asset is as it was.
     pub fn apply(

@@ -663,7 +663,7 @@ fn edit_latency(
 ) -> anyhow::Result<()> {
     use hairloom_core::model::change::ChangeKind;
     use hairloom_core::runtime::frame_plan::LodSettings;
-    use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+    use hairloom_core::runtime::hair::RuntimeOptions;
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::hair_asset::{AssetChange, HairAsset};
@@ -685,11 +685,7 @@ fn edit_latency(
     let vertex_count = (1u32 << super::render::PREVIEW_VERTICES_LOG2) + 1;
     // The viewport's asset: every edit below is a change of its kind taken to the GPU by
     // `HairAsset::apply`, as the viewport's paint callback does.
-    let mut asset = HairAsset::upload(
-        &context,
-        &generator,
-        RuntimeHair::from_document(&document, &options),
-    )?;
+    let mut asset = HairAsset::from_document(&context, &generator, &document, &options)?;
     let bounds = asset.bounds();
     let pad = (bounds.1 - bounds.0) * 0.05;
     let camera = Camera::framing(

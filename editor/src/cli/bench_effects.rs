@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use hairloom_core::runtime::frame_plan::LodSettings;
-use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::hair::RuntimeOptions;
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::{GpuContext, describe};
 use hairloom_render::hair_asset::HairAsset;
@@ -47,16 +47,14 @@ pub fn run(
     let bundles = document.hair_mesh.bundles.len().max(1);
     for &count in strands {
         let per_bundle = count.div_ceil(bundles).clamp(1, 4096) as u32;
-        let asset = HairAsset::upload(
+        let asset = HairAsset::from_document(
             &context,
             &generator,
-            RuntimeHair::from_document(
-                &document,
-                &RuntimeOptions {
-                    strands_per_bundle: per_bundle,
-                    ..RuntimeOptions::default()
-                },
-            ),
+            &document,
+            &RuntimeOptions {
+                strands_per_bundle: per_bundle,
+                ..RuntimeOptions::default()
+            },
         )?;
         let (lo, hi) = asset.bounds();
         let pad = (hi - lo) * 0.05;

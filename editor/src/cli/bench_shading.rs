@@ -17,7 +17,7 @@ use hairloom_core::light::reference_render::{
 };
 use hairloom_core::model::scene::{Effects, Scene};
 use hairloom_core::runtime::frame_plan::LodSettings;
-use hairloom_core::runtime::hair::{DEFAULT_SAMPLE_SEED, RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::hair::{DEFAULT_SAMPLE_SEED, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::strands::reference::{StrandOptions, generate_parallel};
 use hairloom_render::device::{GpuContext, describe};
@@ -129,16 +129,14 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
         let path = hairloom_core::samples::default_sample_path()
             .with_file_name(format!("{name}.hairloom"));
         let document = hairloom_core::io::project::load(&path)?.document;
-        let asset = HairAsset::upload(
+        let asset = HairAsset::from_document(
             &context,
             &generator,
-            RuntimeHair::from_document(
-                &document,
-                &RuntimeOptions {
-                    strands_per_bundle: settings.strands_per_bundle,
-                    ..RuntimeOptions::default()
-                },
-            ),
+            &document,
+            &RuntimeOptions {
+                strands_per_bundle: settings.strands_per_bundle,
+                ..RuntimeOptions::default()
+            },
         )
         .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
         let (lo, hi) = asset.bounds();

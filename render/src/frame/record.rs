@@ -173,14 +173,7 @@ impl<'a> FrameRecorder<'a> {
                 let mut pass = begin(encoder);
                 self.bind_lighting(&mut pass);
                 if let Some(pipeline) = pipeline {
-                    HairRenderer::draw_with(
-                        &mut pass,
-                        pipeline,
-                        &frame.hair,
-                        0,
-                        index,
-                        frame.batch_runs(index),
-                    );
+                    self.draw_batch(&mut pass, pipeline, index);
                 }
             }
             if batch_count == 0 {
@@ -213,14 +206,7 @@ impl<'a> FrameRecorder<'a> {
             });
             self.bind_lighting(&mut pass);
             if index < batch_count {
-                HairRenderer::draw_with(
-                    &mut pass,
-                    pipeline,
-                    &frame.hair,
-                    0,
-                    index,
-                    frame.batch_runs(index),
-                );
+                self.draw_batch(&mut pass, pipeline, index);
             }
         }
         let mut pass = begin(encoder);
@@ -246,6 +232,24 @@ impl<'a> FrameRecorder<'a> {
         {
             HairRenderer::draw_with(pass, pipeline, &frame.hair, 0, 0, frame.batch_runs(0));
         }
+    }
+
+    /// The hair ribbons of batch `index` with `pipeline` (depth, lit or coverage).
+    fn draw_batch(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        pipeline: &wgpu::RenderPipeline,
+        index: usize,
+    ) {
+        let frame = self.frame;
+        HairRenderer::draw_with(
+            pass,
+            pipeline,
+            &frame.hair,
+            0,
+            index,
+            frame.batch_runs(index),
+        );
     }
 
     fn bind_lighting(&self, pass: &mut wgpu::RenderPass<'_>) {

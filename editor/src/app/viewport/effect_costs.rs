@@ -34,17 +34,15 @@ impl Viewport {
         std::thread::spawn(move || {
             let result = (|| -> anyhow::Result<Vec<EffectCost>> {
                 // On this worker thread, never the UI's: the document's own asset.
-                let asset = HairAsset::upload(
+                let asset = HairAsset::from_document(
                     &context,
                     &generator,
-                    RuntimeHair::from_document(
-                        &document,
-                        &RuntimeOptions {
-                            precision: settings.precision,
-                            strands_per_bundle: settings.strands_per_bundle,
-                            ..RuntimeOptions::default()
-                        },
-                    ),
+                    &document,
+                    &RuntimeOptions {
+                        precision: settings.precision,
+                        strands_per_bundle: settings.strands_per_bundle,
+                        ..RuntimeOptions::default()
+                    },
                 )?;
                 let bounds = asset.bounds();
                 let (lo, hi) = camera_bounds.unwrap_or(bounds);

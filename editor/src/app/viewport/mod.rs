@@ -50,7 +50,7 @@ use hairloom_render::renderer::strand_gen::StrandGenRenderer;
 
 use super::gizmo::{GizmoAdapter, GizmoStep};
 use super::state::{DragTool, EditorState, SelectMode};
-use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+use hairloom_core::runtime::hair::RuntimeOptions;
 use hairloom_render::measure::{AccuracyRow, measure_accuracy};
 use hairloom_render::preview::default_scene;
 
