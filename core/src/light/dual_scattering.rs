@@ -37,7 +37,7 @@ pub const D_F: f64 = 0.7;
 pub const D_B: f64 = 0.7;
 
 /// Incident offsets averaged over (midpoints of `[−1, 1]`).
-const H_SAMPLES: usize = 48;
+pub(crate) const H_SAMPLES: usize = 48;
 
 /// The precomputed tables of one material.
 #[derive(Clone, Debug, PartialEq)]
@@ -190,19 +190,7 @@ impl DualScatteringTables {
 
     /// `N_G,p` at `(|θ_i|, |φ|)`, bilinearly interpolated between texel centres.
     pub fn lobe(&self, p: usize, theta: f64, phi: f64) -> [f64; 3] {
-        let coordinate = |value: f64, range: f64, count: usize| {
-            let x = (value.abs().min(range) / range) * count as f64 - 0.5;
-            let lo = x.floor().clamp(0.0, (count - 1) as f64) as usize;
-            (lo, (lo + 1).min(count - 1), (x - lo as f64).clamp(0.0, 1.0))
-        };
-        let (t0, t1, tt) = coordinate(theta, FRAC_PI_2, THETA_COUNT);
-        let (p0, p1, pt) = coordinate(phi, PI, PHI_COUNT);
-        let at = |t: usize, j: usize| self.lobes[(p * THETA_COUNT + t) * PHI_COUNT + j];
-        std::array::from_fn(|c| {
-            let a = at(t0, p0)[c] as f64 * (1.0 - pt) + at(t0, p1)[c] as f64 * pt;
-            let b = at(t1, p0)[c] as f64 * (1.0 - pt) + at(t1, p1)[c] as f64 * pt;
-            a * (1.0 - tt) + b * tt
-        })
+        bilinear_lobe(&self.lobes, p, theta, phi)
     }
 
     /// The dual-scattering response `F` (the shader's `dual_scattering`): directions in the
@@ -241,6 +229,25 @@ impl DualScatteringTables {
     }
 }
 
+/// Lobe layer `p` of a `P_MAX × THETA_COUNT × PHI_COUNT` table at `(|θ_i|, |φ|)`, bilinearly
+/// interpolated between texel centres (what the GPU's filtered sample returns, and what the
+/// aggregated model's manual lookup computes).
+pub(crate) fn bilinear_lobe(lobes: &[[f32; 4]], p: usize, theta: f64, phi: f64) -> [f64; 3] {
+    let coordinate = |value: f64, range: f64, count: usize| {
+        let x = (value.abs().min(range) / range) * count as f64 - 0.5;
+        let lo = x.floor().clamp(0.0, (count - 1) as f64) as usize;
+        (lo, (lo + 1).min(count - 1), (x - lo as f64).clamp(0.0, 1.0))
+    };
+    let (t0, t1, tt) = coordinate(theta, FRAC_PI_2, THETA_COUNT);
+    let (p0, p1, pt) = coordinate(phi, PI, PHI_COUNT);
+    let at = |t: usize, j: usize| lobes[(p * THETA_COUNT + t) * PHI_COUNT + j];
+    std::array::from_fn(|c| {
+        let a = at(t0, p0)[c] as f64 * (1.0 - pt) + at(t0, p1)[c] as f64 * pt;
+        let b = at(t1, p0)[c] as f64 * (1.0 - pt) + at(t1, p1)[c] as f64 * pt;
+        a * (1.0 - tt) + b * tt
+    })
+}
+
 /// `∫_a^b N_p(φ) dφ` for an interval no longer than a turn, exactly: `N_p` is a trimmed
 /// logistic on the circle, so the integral is a difference of its cumulative distribution
 /// (wrapped once when the interval crosses ±π).
@@ -270,14 +277,14 @@ pub(crate) fn ds_gaussian(x: f64, variance: f64) -> f64 {
     (-x * x / (2.0 * variance)).exp() / (2.0 * PI * variance).sqrt()
 }
 
-struct Gamma {
-    gamma_o: f64,
-    gamma_t: f64,
+pub(crate) struct Gamma {
+    pub(crate) gamma_o: f64,
+    pub(crate) gamma_t: f64,
     /// Path length through the fibre in radii (`2 cos γ_t / cos θ_t`).
-    path: f64,
+    pub(crate) path: f64,
 }
 
-fn gamma(bsdf: &HairBsdf, w: DVec3, h: f64) -> Gamma {
+pub(crate) fn gamma(bsdf: &HairBsdf, w: DVec3, h: f64) -> Gamma {
     let sin_theta = w.x;
     let cos_theta = (1.0 - sin_theta * sin_theta).max(0.0).sqrt();
     let sin_theta_t = sin_theta / bsdf.eta;
