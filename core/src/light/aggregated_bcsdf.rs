@@ -425,63 +425,47 @@ pub fn cluster_hairs_on_path(
     wi: DVec3,
     across: f64,
 ) -> HairsOnPath {
+    // Everything in the ellipse's unit-circle coordinates, where lines stay lines and the
+    // fraction of the width a ray is at is kept: the entry point is then exactly on the
+    // circle, and the light's chord from it is well-conditioned even through a flat ellipse.
     let (a, b) = (shape.semi_major_m, shape.semi_minor_m);
-    let (u, w) = (
-        (shape.major_angle_rad.cos(), shape.major_angle_rad.sin()),
-        (-shape.major_angle_rad.sin(), shape.major_angle_rad.cos()),
-    );
-    // To the ellipse's unit-circle coordinates.
-    let unit = |p: (f64, f64)| ((p.0 * u.0 + p.1 * u.1) / a, (p.0 * w.0 + p.1 * w.1) / b);
-    let planar = |d: DVec3, fallback: (f64, f64)| {
+    let (cos, sin) = (shape.major_angle_rad.cos(), shape.major_angle_rad.sin());
+    let unit = |p: (f64, f64)| ((p.0 * cos + p.1 * sin) / a, (p.1 * cos - p.0 * sin) / b);
+    let planar = |d: DVec3| {
         let length = (d.y * d.y + d.z * d.z).sqrt();
-        if length > 1e-6 && length.is_finite() {
-            ((d.y / length, d.z / length), length)
-        } else {
-            (fallback, 0.0)
-        }
+        (length > 1e-6 && length.is_finite()).then(|| ((d.y / length, d.z / length), length))
     };
-    let (view, _) = planar(wo, (0.0, 1.0));
-    let side = (view.1, -view.0);
-    // Half the width the viewer sees: the ellipse's support along `side`.
-    let half_width = ((a * (side.0 * u.0 + side.1 * u.1)).powi(2)
-        + (b * (side.0 * w.0 + side.1 * w.1)).powi(2))
-    .sqrt();
+    let (view, _) = planar(wo).unwrap_or(((0.0, 1.0), 1.0));
+    let v = unit(view);
+    let v_length = (v.0 * v.0 + v.1 * v.1).sqrt();
+    let v = (v.0 / v_length, v.1 / v_length);
+    // The ribbon's `across` runs along (view.y, −view.y)'s image, which points the same way
+    // as (v.1, −v.0) in unit coordinates (the map keeps orientation).
+    let side = (v.1, -v.0);
     let s = if across.is_finite() {
         across.clamp(-1.0, 1.0)
     } else {
         0.0
     };
-    let start = (s * half_width * side.0, s * half_width * side.1);
-    // The eye's ray enters at the larger root of |start + t view|² = 1 (unit coordinates).
-    let (p0, d0) = (unit(start), unit(view));
-    let t = circle_roots(p0, d0).map_or(0.0, |(_, far)| far);
-    let entry = (start.0 + t * view.0, start.1 + t * view.1);
-    let (light, in_plane) = planar(wi, (0.0, 0.0));
-    if in_plane == 0.0 {
+    let along = (1.0 - s * s).max(0.0).sqrt();
+    let entry = (s * side.0 + along * v.0, s * side.1 + along * v.1);
+    let Some((light, in_plane)) = planar(wi) else {
         return HairsOnPath::ALONE;
-    }
-    let (back_m, toward_m) = circle_roots(unit(entry), unit(light)).unwrap_or((0.0, 0.0));
+    };
+    // From a point p of the unit circle the line p + t d meets it again at t = −2 p·d / |d|².
+    let d = unit(light);
+    let dd = d.0 * d.0 + d.1 * d.1;
+    let other = -2.0 * (entry.0 * d.0 + entry.1 * d.1) / dd;
     let per_m = shape.crossings_per_m() / in_plane.max(0.1);
-    HairsOnPath {
-        before: 1.0 + per_m * toward_m.max(0.0),
-        behind: per_m * (-back_m).max(0.0),
+    let path = HairsOnPath {
+        before: 1.0 + per_m * other.max(0.0),
+        behind: per_m * (-other).max(0.0),
+    };
+    if path.before.is_finite() && path.behind.is_finite() {
+        path
+    } else {
+        HairsOnPath::ALONE
     }
-}
-
-/// Both `t` with `|p + t d| = 1`, smaller first, or `None` when the line misses the unit
-/// circle or `d` is zero.
-fn circle_roots(p: (f64, f64), d: (f64, f64)) -> Option<(f64, f64)> {
-    let aa = d.0 * d.0 + d.1 * d.1;
-    if aa < 1e-18 {
-        return None;
-    }
-    let bb = p.0 * d.0 + p.1 * d.1;
-    let cc = p.0 * p.0 + p.1 * p.1 - 1.0;
-    // Tangent rays (the ribbon's edges) graze the ellipse: a small negative discriminant is
-    // rounding, not a miss.
-    let root = (bb * bb - aa * cc).max(0.0).sqrt();
-    let roots = ((-bb - root) / aa, (-bb + root) / aa);
-    (roots.0.is_finite() && roots.1.is_finite()).then_some(roots)
 }
 
 #[cfg(test)]

@@ -115,6 +115,7 @@ pub const SCENE: &str = shader_file!("shared/scene.wgsl");
 pub const HAIR_BSDF: &str = shader_file!("light/hair_bsdf.wgsl");
 pub const KAJIYA_KAY: &str = shader_file!("light/kajiya_kay.wgsl");
 pub const DUAL_SCATTERING: &str = shader_file!("light/dual_scattering.wgsl");
+pub const AGGREGATED_BCSDF: &str = shader_file!("light/aggregated_bcsdf.wgsl");
 pub const RADIANCE_KAJIYA_KAY: &str = shader_file!("light/radiance_kajiya_kay.wgsl");
 pub const RADIANCE_MARSCHNER: &str = shader_file!("light/radiance_marschner.wgsl");
 pub const RADIANCE_DUAL_SCATTERING: &str = shader_file!("light/radiance_dual_scattering.wgsl");
@@ -128,6 +129,18 @@ pub const NO_BODY_SHADOWS: &str = shader_file!("light/no_body_shadows.wgsl");
 pub const PREVIEW_HAIR: &str = shader_file!("preview_hair.wgsl");
 pub const PREVIEW_BODY: &str = shader_file!("preview_body.wgsl");
 pub const HAIR_SHADOW: &str = shader_file!("hair_shadow.wgsl");
+
+/// Far hair's shading model (`light/aggregated_bcsdf.wgsl`, after `hair_bsdf.wgsl`), with its
+/// table layout from the one definition in [`hairloom_core::light::aggregated_bcsdf`].
+pub fn aggregated_bcsdf_module() -> String {
+    use hairloom_core::light::aggregated_bcsdf::LOBES_OFFSET;
+    use hairloom_core::light::dual_scattering::{PHI_COUNT, THETA_COUNT};
+    format!(
+        "const AGG_THETA_COUNT: u32 = {THETA_COUNT}u;\n\
+         const AGG_PHI_COUNT: u32 = {PHI_COUNT}u;\n\
+         const AGG_LOBES_OFFSET: u32 = {LOBES_OFFSET}u;\n{AGGREGATED_BCSDF}"
+    )
+}
 
 /// The shadow modules of a lit shader: opacity-map lookups (or none) and body shadows (or none).
 fn shadow_modules(key: &ShaderKey, source: &mut String) {
