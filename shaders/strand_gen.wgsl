@@ -86,3 +86,51 @@ fn main_per_vertex(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = morphed_vertex(input, k, n, run.gamma);
     positions[vertex] = vec4<f32>(p, along_of(k, n));
 }
+
+// Far hair (seed 001, core/src/runtime/thick_hair.rs): one invocation per thick hair, which
+// generates its four corner strands as `main` generates any strand and writes, per vertex,
+// their centre with `along` to `positions` and the half-axes they span to `sections`
+// (2 per vertex: major and the member count, minor). CPU mirror: StrandGen::thick_main.
+// Keep the structs in sync with core/src/runtime/gpu_types.rs.
+struct ThickHairGpu {
+    corners: vec4<u32>,
+    members: u32,
+    block: u32,
+    level: u32,
+    padding: u32,
+}
+
+struct ThickGenParams {
+    first: u32,
+    count: u32,
+    vertex_count: u32,
+    output_offset: u32,
+}
+
+@group(0) @binding(12) var<storage, read> thick_hairs: array<ThickHairGpu>;
+@group(0) @binding(13) var<storage, read_write> sections: array<vec4<f32>>;
+@group(0) @binding(14) var<uniform> thick: ThickGenParams;
+
+@compute @workgroup_size(64)
+fn thick_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let t = id.x;
+    if t >= thick.count {
+        return;
+    }
+    let hair = thick_hairs[thick.first + t];
+    let n = max(thick.vertex_count, 2u);
+    let base = thick.output_offset + t * n;
+    let a = strand_input(hair.corners.x);
+    let b = strand_input(hair.corners.y);
+    let c = strand_input(hair.corners.z);
+    let d = strand_input(hair.corners.w);
+    for (var k = 0u; k < n; k++) {
+        let pa = styled_vertex(a, k, n);
+        let pb = styled_vertex(b, k, n);
+        let pc = styled_vertex(c, k, n);
+        let pd = styled_vertex(d, k, n);
+        positions[base + k] = vec4<f32>(0.25 * (pa + pb + pc + pd), along_of(k, n));
+        sections[2u * (base + k)] = vec4<f32>(0.5 * (pa - pb), f32(hair.members));
+        sections[2u * (base + k) + 1u] = vec4<f32>(0.5 * (pc - pd), 0.0);
+    }
+}

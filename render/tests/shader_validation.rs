@@ -62,6 +62,15 @@ fn embedded() -> Vec<(String, String)> {
             oit_composite_shader(samples),
         ));
     }
+    // Far hair's shading model, after the fibre model it builds on.
+    sources.push((
+        "aggregated_bcsdf".to_string(),
+        format!(
+            "{}\n{}",
+            hairloom_render::renderer::preview_hair::default_hair_shader(),
+            hairloom_render::renderer::shader_composer::aggregated_bcsdf_module()
+        ),
+    ));
     sources.push((
         "viewport_blit".to_string(),
         hairloom_render::renderer::viewport_blit::VIEWPORT_BLIT_SHADER.to_string(),
@@ -117,6 +126,7 @@ fn gpu_structs_match_their_wgsl() {
     use hairloom_core::light::scene_uniforms::{GpuLight, GpuShadowView, SceneUniforms};
     use hairloom_core::runtime::gpu_types::{
         BundleGpu, BundleLodGpu, LodParams, StrandGenParams, StrandRoot, StrandRun, StylingGpu,
+        ThickGenParams, ThickHairGpu,
     };
     use hairloom_render::renderer::preview_body::BodyUniforms;
     use hairloom_render::renderer::preview_hair::{HairUniforms, default_hair_shader};
@@ -144,6 +154,8 @@ fn gpu_structs_match_their_wgsl() {
         (SHADER_SOURCE, "Styling", size_of::<StylingGpu>()),
         (SHADER_SOURCE, "BundleGpu", size_of::<BundleGpu>()),
         (SHADER_SOURCE, "StrandRun", size_of::<StrandRun>()),
+        (SHADER_SOURCE, "ThickHairGpu", size_of::<ThickHairGpu>()),
+        (SHADER_SOURCE, "ThickGenParams", size_of::<ThickGenParams>()),
         (hair, "StrandRun", size_of::<StrandRun>()),
         (hair, "HairUniforms", size_of::<HairUniforms>()),
         (body, "BodyUniforms", size_of::<BodyUniforms>()),

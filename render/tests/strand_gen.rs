@@ -425,3 +425,82 @@ fn hair_above_the_adapter_limits_is_refused_by_name() {
         "{message}"
     );
 }
+
+/// Far hair's thick hairs (`thick_main`) against the mirror (`StrandGen::thick_main`) on the
+/// long sample: every thick hair of every level, centres and both half-axes, exact filtering,
+/// within the strands' bound; and the table names only grown strands of the right bundle.
+#[test]
+fn gpu_thick_hairs_match_the_cpu_mirror() {
+    use hairloom_core::runtime::thick_hair::{FarHair, build_hierarchy};
+    use hairloom_render::renderer::strand_gen::ThickGenRenderer;
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let document = common::sample("head_long_wavy");
+    let size = document.hair_mesh.size() as f32;
+    let runtime = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 16,
+            ..RuntimeOptions::default()
+        },
+    );
+    let vertex_count = 9u32;
+    let hierarchies = build_hierarchy(&runtime, vertex_count as usize).expect("hierarchy");
+    let table = FarHair::new(&hierarchies, runtime.strands_per_bundle);
+    assert!(!table.thick_hairs.is_empty());
+    for thick in &table.thick_hairs {
+        for corner in thick.corners {
+            assert_eq!(corner / runtime.strands_per_bundle, thick.block);
+            assert!(
+                corner % runtime.strands_per_bundle
+                    < runtime.block_strand_count(thick.block as usize)
+            );
+        }
+    }
+    let generator = StrandGenRenderer::new(&context);
+    let thick_gen = ThickGenRenderer::new(&context);
+    let hair = generator.upload(&context, &runtime).expect("upload");
+    let far = thick_gen.upload(&context, table.clone());
+    let count = table.thick_hairs.len() as u32;
+    let readback = thick_gen
+        .generate(
+            &generator,
+            &context,
+            &hair,
+            &far,
+            0,
+            count,
+            vertex_count,
+            Filtering::Exact,
+        )
+        .expect("thick hairs");
+    let (positions, sections) = (readback.positions, readback.sections);
+    let params: Vec<&StylingParams> = std::iter::once(&runtime.styling.global)
+        .chain(runtime.styling.groups.iter().map(|g| &g.params))
+        .collect();
+    let mirror = StrandGen {
+        textures: &runtime.textures,
+        filtering: Filtering::Exact,
+    };
+    let expected = mirror.thick_main(
+        &runtime.strand_roots(),
+        &table.thick_hairs,
+        vertex_count,
+        &params,
+    );
+    assert_eq!(positions.len(), expected.len());
+    let mut worst = 0.0f32;
+    for (i, vertex) in expected.iter().enumerate() {
+        let v = |x: [f32; 4]| glam::Vec3::new(x[0], x[1], x[2]);
+        worst = worst
+            .max(v(positions[i]).distance(vertex.centre))
+            .max(v(sections[2 * i]).distance(vertex.major))
+            .max(v(sections[2 * i + 1]).distance(vertex.minor));
+        assert!((positions[i][3] - vertex.along).abs() < 1e-6);
+        assert_eq!(sections[2 * i][3], vertex.members as f32);
+    }
+    let bound = 1e-5 * size;
+    eprintln!("{count} thick hairs: max |GPU − CPU mirror| = {worst:.3e} (bound {bound:.3e})");
+    assert!(worst <= bound, "{worst} > {bound}");
+}

@@ -85,6 +85,37 @@ pub struct StrandRun {
     pub _padding: u32,
 }
 
+/// One thick hair of far hair's hierarchy (seed 001) as generation reads it: it is drawn
+/// along the centre of its four corner strands, which the GPU generates as it generates any
+/// strand, so it follows the hair mesh with no refit.
+/// Keep in sync with `shaders/strand_gen.wgsl` (`ThickHairGpu`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ThickHairGpu {
+    /// Root indices (block × roots per bundle + sample) of the strands nearest the `+major`,
+    /// `−major`, `+minor` and `−minor` ends of its cross-section.
+    pub corners: [u32; 4],
+    /// Strands it stands for.
+    pub members: u32,
+    /// Its bundle's atlas block.
+    pub block: u32,
+    /// Its level in the bundle's hierarchy (1: about four strands; the last: the whole bundle).
+    pub level: u32,
+    pub _padding: u32,
+}
+
+/// Uniform parameters of generating thick hairs `thick_hairs[first .. first + count]` at
+/// `vertex_count` vertices each, written from `output_offset` on.
+/// Keep in sync with `shaders/strand_gen.wgsl` (`ThickGenParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ThickGenParams {
+    pub first: u32,
+    pub count: u32,
+    pub vertex_count: u32,
+    pub output_offset: u32,
+}
+
 /// One strand's root on the root slice.
 /// Keep in sync with `shaders/shared/strand_vertex.wgsl` (`StrandRoot`).
 #[repr(C)]

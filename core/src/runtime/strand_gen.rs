@@ -3,13 +3,14 @@
 //! runtime textures exactly as the shader computes it, in f32 (the styling ops in f64, within
 //! the parity bound of `render/tests/strand_gen.rs`). Functions carry the names of the WGSL
 //! functions they mirror: [`fetch`], [`StrandGen::strand_position`], [`strand_root`],
-//! [`StrandGen::styled_vertex`] and [`StrandGen::main`] (the compute entry point, one batch).
+//! [`StrandGen::styled_vertex`], [`StrandGen::main`] (the compute entry point, one batch) and
+//! [`StrandGen::thick_main`] (far hair's thick hairs from their corner strands).
 //! The GPU stage that runs the shader is `render/src/renderer/strand_gen.rs`.
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
 
 use crate::model::styling::StylingParams;
-use crate::runtime::gpu_types::{StrandRoot, StrandRun};
+use crate::runtime::gpu_types::{StrandRoot, StrandRun, ThickHairGpu};
 use crate::runtime::hair::strand_root;
 use crate::runtime::textures::{RuntimeTextures, Texture3d, curve_fetch_slices};
 use crate::strands::styling::{
@@ -211,11 +212,7 @@ impl StrandGen<'_> {
         for run in runs {
             for strand in 0..run.strand_count {
                 let root = &roots[(run.first_root + strand) as usize];
-                let params = styling
-                    .get(root.styling as usize)
-                    .or(styling.first())
-                    .copied()
-                    .unwrap_or(&default);
+                let params = params_of(root, styling, &default);
                 let points = self.styled_strand(root, run.vertex_count as usize, params);
                 let mut points: Vec<DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
                 crate::strands::lod::morph_odd_vertices(&mut points, run.gamma as f64);
@@ -224,6 +221,70 @@ impl StrandGen<'_> {
         }
         out
     }
+}
+
+/// A thick hair's vertex as `thick_main` writes it: the centre of its four corner strands'
+/// vertices and the half-axes they span ([`crate::runtime::thick_hair::CrossSection::from_corners`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThickVertex {
+    pub centre: Vec3,
+    /// `k / (n − 1)`.
+    pub along: f32,
+    /// Half of `+major − −major` and of `+minor − −minor`.
+    pub major: Vec3,
+    pub minor: Vec3,
+    pub members: u32,
+}
+
+impl StrandGen<'_> {
+    /// CPU mirror of `thick_main`: every vertex of `thick_hairs` at `vertex_count` vertices
+    /// each, thick-hair-major, with `styling` chosen per corner root as [`StrandGen::main`]
+    /// chooses it. Corner roots out of `roots` are refused by the caller's table
+    /// ([`crate::runtime::thick_hair::FarHair`] only names grown strands).
+    pub fn thick_main(
+        &self,
+        roots: &[StrandRoot],
+        thick_hairs: &[ThickHairGpu],
+        vertex_count: u32,
+        styling: &[&StylingParams],
+    ) -> Vec<ThickVertex> {
+        let default = StylingParams::default();
+        let n = vertex_count.max(2) as usize;
+        let mut out = Vec::with_capacity(thick_hairs.len() * n);
+        for thick in thick_hairs {
+            let inputs = thick.corners.map(|c| {
+                let root = &roots[c as usize];
+                self.strand_input(root, params_of(root, styling, &default))
+            });
+            for k in 0..n {
+                let [a, b, c, d] = inputs
+                    .each_ref()
+                    .map(|input| self.styled_vertex(input, k, n));
+                out.push(ThickVertex {
+                    centre: (a + b + c + d) * 0.25,
+                    along: k as f32 / (n - 1) as f32,
+                    major: (a - b) * 0.5,
+                    minor: (c - d) * 0.5,
+                    members: thick.members,
+                });
+            }
+        }
+        out
+    }
+}
+
+/// The styling parameters of `root`: `styling[root.styling]`, or `styling[0]` when out of
+/// range (as the shader reads them).
+fn params_of<'p>(
+    root: &StrandRoot,
+    styling: &[&'p StylingParams],
+    default: &'p StylingParams,
+) -> &'p StylingParams {
+    styling
+        .get(root.styling as usize)
+        .or(styling.first())
+        .copied()
+        .unwrap_or(default)
 }
 
 /// Every strand as the runtime draws it at full detail, `vertex_count` vertices each: the

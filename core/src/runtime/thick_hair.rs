@@ -175,6 +175,79 @@ pub fn build_hierarchy(
         .collect()
 }
 
+/// One level of one bundle in [`FarHair`]: its thick hairs `thick_hairs[first..][..count]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FarLevel {
+    pub first: u32,
+    pub count: u32,
+    /// The largest diameter (twice the major half-axis) of any of its thick hairs at any
+    /// control point: the widest it can look from anywhere.
+    pub widest_m: f64,
+}
+
+/// Far hair's hierarchy as the GPU draws it: every thick hair of every bundle's levels from
+/// 1 up (level 0 is the strands themselves), flat, with each bundle's levels.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FarHair {
+    pub thick_hairs: Vec<crate::runtime::gpu_types::ThickHairGpu>,
+    /// Per atlas block, its levels from 1 up (`levels[j − 1]` is level `j`); empty for a
+    /// bundle of one strand.
+    pub blocks: Vec<Vec<FarLevel>>,
+}
+
+impl FarHair {
+    /// The table of `hierarchies` (one per atlas block, from [`build_hierarchy`]) for a hair
+    /// with `per_bundle` roots per bundle.
+    pub fn new(hierarchies: &[BundleHierarchy], per_bundle: u32) -> Self {
+        let mut far = FarHair::default();
+        for (block, hierarchy) in hierarchies.iter().enumerate() {
+            let first_root = block as u32 * per_bundle;
+            let mut levels = Vec::new();
+            for (level, hairs) in hierarchy.levels.iter().enumerate().skip(1) {
+                let first = far.thick_hairs.len() as u32;
+                let mut widest_m = 0.0f64;
+                for hair in hairs {
+                    for section in &hair.sections {
+                        widest_m = widest_m.max(2.0 * section.major.length());
+                    }
+                    far.thick_hairs
+                        .push(crate::runtime::gpu_types::ThickHairGpu {
+                            corners: hair.corners.map(|c| first_root + c),
+                            members: hair.members.len() as u32,
+                            block: block as u32,
+                            level: level as u32,
+                            _padding: 0,
+                        });
+                }
+                levels.push(FarLevel {
+                    first,
+                    count: hairs.len() as u32,
+                    widest_m,
+                });
+            }
+            far.blocks.push(levels);
+        }
+        far
+    }
+
+    /// The level block `block` draws when a pixel spans `pixel_m` at its distance: the
+    /// coarsest whose widest thick hair is at most `width_threshold_px` pixels wide (seed 001
+    /// §5.1 step 5, ε_w), or 0 (the strands) when even level 1 is wider. Non-finite or
+    /// non-positive inputs draw the strands.
+    pub fn level_for(&self, block: usize, pixel_m: f64, width_threshold_px: f64) -> usize {
+        let Some(levels) = self.blocks.get(block) else {
+            return 0;
+        };
+        if !(pixel_m > 0.0 && pixel_m.is_finite() && width_threshold_px > 0.0) {
+            return 0;
+        }
+        levels
+            .iter()
+            .rposition(|level| level.widest_m <= width_threshold_px * pixel_m)
+            .map_or(0, |j| j + 1)
+    }
+}
+
 fn check_strands(strands: &[Vec<DVec3>]) -> Result<(), ThickHairError> {
     let Some(first) = strands.first() else {
         return Ok(());
@@ -662,6 +735,93 @@ mod tests {
             moved_m > 0.01,
             "the bend moved the strands by only {moved_m} m"
         );
+    }
+
+    #[test]
+    fn the_far_hair_table_names_corner_strands_and_picks_levels_by_width() {
+        use crate::model::document::Document;
+        use crate::runtime::hair::{RuntimeHair, RuntimeOptions};
+        use crate::runtime::strand_gen::{Filtering, StrandGen, runtime_strands};
+        use crate::samples::{grid_scalp, straight_layers};
+        let scalp = grid_scalp(2, 2, |x, y| DVec3::new(x * 0.02, y * 0.02, 0.0));
+        let document = Document::new("grid", straight_layers(scalp, 4, DVec3::Z * 0.02));
+        let per_bundle = 64;
+        let hair = RuntimeHair::from_document(
+            &document,
+            &RuntimeOptions {
+                strands_per_bundle: per_bundle,
+                ..RuntimeOptions::default()
+            },
+        );
+        let n = 9;
+        let hierarchies = build_hierarchy(&hair, n).expect("builds");
+        let table = FarHair::new(&hierarchies, per_bundle);
+        assert_eq!(table.blocks.len(), hierarchies.len());
+        for (block, (levels, hierarchy)) in table.blocks.iter().zip(&hierarchies).enumerate() {
+            // Levels 1.. of 64 strands: 16, 4 and 1 thick hairs, each wider than the last.
+            let counts: Vec<u32> = levels.iter().map(|l| l.count).collect();
+            assert_eq!(counts, [16, 4, 1]);
+            assert_eq!(levels.len(), hierarchy.levels.len() - 1);
+            for pair in levels.windows(2) {
+                assert!(pair[1].widest_m > pair[0].widest_m, "{levels:?}");
+            }
+            for (j, level) in levels.iter().enumerate() {
+                let hairs = &table.thick_hairs[level.first as usize..][..level.count as usize];
+                for (thick, fitted) in hairs.iter().zip(&hierarchy.levels[j + 1]) {
+                    assert_eq!(thick.block as usize, block);
+                    assert_eq!(thick.level as usize, j + 1);
+                    assert_eq!(thick.members as usize, fitted.members.len());
+                    assert_eq!(
+                        thick.corners,
+                        fitted.corners.map(|c| block as u32 * per_bundle + c)
+                    );
+                }
+            }
+            // ε_w picks the coarsest level under it: a pixel so large that everything is
+            // thin draws one hair; one so small that nothing is draws the strands; between
+            // two levels' widths, the finer.
+            let threshold = 2.0;
+            assert_eq!(table.level_for(block, 1.0, threshold), levels.len());
+            assert_eq!(table.level_for(block, 1e-9, threshold), 0);
+            for j in 0..levels.len() - 1 {
+                let between = 0.5 * (levels[j].widest_m + levels[j + 1].widest_m);
+                assert_eq!(
+                    table.level_for(block, between / threshold, threshold),
+                    j + 1
+                );
+            }
+            for bad in [f64::NAN, 0.0, -1.0, f64::INFINITY] {
+                assert_eq!(table.level_for(block, bad, threshold), 0);
+            }
+        }
+        assert_eq!(table.level_for(table.blocks.len(), 1.0, 2.0), 0);
+        // The GPU's thick hair (its corner strands' centre and half-axes) is the corners'
+        // section of the strands as drawn.
+        let strands = runtime_strands(&hair, n, Filtering::Exact);
+        let generator = StrandGen {
+            textures: &hair.textures,
+            filtering: Filtering::Exact,
+        };
+        let params = [&hair.styling.global];
+        let vertices =
+            generator.thick_main(&hair.strand_roots(), &table.thick_hairs, n as u32, &params);
+        let size = document.hair_mesh.size();
+        for (t, thick) in table.thick_hairs.iter().enumerate() {
+            for k in 0..n {
+                let corners = thick.corners.map(|c| {
+                    let block = (c / per_bundle) as usize;
+                    let first: usize = (0..block)
+                        .map(|b| hair.block_strand_count(b) as usize)
+                        .sum();
+                    strands[first + (c % per_bundle) as usize].points[k]
+                });
+                let section = CrossSection::from_corners(corners, DVec3::Z);
+                let vertex = &vertices[t * n + k];
+                assert!((vertex.centre.as_dvec3() - section.centre).length() < 1e-6 * size);
+                assert!((vertex.major.as_dvec3() - section.major).length() < 1e-6 * size);
+                assert!((vertex.minor.as_dvec3() - section.minor).length() < 1e-6 * size);
+            }
+        }
     }
 
     #[test]

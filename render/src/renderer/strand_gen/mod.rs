@@ -7,13 +7,15 @@
 //!
 //! The stage's jobs, one file each: [`limits`] (what a device can take), [`path`] (where
 //! strands are generated), [`upload`] (the asset on the GPU), [`encode`] (recording a batch)
-//! and [`readback`] (timing, storing and reading back). The mesh path's work distribution is
+//! and [`readback`] (timing, storing and reading back); [`thick`] generates far hair's thick
+//! hairs from their corner strands. The mesh path's work distribution is
 //! mirrored in `hairloom_core::runtime::strand_mesh`.
 
 mod encode;
 mod limits;
 mod path;
 mod readback;
+mod thick;
 mod upload;
 
 pub use encode::*;
@@ -23,6 +25,7 @@ pub use hairloom_core::runtime::strand_mesh::{
 pub use limits::*;
 pub use path::*;
 pub use readback::*;
+pub use thick::*;
 pub use upload::*;
 
 use hairloom_core::runtime::gpu_types::StrandRun;
