@@ -239,15 +239,17 @@ fn exports_of_every_sample_pass_third_party_validators() {
         ]);
         let (code, stdout, stderr) = run(&mut command);
         assert_eq!(code, 0, "{name}: {stderr}");
-        // Five textures and the manifest, plus the body mesh every sample has; the data
-        // files are content-addressed, so their names come from the manifest.
+        // Five textures, the far-hair file and the manifest, plus the body mesh every sample
+        // has; the data files are content-addressed, so their names come from the manifest.
         let manifest: serde_json::Value = serde_json::from_slice(
             &std::fs::read(runtime.join("manifest.json")).expect("manifest"),
         )
         .expect("manifest JSON");
         let body = runtime.join(manifest["body"].as_str().expect("a body file"));
         assert!(body.exists(), "{name}: no body file");
-        assert!(stdout.contains("runtime bundle, 7 files"), "{stdout}");
+        assert!(stdout.contains("runtime bundle, 8 files"), "{stdout}");
+        let far = runtime.join(manifest["far_hair"]["file"].as_str().expect("far hair"));
+        assert!(far.exists(), "{name}: no far-hair file");
         // The bundle's full detail is what --vertices-log2 asked for, like the strand files.
         assert_eq!(manifest["lod"]["max_vertices_log2"], 3, "{name}");
         glbs.push(body);

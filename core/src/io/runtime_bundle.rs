@@ -15,11 +15,12 @@ pub use crate::runtime::hair::LodEntry;
 use crate::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 
-/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 2
-/// stores 3 hair-mesh slices per segment (`p_k, q0, q1`); version 1 stored the quadratics'
-/// joint `m` too (4 slices) and is still read (the `m` slices are dropped on load: `m` is
-/// exactly `(q0 + q1) / 2`).
-pub const RUNTIME_FORMAT_VERSION: u32 = 2;
+/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 3
+/// adds far hair's hierarchy (`manifest.far_hair`); version 2 stores 3 hair-mesh slices per
+/// segment (`p_k, q0, q1`); version 1 stored the quadratics' joint `m` too (4 slices). All
+/// are read (version 1's `m` slices are dropped on load: `m` is exactly `(q0 + q1) / 2`;
+/// bundles before version 3 have no far hair).
+pub const RUNTIME_FORMAT_VERSION: u32 = 3;
 /// Hair-mesh slices per segment in format version 1 bundles.
 const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
@@ -37,6 +38,8 @@ pub enum ExportError {
     TooLarge(usize),
     #[error("writing manifest.json failed: {0}")]
     Manifest(String),
+    #[error("far hair's hierarchy: {0}")]
+    FarHair(#[from] crate::runtime::thick_hair::ThickHairError),
 }
 
 /// One texture of the runtime bundle, as the manifest describes it.
@@ -73,6 +76,17 @@ fn is_full_density(density: &f32) -> bool {
     *density == 1.0
 }
 
+/// Far hair's hierarchy in a runtime bundle (format version 3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FarHairEntry {
+    /// The far-hair file's name (plain, in the bundle folder).
+    pub file: String,
+    pub levels: u32,
+    pub thick_hairs: u32,
+    /// A one-line description of the file; informative.
+    pub contents: String,
+}
+
 /// `manifest.json` of a runtime bundle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Manifest {
@@ -106,6 +120,9 @@ pub struct Manifest {
     /// Progressive root samples, barycentric `(s, t)` with `s + t < 1`, for triangles;
     /// block coordinates are `(s / (1 − t), t)`.
     pub triangle_samples: Vec<[f32; 2]>,
+    /// Far hair's thick hairs and levels (seed 001), from format version 3.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub far_hair: Option<FarHairEntry>,
 }
 
 /// File name of the manifest, the bundle's single commit point (see [`write_bundle_folder`]).
@@ -125,7 +142,7 @@ pub(crate) fn content_addressed_name(stem: &str, extension: &str, bytes: &[u8]) 
 /// Whether `name` is a data file a runtime bundle export writes (content-addressed, or
 /// the fixed names of bundles written before content addressing).
 fn is_bundle_data_file(name: &str) -> bool {
-    const STEMS: [&str; 6] = ["hair_mesh", "uv", "w", "u", "v", "body"];
+    const STEMS: [&str; 7] = ["hair_mesh", "uv", "w", "u", "v", "body", "far_hair"];
     let Some((stem, rest)) = name.split_once('.') else {
         return false;
     };
@@ -137,7 +154,7 @@ fn is_bundle_data_file(name: &str) -> bool {
         Some((hash, extension)) => {
             hash.len() == 16
                 && hash.bytes().all(|b| b.is_ascii_hexdigit())
-                && matches!(extension, "ktx2" | "glb")
+                && matches!(extension, "ktx2" | "glb" | "bin")
         }
     }
 }
@@ -423,10 +440,26 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
             .map(|bytes| content_addressed_name("body", "glb", bytes)),
         quad_samples: hair.samples.quad.clone(),
         triangle_samples: hair.samples.triangle.clone(),
+        far_hair: None,
     };
     if let (Some(name), Some(bytes)) = (&manifest.body, body_glb) {
         files.push((name.clone(), bytes));
     }
+    // Far hair's hierarchy from the strands as a game generates them at full detail.
+    let far = crate::runtime::thick_hair::FarHair::build(
+        hair,
+        (1usize << hair.lod.max_vertices_log2.min(limits::MAX_VERTICES_LOG2)) + 1,
+    )?;
+    let far_bytes = far.to_bytes();
+    let far_file = content_addressed_name("far_hair", "bin", &far_bytes);
+    let mut manifest = manifest;
+    manifest.far_hair = Some(FarHairEntry {
+        file: far_file.clone(),
+        levels: far.blocks.iter().map(|b| b.len() as u32).sum(),
+        thick_hairs: far.thick_hairs.len() as u32,
+        contents: "far hair: each bundle's thick hairs by level (corner strands, member counts) and each level's widest diameter; layout in docs/runtime-format.md".into(),
+    });
+    files.push((far_file, far_bytes));
     let json =
         serde_json::to_vec_pretty(&manifest).map_err(|e| ExportError::Manifest(e.to_string()))?;
     files.push(("manifest.json".into(), json));
@@ -487,11 +520,7 @@ impl BundleFiles for std::collections::HashMap<String, Vec<u8>> {
 /// Loads and checks a runtime bundle folder written by [`write_bundle_folder`]: see
 /// [`load_runtime_bundle_from`]. Only files inside `dir` are read.
 pub fn load_runtime_bundle(dir: &std::path::Path) -> Result<RuntimeHair, BundleError> {
-    let folder = crate::io::input_files::InputFolder::new(dir).map_err(|e| BundleError {
-        file: dir.display().to_string(),
-        message: e.to_string(),
-    })?;
-    load_runtime_bundle_from(&BundleFolder(folder), &dir.display().to_string())
+    load_runtime_asset(dir).map(|asset| asset.hair)
 }
 
 /// A format version 1 hair-mesh texture (`p_k, q0, m, q1` per segment) in today's layout
@@ -523,6 +552,33 @@ pub fn load_runtime_bundle_from(
     files: &dyn BundleFiles,
     shown: &str,
 ) -> Result<RuntimeHair, BundleError> {
+    load_runtime_asset_from(files, shown).map(|asset| asset.hair)
+}
+
+/// A runtime bundle as loaded: the hair, and far hair's hierarchy where the bundle has one
+/// (format version 3). Kept apart from [`RuntimeHair`], which changes as a document is
+/// edited: the hierarchy belongs to the strands it was built from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedBundle {
+    pub hair: RuntimeHair,
+    pub far_hair: Option<crate::runtime::thick_hair::FarHair>,
+}
+
+/// Loads a runtime bundle folder with its far hair: see [`load_runtime_asset_from`].
+pub fn load_runtime_asset(dir: &std::path::Path) -> Result<LoadedBundle, BundleError> {
+    let folder = crate::io::input_files::InputFolder::new(dir).map_err(|e| BundleError {
+        file: dir.display().to_string(),
+        message: e.to_string(),
+    })?;
+    load_runtime_asset_from(&BundleFolder(folder), &dir.display().to_string())
+}
+
+/// [`load_runtime_bundle_from`], plus the far-hair file where the manifest names one,
+/// checked against the bundles it describes ([`crate::runtime::thick_hair::FarHair::from_bytes`]).
+pub fn load_runtime_asset_from(
+    files: &dyn BundleFiles,
+    shown: &str,
+) -> Result<LoadedBundle, BundleError> {
     let error = |file: &str, message: String| BundleError {
         file: format!("{shown}/{file}"),
         message,
@@ -542,7 +598,7 @@ pub fn load_runtime_bundle_from(
             "not a Hairloom runtime manifest (\"format\" is not \"hairloom-runtime\")".into(),
         ));
     }
-    if found != RUNTIME_FORMAT_VERSION as u64 && found != 1 {
+    if !(1..=RUNTIME_FORMAT_VERSION as u64).contains(&found) {
         return Err(error(
             MANIFEST_FILE,
             format!(
@@ -744,7 +800,8 @@ pub fn load_runtime_bundle_from(
                 .to_body()
         }
     };
-    Ok(RuntimeHair {
+    let far_entry = manifest.far_hair.clone();
+    let hair = RuntimeHair {
         textures,
         samples: RootSamples {
             quad: manifest.quad_samples,
@@ -763,7 +820,41 @@ pub fn load_runtime_bundle_from(
         body,
         source: manifest.source,
         sample_seed: None,
-    })
+    };
+    let far_hair = match far_entry {
+        None => None,
+        Some(entry) => {
+            check_file_name(&entry.file).map_err(|message| error(MANIFEST_FILE, message))?;
+            let bytes = files
+                .read(&entry.file, limits::FILE_BYTES)
+                .map_err(|e| error(&entry.file, e))?;
+            let grown: Vec<u32> = (0..hair.textures.atlas.blocks.len())
+                .map(|block| hair.block_strand_count(block))
+                .collect();
+            let far = crate::runtime::thick_hair::FarHair::from_bytes(
+                &bytes,
+                &grown,
+                hair.strands_per_bundle,
+            )
+            .map_err(|message| error(&entry.file, message))?;
+            let levels: usize = far.blocks.iter().map(Vec::len).sum();
+            if (levels, far.thick_hairs.len())
+                != (entry.levels as usize, entry.thick_hairs as usize)
+            {
+                return Err(error(
+                    MANIFEST_FILE,
+                    format!(
+                        "far_hair lists {} levels and {} thick hairs, its file {levels} and {}",
+                        entry.levels,
+                        entry.thick_hairs,
+                        far.thick_hairs.len()
+                    ),
+                ));
+            }
+            Some(far)
+        }
+    };
+    Ok(LoadedBundle { hair, far_hair })
 }
 /// A bundle is one flat folder: the manifest names its files by plain name only.
 fn check_file_name(name: &str) -> Result<(), String> {
@@ -856,7 +947,7 @@ mod tests {
         let document = Document::new("grid", grid(3, 2, 2, 0.5));
         let files = runtime_bundle(&document, &RuntimeOptions::default()).expect("export");
         let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-        assert_eq!(names.len(), 6);
+        assert_eq!(names.len(), 7);
         for (name, stem) in names.iter().zip(["hair_mesh", "uv", "w", "u", "v"]) {
             assert!(
                 name.starts_with(&format!("{stem}.")) && name.ends_with(".ktx2"),
@@ -864,7 +955,9 @@ mod tests {
             );
             assert!(is_bundle_data_file(name), "{name}");
         }
-        assert_eq!(names[5], MANIFEST_FILE);
+        assert!(names[5].starts_with("far_hair.") && names[5].ends_with(".bin"));
+        assert!(is_bundle_data_file(names[5]));
+        assert_eq!(names[6], MANIFEST_FILE);
         // Names follow content: the same texture gets the same name, another a new one.
         assert_eq!(
             names[0],
@@ -872,8 +965,13 @@ mod tests {
         );
         assert_ne!(names[0], content_addressed_name("hair_mesh", "ktx2", b"x"));
         assert!(!is_bundle_data_file("notes.ktx2") && !is_bundle_data_file("w.12.ktx2"));
-        let manifest: Manifest = serde_json::from_slice(&files[5].1).expect("manifest");
+        let manifest: Manifest = serde_json::from_slice(&files[6].1).expect("manifest");
         assert_eq!(manifest.bundles.len(), 6);
+        assert_eq!(manifest.format_version, 3);
+        assert_eq!(
+            manifest.far_hair.as_ref().map(|f| f.file.as_str()),
+            Some(names[5])
+        );
         assert_eq!(manifest.hair_mesh.size[2], 1 + 3 * 2);
         assert_eq!(manifest.slices_per_segment, 3);
         assert_eq!(manifest.uv.size[2], 0);
@@ -883,6 +981,152 @@ mod tests {
             runtime_bundle(&empty, &RuntimeOptions::default()),
             Err(ExportError::NothingToExport)
         ));
+    }
+
+    #[test]
+    fn far_hair_round_trips_and_older_or_corrupt_far_hair_is_handled_by_name() {
+        use crate::runtime::thick_hair::FarHair;
+        let mut mesh = grid(3, 2, 2, 0.5);
+        crate::geometry::interior::place_interior(&mut mesh, None);
+        let document = Document::new("grid", mesh);
+        let options = RuntimeOptions {
+            strands_per_bundle: 16,
+            ..RuntimeOptions::default()
+        };
+        let files: HashMap<String, Vec<u8>> = runtime_bundle(&document, &options)
+            .expect("export")
+            .into_iter()
+            .collect();
+        let loaded = load_runtime_asset_from(&files, "memory").expect("loads");
+        let built = FarHair::build(
+            &RuntimeHair::from_document(&document, &options),
+            (1 << options.lod.max_vertices_log2) + 1,
+        )
+        .expect("builds");
+        let far = loaded.far_hair.clone().expect("far hair");
+        assert_eq!(far.thick_hairs, built.thick_hairs);
+        assert_eq!(far.blocks.len(), built.blocks.len());
+        for (a, b) in far
+            .blocks
+            .iter()
+            .flatten()
+            .zip(built.blocks.iter().flatten())
+        {
+            assert_eq!((a.first, a.count), (b.first, b.count));
+            // Stored as f32.
+            assert!((a.widest_m - b.widest_m).abs() <= 1e-6 * b.widest_m.max(1e-9));
+        }
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&files[MANIFEST_FILE]).expect("manifest");
+        let far_file = manifest["far_hair"]["file"]
+            .as_str()
+            .expect("named")
+            .to_string();
+        // A version 2 bundle (no far hair) still loads, without it.
+        let mut older = files.clone();
+        let mut value = manifest.clone();
+        value["format_version"] = 2.into();
+        value.as_object_mut().expect("object").remove("far_hair");
+        older.insert(
+            MANIFEST_FILE.into(),
+            serde_json::to_vec(&value).expect("json"),
+        );
+        older.remove(&far_file);
+        let loaded = load_runtime_asset_from(&older, "memory").expect("version 2 loads");
+        assert_eq!(loaded.far_hair, None);
+        assert_eq!(loaded.hair.textures, textures_of(&files));
+        // Damage to the file or disagreement with the manifest is named.
+        let damaged = |edit: &dyn Fn(&mut Vec<u8>)| {
+            let mut files = files.clone();
+            edit(files.get_mut(&far_file).expect("file"));
+            load_runtime_asset_from(&files, "memory")
+                .expect_err("refused")
+                .to_string()
+        };
+        let word_at = |bytes: &mut Vec<u8>, at: usize, value: u32| {
+            bytes[at..at + 4].copy_from_slice(&value.to_le_bytes())
+        };
+        let hairs_at = |bytes: &Vec<u8>| {
+            let levels = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]);
+            24 + 16 * levels as usize
+        };
+        for (what, edit, expected) in [
+            (
+                "magic",
+                Box::new(|b: &mut Vec<u8>| b[0] = b'X') as Box<dyn Fn(&mut Vec<u8>)>,
+                "not a far-hair file",
+            ),
+            (
+                "truncated",
+                Box::new(|b: &mut Vec<u8>| {
+                    b.pop();
+                }),
+                "bytes where",
+            ),
+            (
+                "huge counts",
+                Box::new(move |b: &mut Vec<u8>| word_at(b, 16, u32::MAX)),
+                "bytes where",
+            ),
+            (
+                "corner of another bundle",
+                Box::new(move |b: &mut Vec<u8>| {
+                    let at = hairs_at(b);
+                    word_at(b, at, 16 * 5 + 1)
+                }),
+                "is not a grown strand of bundle",
+            ),
+            (
+                "no members",
+                Box::new(move |b: &mut Vec<u8>| {
+                    let at = hairs_at(b) + 16;
+                    word_at(b, at, 0)
+                }),
+                "members",
+            ),
+            (
+                "overlapping levels",
+                Box::new(move |b: &mut Vec<u8>| word_at(b, 24 + 16 + 4, 0)),
+                "do not follow on",
+            ),
+            (
+                "NaN width",
+                Box::new(move |b: &mut Vec<u8>| word_at(b, 24 + 12, f32::NAN.to_bits())),
+                "widest diameter",
+            ),
+        ] {
+            let message = damaged(&*edit);
+            assert!(
+                message.contains(&far_file) && message.contains(expected),
+                "{what}: {message}"
+            );
+        }
+        let mut disagreeing = files.clone();
+        let mut value = manifest.clone();
+        value["far_hair"]["thick_hairs"] = 1.into();
+        disagreeing.insert(
+            MANIFEST_FILE.into(),
+            serde_json::to_vec(&value).expect("json"),
+        );
+        let message = load_runtime_asset_from(&disagreeing, "memory")
+            .expect_err("refused")
+            .to_string();
+        assert!(message.contains("far_hair lists"), "{message}");
+        let mut outside = files.clone();
+        let mut value = manifest;
+        value["far_hair"]["file"] = "../far_hair.bin".into();
+        outside.insert(
+            MANIFEST_FILE.into(),
+            serde_json::to_vec(&value).expect("json"),
+        );
+        assert!(load_runtime_asset_from(&outside, "memory").is_err());
+    }
+
+    fn textures_of(files: &HashMap<String, Vec<u8>>) -> crate::runtime::textures::RuntimeTextures {
+        load_runtime_asset_from(files, "memory")
+            .expect("loads")
+            .hair
+            .textures
     }
 
     #[test]

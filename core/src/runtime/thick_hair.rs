@@ -248,6 +248,179 @@ impl FarHair {
     }
 }
 
+/// The far-hair file of a runtime bundle (`far_hair.HASH.bin`, `docs/runtime-format.md`):
+/// a 24-byte header (`"HLFH"`, version 1, blocks, level entries, thick hairs, 0), the level
+/// entries (block, first, count: u32; widest diameter: f32 — each block's levels from 1 up,
+/// blocks ascending), then the thick hairs as [`ThickHairGpu`](crate::runtime::gpu_types::ThickHairGpu)
+/// (32 bytes), all little-endian.
+pub const FAR_HAIR_MAGIC: [u8; 4] = *b"HLFH";
+/// Version of the far-hair file layout.
+pub const FAR_HAIR_FILE_VERSION: u32 = 1;
+const FAR_HAIR_HEADER_BYTES: usize = 24;
+const FAR_LEVEL_BYTES: usize = 16;
+const THICK_HAIR_BYTES: usize = 32;
+
+impl FarHair {
+    /// The table of `hair` as the runtime draws it at full detail with `vertex_count`
+    /// control points per strand (what an export stores).
+    pub fn build(
+        hair: &crate::runtime::hair::RuntimeHair,
+        vertex_count: usize,
+    ) -> Result<Self, ThickHairError> {
+        Ok(Self::new(
+            &build_hierarchy(hair, vertex_count)?,
+            hair.strands_per_bundle,
+        ))
+    }
+
+    /// The far-hair file's bytes (see [`FAR_HAIR_MAGIC`]).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let levels: usize = self.blocks.iter().map(Vec::len).sum();
+        let mut out = Vec::with_capacity(
+            FAR_HAIR_HEADER_BYTES
+                + levels * FAR_LEVEL_BYTES
+                + self.thick_hairs.len() * THICK_HAIR_BYTES,
+        );
+        out.extend_from_slice(&FAR_HAIR_MAGIC);
+        for word in [
+            FAR_HAIR_FILE_VERSION,
+            self.blocks.len() as u32,
+            levels as u32,
+            self.thick_hairs.len() as u32,
+            0,
+        ] {
+            out.extend_from_slice(&word.to_le_bytes());
+        }
+        for (block, block_levels) in self.blocks.iter().enumerate() {
+            for level in block_levels {
+                for word in [block as u32, level.first, level.count] {
+                    out.extend_from_slice(&word.to_le_bytes());
+                }
+                out.extend_from_slice(&(level.widest_m as f32).to_le_bytes());
+            }
+        }
+        for hair in &self.thick_hairs {
+            out.extend_from_slice(bytemuck::bytes_of(hair));
+        }
+        out
+    }
+
+    /// Reads and checks a far-hair file for a bundle whose blocks grow `grown[b]` of
+    /// `per_bundle` strands each: sizes, every level inside the table, every thick hair in
+    /// its block's level with corners among the block's grown strands and a member count the
+    /// block can have. The message names the first problem.
+    pub fn from_bytes(bytes: &[u8], grown: &[u32], per_bundle: u32) -> Result<Self, String> {
+        let word = |at: usize| -> u32 {
+            u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
+        };
+        if bytes.len() < FAR_HAIR_HEADER_BYTES || bytes[..4] != FAR_HAIR_MAGIC {
+            return Err("not a far-hair file (no \"HLFH\" header)".into());
+        }
+        if word(4) != FAR_HAIR_FILE_VERSION {
+            return Err(format!(
+                "far-hair file version {} is not supported (this build reads {FAR_HAIR_FILE_VERSION})",
+                word(4)
+            ));
+        }
+        let (blocks, level_count, hair_count) =
+            (word(8) as usize, word(12) as usize, word(16) as usize);
+        if blocks != grown.len() {
+            return Err(format!(
+                "the file has {blocks} bundles, the manifest {}",
+                grown.len()
+            ));
+        }
+        // Sizes first, in u64, so that hostile counts cannot overflow or allocate.
+        let expected = FAR_HAIR_HEADER_BYTES as u64
+            + level_count as u64 * FAR_LEVEL_BYTES as u64
+            + hair_count as u64 * THICK_HAIR_BYTES as u64;
+        if bytes.len() as u64 != expected {
+            return Err(format!(
+                "{} bytes where {level_count} levels and {hair_count} thick hairs take {expected}",
+                bytes.len()
+            ));
+        }
+        let mut far = FarHair {
+            thick_hairs: Vec::with_capacity(hair_count),
+            blocks: vec![Vec::new(); blocks],
+        };
+        let hairs_at = FAR_HAIR_HEADER_BYTES + level_count * FAR_LEVEL_BYTES;
+        for i in 0..hair_count {
+            let at = hairs_at + i * THICK_HAIR_BYTES;
+            far.thick_hairs.push(bytemuck::pod_read_unaligned(
+                &bytes[at..at + THICK_HAIR_BYTES],
+            ));
+        }
+        let mut last_block = 0;
+        // Levels tile the thick hairs in order, so every record is checked once.
+        let mut next = 0u64;
+        for i in 0..level_count {
+            let at = FAR_HAIR_HEADER_BYTES + i * FAR_LEVEL_BYTES;
+            let (block, first, count) = (word(at) as usize, word(at + 4), word(at + 8));
+            let widest_m = f32::from_le_bytes([
+                bytes[at + 12],
+                bytes[at + 13],
+                bytes[at + 14],
+                bytes[at + 15],
+            ]) as f64;
+            if block >= blocks || block < last_block {
+                return Err(format!(
+                    "level entry {i}: bundle {block} is out of order or past the {blocks} bundles"
+                ));
+            }
+            last_block = block;
+            if count == 0 || first as u64 != next || next + count as u64 > hair_count as u64 {
+                return Err(format!(
+                    "level entry {i}: thick hairs {first}..{} do not follow on from {next} inside the {hair_count} in the file",
+                    first as u64 + count as u64
+                ));
+            }
+            next += count as u64;
+            if !(widest_m.is_finite() && widest_m >= 0.0) {
+                return Err(format!("level entry {i}: widest diameter {widest_m} m"));
+            }
+            far.blocks[block].push(FarLevel {
+                first,
+                count,
+                widest_m,
+            });
+            let level = far.blocks[block].len() as u32;
+            for (j, hair) in far.thick_hairs[first as usize..][..count as usize]
+                .iter()
+                .enumerate()
+            {
+                let t = first as usize + j;
+                if hair.block as usize != block || hair.level != level {
+                    return Err(format!(
+                        "thick hair {t}: says bundle {} level {}, listed under bundle {block} level {level}",
+                        hair.block, hair.level
+                    ));
+                }
+                if hair.members == 0 || hair.members > grown[block] {
+                    return Err(format!(
+                        "thick hair {t}: {} members in a bundle growing {}",
+                        hair.members, grown[block]
+                    ));
+                }
+                for corner in hair.corners {
+                    let (owner, sample) = (corner / per_bundle.max(1), corner % per_bundle.max(1));
+                    if owner as usize != block || sample >= grown[block] {
+                        return Err(format!(
+                            "thick hair {t}: corner root {corner} is not a grown strand of bundle {block}"
+                        ));
+                    }
+                }
+            }
+        }
+        if next != hair_count as u64 {
+            return Err(format!(
+                "the levels list {next} of the {hair_count} thick hairs in the file"
+            ));
+        }
+        Ok(far)
+    }
+}
+
 fn check_strands(strands: &[Vec<DVec3>]) -> Result<(), ThickHairError> {
     let Some(first) = strands.first() else {
         return Ok(());
