@@ -14,15 +14,9 @@ const AGG_D_1PLUS: f32 = 0.6;
 const AGG_C_M: f32 = 0.2;
 const AGG_D_B: f32 = 0.7;
 
-// x^y for x ≥ 0, with 0^0 = 1 (WGSL's pow leaves both undefined).
-fn agg_pow(x: f32, y: f32) -> f32 {
-    if y <= 0.0 {
-        return 1.0;
-    }
-    if x <= 0.0 {
-        return 0.0;
-    }
-    return exp2(y * log2(x));
+// E[a^k] for a Poisson count k of mean `mean` (what passes a random number of hairs).
+fn expected_power(a: f32, mean: f32) -> f32 {
+    return exp(-max(mean, 0.0) * (1.0 - clamp(a, 0.0, 1.0)));
 }
 
 fn agg_gaussian(x: f32, variance: f32) -> f32 {
@@ -55,13 +49,13 @@ fn agg_lobe(p: u32, theta: f32, phi: f32) -> vec3<f32> {
     return mix(a, b, t.z);
 }
 
-// Σ_{i=1}^{n} a^{2i−1} in closed form.
+// E[Σ_{i=1}^{k} a^{2i−1}] for a Poisson count k of mean n, in closed form.
 fn odd_power_sum(a: f32, n: f32) -> f32 {
     let a2 = a * a;
     if 1.0 - a2 < 1e-6 {
         return a * n;
     }
-    return a * (1.0 - agg_pow(a2, n)) / (1.0 - a2);
+    return a * (1.0 - expected_power(a2, n)) / (1.0 - a2);
 }
 
 // f for the shaded fibre of a cluster: `path` = (hairs before, itself included; hairs behind)
@@ -94,7 +88,7 @@ fn aggregated_bcsdf(wo: vec3<f32>, wi: vec3<f32>, path: vec2<f32>, coverage: f32
     let single_back = agg_profile(2u, theta_i);
     let r_f = agg_profile(3u, theta_i).x;
     let widen = 4.0 * before * forward.w;
-    let sharpness = agg_pow(clamp(r_f, 0.0, 1.0), before);
+    let sharpness = expected_power(clamp(r_f, 0.0, 1.0), before);
     var lobes = vec3<f32>(0.0);
     for (var p = 0u; p < 4u; p++) {
         let o = tilted(p, sin_theta_o, cos_theta_o);
@@ -107,14 +101,15 @@ fn aggregated_bcsdf(wo: vec3<f32>, wi: vec3<f32>, path: vec2<f32>, coverage: f32
         lobes += m * (sharpness * shaped + (1.0 - sharpness) * mean / TAU);
     }
     let near_half = select(0.0, 1.0 / PI, phi < 0.5 * PI);
-    let shadow_angle = min(phi, 0.5 * PI);
-    let p_s = (1.0 - rho) * (1.0 - cos(shadow_angle));
-    let p_m = (1.0 - rho) * AGG_C_M;
+    // Eq. 12-13 on the light's side; past |φ| = π/2 both fade to 0 at φ = π (n counts it).
+    let cos_phi = cos(phi);
+    let p_s = (1.0 - rho) * (1.0 - abs(cos_phi));
+    let p_m = (1.0 - rho) * AGG_C_M * min(1.0 + cos_phi, 1.0);
     let p_n = max(1.0 - p_s - p_m, 0.0);
     var out = vec3<f32>(0.0);
     for (var c = 0; c < 3; c++) {
         let a_f = clamp(forward[c], 0.0, 1.0);
-        let local = AGG_D_B * max(back[c], 0.0) * (1.0 - agg_pow(a_f * a_f, behind));
+        let local = AGG_D_B * max(back[c], 0.0) * (1.0 - expected_power(a_f * a_f, behind));
         let gaps = AGG_D_1PLUS * max(single_back[c], 0.0) * odd_power_sum(a_f, behind);
         let total_b = local + gaps;
         var variance_b = single_back.w;
@@ -123,7 +118,7 @@ fn aggregated_bcsdf(wo: vec3<f32>, wi: vec3<f32>, path: vec2<f32>, coverage: f32
         }
         let b_hat = total_b * agg_gaussian(theta_h - back.w, variance_b) / (2.0 * cos_theta_d) * near_half;
         let s = p_s * a_f + p_n;
-        out[c] = s * (agg_pow(a_f, before) * lobes[c] + b_hat);
+        out[c] = s * (expected_power(a_f, before) * lobes[c] + b_hat);
     }
     return select(vec3<f32>(0.0), out, (out < vec3<f32>(3.0e38)) & (out >= vec3<f32>(0.0)));
 }

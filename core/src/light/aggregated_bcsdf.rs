@@ -14,7 +14,8 @@
 //!
 //! - **R̂, T̂T, TRT and the residual lobe** (the paper's R̂, T̂, D̂): the shaded fibre's lobes
 //!   averaged over the incident offset `h` (a thick hair's shading point is some fibre at some
-//!   offset), attenuated by the `n − 1` fibres before it (eq. 7). Each longitudinal lobe is the
+//!   offset), attenuated by the `n − 1` fibres before it (eq. 7; as the mean over a Poisson
+//!   count of fibres, `exp(−(n − 1)(1 − a_F))`, not `a_F^{n−1}`, see [`expected_power`]). Each longitudinal lobe is the
 //!   fibre's own `M_p` with its variance widened by `(n − 1) β_f²` (eq. 9; the paper's
 //!   Gaussians in `θ_h` lose most of a rough lobe's energy off the sphere, `M_p` is
 //!   normalised at every width and exact at `n = 1`). Azimuthally, the forward scatterings
@@ -34,9 +35,11 @@
 //!   furnace gives it. Its variance is the attenuation-weighted mean of the paths' (`σ_b²`
 //!   for `A₁ + A₃`, `σ_b² + m β_f²` for `A₁₊`), uniform over the near half circle.
 //! - **S** (eq. 12-15): shadowing-masking by the cluster's own fibres. The paper defines it for
-//!   `|φ| < π/2`; beyond, the light comes through the cluster (that is `n`), so we hold the
-//!   shadowing angle at `π/2` there to keep `S` continuous. `P_n` is kept ≥ 0 (for sparse
-//!   clusters `P_s + P_m` can pass 1).
+//!   `|φ| < π/2`; beyond, the light comes through the cluster, which `n` already counts, so
+//!   `P_s = (1 − ρ)(1 − |cos φ|)` and `P_m = (1 − ρ) c_m min(1, 1 + cos φ)` fade to 0 at
+//!   `φ = π`, continuously (holding the front's values there shadowed back light twice: the
+//!   explicit-fibre reference measured it several times too dark). `P_n` is kept ≥ 0 (for
+//!   sparse clusters `P_s + P_m` can pass 1).
 //! - **n from the cluster's shape** (§5.2): the paper's `n = ρ l √(N / π|r_A||r_B|)` is not the
 //!   mean free path of a fibre bundle; we use the exact expectation for fibres of radius `r`
 //!   placed at random in the cross-section, `2 r (N − 1) / (π a b)` crossings per metre past
@@ -225,7 +228,7 @@ impl AggregatedTables {
         let widen = 4.0 * before * forward[3];
         let lobe = |x: f64, v: f64| ds_gaussian(x, v) / (2.0 * cos_theta_d);
         // First harmonic of the azimuthal lobes after n − 1 forward deflections.
-        let sharpness = r_f.clamp(0.0, 1.0).powf(before);
+        let sharpness = expected_power(r_f.clamp(0.0, 1.0), before);
         let mut out = [0.0; 3];
         let mut lobes = [0.0; 3];
         for p in 0..=P_MAX {
@@ -249,15 +252,17 @@ impl AggregatedTables {
             }
         }
         let near_half = if phi < FRAC_PI_2 { 1.0 / PI } else { 0.0 };
-        let shadow_angle = phi.min(FRAC_PI_2);
-        let p_s = (1.0 - rho) * (1.0 - shadow_angle.cos());
-        let p_m = (1.0 - rho) * C_M;
+        // Eq. 12-13 where the eye and the light share a side (|φ| < π/2); past it the light
+        // comes through the cluster, which `n` already counts, so both fade to 0 at φ = π.
+        let cos_phi = phi.cos();
+        let p_s = (1.0 - rho) * (1.0 - cos_phi.abs());
+        let p_m = (1.0 - rho) * C_M * (1.0 + cos_phi).min(1.0);
         let p_n = (1.0 - p_s - p_m).max(0.0);
         for c in 0..3 {
             let a_f = forward[c].clamp(0.0, 1.0);
             // Dual scattering's A₁ + A₃ assume hairs without end behind the shaded one; with
             // `behind` of them the series stops there (a single strand returns nothing).
-            let local = D_B * back[c].max(0.0) * (1.0 - (a_f * a_f).powf(behind));
+            let local = D_B * back[c].max(0.0) * (1.0 - expected_power(a_f * a_f, behind));
             let gaps = D_1PLUS * single_back[c].max(0.0) * odd_power_sum(a_f, behind);
             let total_b = local + gaps;
             let variance_b = if total_b > 1e-12 {
@@ -267,19 +272,29 @@ impl AggregatedTables {
             };
             let b_hat = total_b * lobe(theta_h - back[3], variance_b) * near_half;
             let s = p_s * a_f + p_n;
-            out[c] = s * (a_f.powf(before) * lobes[c] + b_hat);
+            out[c] = s * (expected_power(a_f, before) * lobes[c] + b_hat);
         }
         out.map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 })
     }
 }
 
-/// `Σ_{i=1}^{n} a^{2i−1} = a (1 − a^{2n}) / (1 − a²)`, for real `n ≥ 0` and `a ∈ [0, 1]`.
+/// `E[a^k]` for a Poisson count `k` of mean `mean`: `exp(−mean (1 − a))`. The hairs a ray
+/// meets in a cluster are a random count, and what passes them is the mean of `a^k`, not
+/// `a` to the mean count (the paper's `a_F^{n−1}`): by Jensen's inequality that is darker,
+/// and the explicit-fibre reference ([`crate::light::cluster_reference`]) measured it
+/// several times too dark for back light through sparse clusters.
+pub fn expected_power(a: f64, mean: f64) -> f64 {
+    (-mean.max(0.0) * (1.0 - a.clamp(0.0, 1.0))).exp()
+}
+
+/// `E[Σ_{i=1}^{k} a^{2i−1}] = a (1 − E[a^{2k}]) / (1 − a²)` for a Poisson count `k` of mean
+/// `n` (the `A₁₊` series over the hairs behind), `a ∈ [0, 1]`.
 pub fn odd_power_sum(a: f64, n: f64) -> f64 {
     let a2 = a * a;
     if 1.0 - a2 < 1e-6 {
         return a * n;
     }
-    a * (1.0 - a2.powf(n)) / (1.0 - a2)
+    a * (1.0 - expected_power(a2, n)) / (1.0 - a2)
 }
 
 /// `∫_{π/2}^{3π/2} N_p(φ) cos(φ − π) dφ`: lobe `p`'s forward-scattered light weighted by the
@@ -662,7 +677,7 @@ mod tests {
                 behind: 0.0,
             };
             let f = black.aggregated_bcsdf(eye, direction(theta_i, FRAC_PI_2 + 0.3), path, 1.0);
-            f[0] / black.agg_profile(0, theta_i)[0].powf(before - 1.0)
+            f[0] / expected_power(black.agg_profile(0, theta_i)[0], before - 1.0)
         };
         let spread = |before: f64| shape(before, 1.1) / shape(before, 0.25);
         assert!(

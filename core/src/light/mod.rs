@@ -8,11 +8,13 @@
 //! | [`hair_bsdf`] | the Marschner R / TT / TRT fibre model in Chiang's energy-conserving form |
 //! | [`dual_scattering`] | Zinke et al. 2008's multiple-scattering tables and response |
 //! | [`aggregated_bcsdf`] | far hair: seed 001's aggregated BCSDF for a thick hair standing for a cluster of fibres |
+//! | [`cluster_reference`] | the explicit-fibre reference the aggregated BCSDF is measured against |
 //! | [`opacity_maps`] | shadow views, opacity-map layers and lookups (Kim & Neumann 2001; Yuksel & Keyser 2008) |
 //! | [`scene_uniforms`] | the scene as the shaders receive it (`shaders/shared/scene.wgsl`) |
 //! | [`reference_render`] | the CPU path tracer: f64 reference strands as fibres, exact shadows, many bounces |
 
 pub mod aggregated_bcsdf;
+pub mod cluster_reference;
 pub mod dual_scattering;
 pub mod hair_bsdf;
 pub mod material;
