@@ -123,12 +123,41 @@ fn aggregated_bcsdf(wo: vec3<f32>, wi: vec3<f32>, path: vec2<f32>, coverage: f32
     return select(vec3<f32>(0.0), out, (out < vec3<f32>(3.0e38)) & (out >= vec3<f32>(0.0)));
 }
 
+const AGG_VISIBLE_DEPTHS: u32 = 3u;
+
+// How far the line p + t d runs inside the unit circle ahead and behind, for p inside or on
+// it (the stable roots of |p + t d|² = 1).
+fn chord_ends(p: vec2<f32>, d: vec2<f32>) -> vec2<f32> {
+    let aa = dot(d, d);
+    if aa < 1e-18 {
+        return vec2<f32>(0.0);
+    }
+    let bb = dot(p, d);
+    let cc = min(dot(p, p) - 1.0, 0.0);
+    let root = sqrt(max(bb * bb - aa * cc, 0.0));
+    let q = -(bb + select(-root, root, bb >= 0.0));
+    var t = vec2<f32>(0.0);
+    if q != 0.0 {
+        t = vec2<f32>(q / aa, cc / q);
+    }
+    return vec2<f32>(max(max(t.x, t.y), 0.0), max(-min(t.x, t.y), 0.0));
+}
+
 // (hairs before the shaded fibre, itself included; hairs behind it) on the light's line
-// through the point where the eye's ray at `across` ∈ [−1, 1] enters the cluster's ellipse.
+// through the k-th of AGG_VISIBLE_DEPTHS depths at which the eye's ray at `across` ∈ [−1, 1]
+// meets its fibre (quantiles of the exponential first-hit depth within the ellipse's chord).
 // `shape`: semi-major, semi-minor (m), major-axis angle in the fibre frame's y-z plane,
-// crossings per metre. Computed in the ellipse's unit-circle coordinates, where the entry is
-// exactly on the circle and the light's chord from it stays well-conditioned.
-fn cluster_hairs_on_path(shape: vec4<f32>, wo: vec3<f32>, wi: vec3<f32>, across: f32) -> vec2<f32> {
+// crossings per metre. In the ellipse's unit-circle coordinates, where the entry is exactly on
+// the circle and chords stay well-conditioned; counts follow the in-plane chords (fibres run
+// along the hair).
+fn cluster_hairs_on_path(
+    shape: vec4<f32>,
+    fibre_radius_m: f32,
+    wo: vec3<f32>,
+    wi: vec3<f32>,
+    across: f32,
+    k: u32,
+) -> vec2<f32> {
     let c = cos(shape.z);
     let s_angle = sin(shape.z);
     let to_unit = mat2x2<f32>(vec2<f32>(c / shape.x, -s_angle / shape.y), vec2<f32>(s_angle / shape.x, c / shape.y));
@@ -137,24 +166,63 @@ fn cluster_hairs_on_path(shape: vec4<f32>, wo: vec3<f32>, wi: vec3<f32>, across:
     if view_length > 1e-6 {
         view = wo.yz / view_length;
     }
-    let v = normalize(to_unit * view);
-    let side = vec2<f32>(v.y, -v.x);
+    let v = to_unit * view;
+    let v_length = length(v);
+    if !(v_length > 0.0 && v_length < 3.0e38) {
+        return vec2<f32>(1.0, 0.0);
+    }
+    let v_hat = v / v_length;
+    let side = vec2<f32>(v_hat.y, -v_hat.x);
     var s = 0.0;
     if across < 3.0e38 && across > -3.0e38 {
         s = clamp(across, -1.0, 1.0);
     }
-    let entry = s * side + sqrt(max(1.0 - s * s, 0.0)) * v;
+    let entry = s * side + sqrt(max(1.0 - s * s, 0.0)) * v_hat;
+    let inward = -v;
+    let chord = max(-2.0 * dot(entry, inward) / (v_length * v_length), 0.0);
+    let u = (f32(min(k, AGG_VISIBLE_DEPTHS - 1u)) + 0.5) / f32(AGG_VISIBLE_DEPTHS);
+    let rate = shape.w;
+    let q = rate * chord;
+    var depth = u * chord;
+    if q >= 1e-4 {
+        depth = -log(1.0 - u * (1.0 - exp(-q))) / rate;
+    }
+    depth = clamp(depth, 0.0, chord);
     let in_plane = length(wi.yz);
     if !(in_plane > 1e-6) {
         return vec2<f32>(1.0, 0.0);
     }
-    // From a point p of the unit circle the line p + t d meets it again at t = −2 p·d / |d|².
-    let d = to_unit * (wi.yz / in_plane);
-    let other = -2.0 * dot(entry, d) / dot(d, d);
-    let per_m = shape.w / max(in_plane, 0.1);
-    let path = vec2<f32>(1.0 + per_m * max(other, 0.0), per_m * max(-other, 0.0));
+    let light = wi.yz / in_plane;
+    let ends = chord_ends(entry + depth * inward, to_unit * light);
+    // The eye's ray is empty up to the shaded fibre: light leaving back along it meets
+    // nothing while the two stay within a fibre's width.
+    let cos_a = dot(light, view);
+    var free = 0.0;
+    if cos_a > 0.0 {
+        let sin_a = sqrt(max(1.0 - cos_a * cos_a, 0.0));
+        free = min(ends.x, min(depth / max(cos_a, 1e-6), 2.0 * fibre_radius_m / max(sin_a, 1e-6)));
+    }
+    let path = vec2<f32>(1.0 + rate * max(ends.x - free, 0.0), rate * ends.y);
     if !(path.x < 3.0e38 && path.y < 3.0e38) {
         return vec2<f32>(1.0, 0.0);
     }
     return path;
+}
+
+// What a thick hair shows at `across` of its ribbon: `aggregated_bcsdf` averaged over the
+// depths of the fibre the eye meets.
+fn aggregated_cluster(
+    shape: vec4<f32>,
+    fibre_radius_m: f32,
+    coverage: f32,
+    wo: vec3<f32>,
+    wi: vec3<f32>,
+    across: f32,
+) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < AGG_VISIBLE_DEPTHS; k++) {
+        let path = cluster_hairs_on_path(shape, fibre_radius_m, wo, wi, across, k);
+        sum += aggregated_bcsdf(wo, wi, path, coverage);
+    }
+    return sum / f32(AGG_VISIBLE_DEPTHS);
 }

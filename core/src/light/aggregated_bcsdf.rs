@@ -43,8 +43,12 @@
 //! - **n from the cluster's shape** (§5.2): the paper's `n = ρ l √(N / π|r_A||r_B|)` is not the
 //!   mean free path of a fibre bundle; we use the exact expectation for fibres of radius `r`
 //!   placed at random in the cross-section, `2 r (N − 1) / (π a b)` crossings per metre past
-//!   the shaded fibre (tested against fibres placed at random), along the path from the
-//!   shaded point on the viewer-facing side of the ellipse to where the light enters.
+//!   the shaded fibre (tested against fibres placed at random), along the in-plane chord
+//!   from the shaded point to where the light enters. The shaded point is not on the edge
+//!   alone: the eye meets its first fibre at an exponentially distributed depth, and
+//!   [`AggregatedTables::aggregated_cluster`] averages three quantiles of it
+//!   ([`cluster_hairs_on_path`]); light leaving back along the eye's (empty) ray crosses
+//!   nothing while within a fibre's width of it.
 //!
 //! `d₁₊ = 0.6`, `c_m = 0.2` as in the paper; `D_B` is dual scattering's.
 
@@ -430,56 +434,203 @@ impl HairsOnPath {
     };
 }
 
-/// The hairs on the light's line through the shaded point, which is where the eye's ray at
-/// offset `across ∈ [−1, 1]` of the ribbon's width enters the ellipse: toward the light along
-/// `wi` to the ellipse's edge, and away from it. Each length is the in-plane chord over the
-/// in-plane share of `wi` (capped at ten times: light along the tangent).
+/// Depths along the eye's ray at which the shaded fibre is taken ([`cluster_hairs_on_path`]).
+pub const VISIBLE_DEPTHS: u32 = 3;
+
+/// The hairs on the light's line through the shaded fibre, which lies on the eye's ray at
+/// offset `across ∈ [−1, 1]` of the ribbon's width, `depth_m` past where that ray enters the
+/// ellipse (in the cross-section): toward the light along `wi` to the ellipse's edge, and away
+/// from it. Fibres run along the hair, so a ray meets the ones its cross-section part crosses:
+/// counts follow the in-plane chords.
+pub fn cluster_hairs_at_depth(
+    shape: &ClusterShape,
+    wo: DVec3,
+    wi: DVec3,
+    across: f64,
+    depth_m: f64,
+) -> HairsOnPath {
+    let Some(geometry) = EyeRay::new(shape, wo, across) else {
+        return HairsOnPath::ALONE;
+    };
+    let depth = if depth_m.is_finite() {
+        depth_m.clamp(0.0, geometry.chord_m)
+    } else {
+        0.0
+    };
+    geometry.hairs_from(shape, wi, depth)
+}
+
+/// The hairs on the light's line through the `k`-th of [`VISIBLE_DEPTHS`] depths at which the
+/// eye's ray at `across` meets its fibre: the first fibre a ray meets lies at an exponentially
+/// distributed depth (rate: crossings per metre) within the ellipse's chord, and the depths
+/// are that distribution's quantiles `(k + ½) / VISIBLE_DEPTHS`. In a sparse cluster the eye
+/// sees fibres deep inside, nearer a back light: taking the shaded fibre on the edge alone
+/// made back light several times too dark against explicit fibres.
 pub fn cluster_hairs_on_path(
     shape: &ClusterShape,
     wo: DVec3,
     wi: DVec3,
     across: f64,
+    k: u32,
 ) -> HairsOnPath {
-    // Everything in the ellipse's unit-circle coordinates, where lines stay lines and the
-    // fraction of the width a ray is at is kept: the entry point is then exactly on the
-    // circle, and the light's chord from it is well-conditioned even through a flat ellipse.
-    let (a, b) = (shape.semi_major_m, shape.semi_minor_m);
-    let (cos, sin) = (shape.major_angle_rad.cos(), shape.major_angle_rad.sin());
-    let unit = |p: (f64, f64)| ((p.0 * cos + p.1 * sin) / a, (p.1 * cos - p.0 * sin) / b);
-    let planar = |d: DVec3| {
-        let length = (d.y * d.y + d.z * d.z).sqrt();
-        (length > 1e-6 && length.is_finite()).then(|| ((d.y / length, d.z / length), length))
-    };
-    let (view, _) = planar(wo).unwrap_or(((0.0, 1.0), 1.0));
-    let v = unit(view);
-    let v_length = (v.0 * v.0 + v.1 * v.1).sqrt();
-    let v = (v.0 / v_length, v.1 / v_length);
-    // The ribbon's `across` runs along (view.y, −view.y)'s image, which points the same way
-    // as (v.1, −v.0) in unit coordinates (the map keeps orientation).
-    let side = (v.1, -v.0);
-    let s = if across.is_finite() {
-        across.clamp(-1.0, 1.0)
-    } else {
-        0.0
-    };
-    let along = (1.0 - s * s).max(0.0).sqrt();
-    let entry = (s * side.0 + along * v.0, s * side.1 + along * v.1);
-    let Some((light, in_plane)) = planar(wi) else {
+    let Some(geometry) = EyeRay::new(shape, wo, across) else {
         return HairsOnPath::ALONE;
     };
-    // From a point p of the unit circle the line p + t d meets it again at t = −2 p·d / |d|².
-    let d = unit(light);
-    let dd = d.0 * d.0 + d.1 * d.1;
-    let other = -2.0 * (entry.0 * d.0 + entry.1 * d.1) / dd;
-    let per_m = shape.crossings_per_m() / in_plane.max(0.1);
-    let path = HairsOnPath {
-        before: 1.0 + per_m * other.max(0.0),
-        behind: per_m * (-other).max(0.0),
-    };
-    if path.before.is_finite() && path.behind.is_finite() {
-        path
+    let u = (k.min(VISIBLE_DEPTHS - 1) as f64 + 0.5) / VISIBLE_DEPTHS as f64;
+    let rate = shape.crossings_per_m();
+    let q = rate * geometry.chord_m;
+    let depth = if q < 1e-4 {
+        u * geometry.chord_m
     } else {
-        HairsOnPath::ALONE
+        -(1.0 - u * (1.0 - (-q).exp())).ln() / rate
+    };
+    geometry.hairs_from(shape, wi, depth.clamp(0.0, geometry.chord_m))
+}
+
+/// The eye's ray through a cluster, in the ellipse's unit-circle coordinates (where lines stay
+/// lines and the fraction of the width a ray is at is kept, so the entry is exactly on the
+/// circle and chords stay well-conditioned even through a flat ellipse).
+struct EyeRay {
+    /// Where the ray enters, and its direction into the cluster per metre of the
+    /// cross-section, both in unit-circle coordinates.
+    entry: (f64, f64),
+    inward: (f64, f64),
+    /// Its chord through the ellipse, in metres of the cross-section.
+    chord_m: f64,
+    /// Toward the eye, unit, in the cross-section (metres).
+    view: (f64, f64),
+    cos: f64,
+    sin: f64,
+}
+
+impl EyeRay {
+    fn new(shape: &ClusterShape, wo: DVec3, across: f64) -> Option<Self> {
+        let (cos, sin) = (shape.major_angle_rad.cos(), shape.major_angle_rad.sin());
+        let mut ray = EyeRay {
+            entry: (0.0, 0.0),
+            inward: (0.0, 0.0),
+            chord_m: 0.0,
+            view: (0.0, 1.0),
+            cos,
+            sin,
+        };
+        let view = planar(wo).map_or((0.0, 1.0), |(d, _)| d);
+        ray.view = view;
+        let v = ray.unit(shape, view);
+        let v_length = (v.0 * v.0 + v.1 * v.1).sqrt();
+        if !(v_length > 0.0 && v_length.is_finite()) {
+            return None;
+        }
+        let v_hat = (v.0 / v_length, v.1 / v_length);
+        // The ribbon's `across` runs along (view.y, −view.x)'s image, which points the same
+        // way as (v.1, −v.0) in unit coordinates (the map keeps orientation).
+        let side = (v_hat.1, -v_hat.0);
+        let s = if across.is_finite() {
+            across.clamp(-1.0, 1.0)
+        } else {
+            0.0
+        };
+        let along = (1.0 - s * s).max(0.0).sqrt();
+        ray.entry = (s * side.0 + along * v_hat.0, s * side.1 + along * v_hat.1);
+        ray.inward = (-v.0, -v.1);
+        // From a point p of the unit circle the line p + t d meets it again at −2 p·d / |d|².
+        let dd = v_length * v_length;
+        ray.chord_m =
+            (-2.0 * (ray.entry.0 * ray.inward.0 + ray.entry.1 * ray.inward.1) / dd).max(0.0);
+        Some(ray)
+    }
+
+    /// A cross-section direction (metres) in unit-circle coordinates.
+    fn unit(&self, shape: &ClusterShape, p: (f64, f64)) -> (f64, f64) {
+        (
+            (p.0 * self.cos + p.1 * self.sin) / shape.semi_major_m,
+            (p.1 * self.cos - p.0 * self.sin) / shape.semi_minor_m,
+        )
+    }
+
+    /// The hairs on the light's line through the point `depth_m` along the ray.
+    fn hairs_from(&self, shape: &ClusterShape, wi: DVec3, depth_m: f64) -> HairsOnPath {
+        let Some((light, _)) = planar(wi) else {
+            return HairsOnPath::ALONE;
+        };
+        let p = (
+            self.entry.0 + depth_m * self.inward.0,
+            self.entry.1 + depth_m * self.inward.1,
+        );
+        let d = self.unit(shape, light);
+        let (toward, away) = chord_ends(p, d);
+        // The eye's ray is empty up to the shaded fibre: a light ray leaving back along it
+        // meets nothing while the two stay within a fibre's width (the correlation seed 001's
+        // shadowing-masking stands for; without it, deep fibres went dark under front light).
+        let cos_a = light.0 * self.view.0 + light.1 * self.view.1;
+        let free = if cos_a > 0.0 {
+            let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+            let along_eye = depth_m / cos_a.max(1e-6);
+            let beside_eye = 2.0 * shape.fibre_radius_m / sin_a.max(1e-6);
+            toward.min(along_eye).min(beside_eye)
+        } else {
+            0.0
+        };
+        let per_m = shape.crossings_per_m();
+        let path = HairsOnPath {
+            before: 1.0 + per_m * (toward - free).max(0.0),
+            behind: per_m * away,
+        };
+        if path.before.is_finite() && path.behind.is_finite() {
+            path
+        } else {
+            HairsOnPath::ALONE
+        }
+    }
+}
+
+/// A direction's part across the fibres, normalised, and its length; `None` along them.
+fn planar(d: DVec3) -> Option<((f64, f64), f64)> {
+    let length = (d.y * d.y + d.z * d.z).sqrt();
+    (length > 1e-6 && length.is_finite()).then(|| ((d.y / length, d.z / length), length))
+}
+
+/// How far the line `p + t d` runs inside the unit circle ahead (`t > 0`) and behind, for `p`
+/// inside or on it: the roots of `|p + t d|² = 1` by the stable form (a point on the circle
+/// gives exactly 0 on one side).
+fn chord_ends(p: (f64, f64), d: (f64, f64)) -> (f64, f64) {
+    let aa = d.0 * d.0 + d.1 * d.1;
+    if aa < 1e-18 {
+        return (0.0, 0.0);
+    }
+    let bb = p.0 * d.0 + p.1 * d.1;
+    let cc = (p.0 * p.0 + p.1 * p.1 - 1.0).min(0.0);
+    let root = (bb * bb - aa * cc).max(0.0).sqrt();
+    let q = -(bb + if bb >= 0.0 { root } else { -root });
+    let (t1, t2) = if q != 0.0 {
+        (q / aa, cc / q)
+    } else {
+        (0.0, 0.0)
+    };
+    let (lo, hi) = (t1.min(t2), t1.max(t2));
+    (hi.max(0.0), (-lo).max(0.0))
+}
+
+impl AggregatedTables {
+    /// What a thick hair shows at `across` of its ribbon: [`Self::aggregated_bcsdf`] averaged
+    /// over the [`VISIBLE_DEPTHS`] depths of the fibre the eye meets
+    /// ([`cluster_hairs_on_path`]); the shader's `aggregated_cluster`.
+    pub fn aggregated_cluster(
+        &self,
+        shape: &ClusterShape,
+        wo: DVec3,
+        wi: DVec3,
+        across: f64,
+    ) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for k in 0..VISIBLE_DEPTHS {
+            let path = cluster_hairs_on_path(shape, wo, wi, across, k);
+            let f = self.aggregated_bcsdf(wo, wi, path, shape.coverage());
+            for c in 0..3 {
+                sum[c] += f[c] / VISIBLE_DEPTHS as f64;
+            }
+        }
+        sum
     }
 }
 
@@ -550,8 +701,7 @@ mod tests {
                 for j in 0..np_ {
                     let phi = (j as f64 + 0.5) * TAU / np_ as f64;
                     let wi = direction(theta, phi);
-                    let n = cluster_hairs_on_path(shape, wo, wi, across);
-                    let f = tables.aggregated_bcsdf(wo, wi, n, shape.coverage());
+                    let f = tables.aggregated_cluster(shape, wo, wi, across);
                     let d_omega = theta.cos() * (PI / nt as f64) * (TAU / np_ as f64);
                     for c in 0..3 {
                         sum[c] += f[c] * d_omega / nh as f64;
@@ -745,36 +895,56 @@ mod tests {
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * b.max(1.0);
         let through = shape.crossings_per_m() * 20.0 * r;
         // Light from the viewer: it meets the shaded hair first, the thickness (2b) behind.
-        let front = cluster_hairs_on_path(&shape, wo, direction(0.0, FRAC_PI_2), 0.0);
+        let at_edge = |wi: DVec3, across: f64| cluster_hairs_at_depth(&shape, wo, wi, across, 0.0);
+        let front = at_edge(direction(0.0, FRAC_PI_2), 0.0);
         assert!(
             close(front.before, 1.0) && close(front.behind, through),
             "{front:?}"
         );
         // Light from behind: through the whole thickness, nothing behind.
-        let back = cluster_hairs_on_path(&shape, wo, direction(0.0, -FRAC_PI_2), 0.0);
+        let back = at_edge(direction(0.0, -FRAC_PI_2), 0.0);
         assert!(
             close(back.before, 1.0 + through) && close(back.behind, 0.0),
             "{back:?}"
         );
         // Light from the side, a quarter of the width in from the far edge: the shaded point
         // is at y = −a/2, so the light crosses to y = +a/2 (a) and nothing lies behind.
-        let side = cluster_hairs_on_path(&shape, wo, direction(0.0, 0.0), -0.5);
+        let side = at_edge(direction(0.0, 0.0), -0.5);
         let expected = 1.0 + shape.crossings_per_m() * 30.0 * r;
         assert!(
             close(side.before, expected) && close(side.behind, 0.0),
             "{side:?}"
         );
-        // Tilting the light out of the cross-section lengthens the path by 1 / cos θ.
-        let tilted = cluster_hairs_on_path(&shape, wo, direction(0.5, -FRAC_PI_2), 0.0);
+        // Tilting the light along the fibres crosses the same ones.
+        let tilted = at_edge(direction(0.5, -FRAC_PI_2), 0.0);
+        assert!(close(tilted.before, 1.0 + through), "{tilted:?}");
+        // Deeper along the eye's ray, back light crosses fewer fibres and front light more;
+        // the depths the eye sees lie inside the chord, shallowest first.
+        let half = at_edge(direction(0.0, -FRAC_PI_2), 0.0);
+        let deep = cluster_hairs_at_depth(&shape, wo, direction(0.0, -FRAC_PI_2), 0.0, 10.0 * r);
         assert!(
-            close(tilted.before, 1.0 + through / 0.5f64.cos()),
-            "{tilted:?}"
+            close(deep.before, 1.0 + 0.5 * (half.before - 1.0)),
+            "{deep:?}"
         );
+        let depths = |wi: DVec3| -> Vec<f64> {
+            (0..VISIBLE_DEPTHS)
+                .map(|k| cluster_hairs_on_path(&shape, wo, wi, 0.0, k).before)
+                .collect()
+        };
+        let oblique = depths(direction(0.0, 0.6));
+        assert!(oblique.windows(2).all(|w| w[0] <= w[1]), "{oblique:?}");
+        assert!(oblique[VISIBLE_DEPTHS as usize - 1] > 1.5, "{oblique:?}");
+        // Light along the eye's own ray comes back through the gap the eye looked through.
+        for n in depths(direction(0.0, FRAC_PI_2)) {
+            assert!(close(n, 1.0), "{n}");
+        }
         // A single strand has nothing else on the path.
         let one = ClusterShape::new(0.0, 0.0, 0.0, 1, r).expect("valid");
         for across in [-1.0, 0.0, 0.7, 1.0] {
-            let n = cluster_hairs_on_path(&one, wo, direction(-0.3, -1.0), across);
-            assert_eq!(n, HairsOnPath::ALONE);
+            for k in 0..VISIBLE_DEPTHS {
+                let n = cluster_hairs_on_path(&one, wo, direction(-0.3, -1.0), across, k);
+                assert_eq!(n, HairsOnPath::ALONE);
+            }
         }
     }
 
@@ -790,12 +960,14 @@ mod tests {
         for shape in clusters() {
             for (wo, wi) in hard {
                 for across in [-1.0, 1.0, f64::NAN, 3.0] {
-                    let n = cluster_hairs_on_path(&shape, wo, wi, across);
-                    assert!(
-                        n.before.is_finite() && n.before >= 1.0 && n.behind >= 0.0,
-                        "{shape:?}: {n:?}"
-                    );
-                    let f = tables.aggregated_bcsdf(wo, wi, n, shape.coverage());
+                    for k in 0..VISIBLE_DEPTHS {
+                        let n = cluster_hairs_on_path(&shape, wo, wi, across, k);
+                        assert!(
+                            n.before.is_finite() && n.before >= 1.0 && n.behind >= 0.0,
+                            "{shape:?}: {n:?}"
+                        );
+                    }
+                    let f = tables.aggregated_cluster(&shape, wo, wi, across);
                     assert!(f.iter().all(|v| v.is_finite() && *v >= 0.0), "{f:?}");
                 }
             }

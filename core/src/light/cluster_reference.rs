@@ -260,7 +260,7 @@ mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     use super::*;
-    use crate::light::aggregated_bcsdf::{AggregatedTables, ClusterShape, cluster_hairs_on_path};
+    use crate::light::aggregated_bcsdf::{AggregatedTables, ClusterShape};
     use crate::light::material::Fibre;
     use crate::model::scene::{HairMaterial, Pigment};
 
@@ -303,8 +303,7 @@ mod tests {
                 let weight = tilt.sin();
                 for s in 0..8 {
                     let across = -1.0 + (s as f64 + 0.5) / 4.0;
-                    let path = cluster_hairs_on_path(&shape, wo, wi, across);
-                    let f = tables.aggregated_bcsdf(wo, wi, path, shape.coverage());
+                    let f = tables.aggregated_cluster(&shape, wo, wi, across);
                     let g = bsdf.hair_bsdf(wo, wi, across, sigma_a);
                     for c in 0..3 {
                         aggregated[c] += weight * f[c];
