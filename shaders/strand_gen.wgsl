@@ -91,15 +91,8 @@ fn main_per_vertex(@builtin(global_invocation_id) id: vec3<u32>) {
 // generates its four corner strands as `main` generates any strand and writes, per vertex,
 // their centre with `along` to `positions` and the half-axes they span to `sections`
 // (2 per vertex: major and the member count, minor). CPU mirror: StrandGen::thick_main.
-// Keep the structs in sync with core/src/runtime/gpu_types.rs.
-struct ThickHairGpu {
-    corners: vec4<u32>,
-    members: u32,
-    block: u32,
-    level: u32,
-    padding: u32,
-}
-
+// `ThickHairGpu` is in shared/thick_hair.wgsl. Keep the structs in sync with
+// core/src/runtime/gpu_types.rs.
 struct ThickGenParams {
     first: u32,
     count: u32,

@@ -62,6 +62,10 @@ fn embedded() -> Vec<(String, String)> {
             oit_composite_shader(samples),
         ));
     }
+    sources.push((
+        "far_lod".to_string(),
+        hairloom_render::renderer::far_lod::FAR_LOD_SOURCE.to_string(),
+    ));
     // Far hair's shading model, after the fibre model it builds on.
     sources.push((
         "aggregated_bcsdf".to_string(),
@@ -156,6 +160,11 @@ fn gpu_structs_match_their_wgsl() {
         (SHADER_SOURCE, "StrandRun", size_of::<StrandRun>()),
         (SHADER_SOURCE, "ThickHairGpu", size_of::<ThickHairGpu>()),
         (SHADER_SOURCE, "ThickGenParams", size_of::<ThickGenParams>()),
+        (
+            hairloom_render::renderer::far_lod::FAR_LOD_SOURCE,
+            "FarLodParams",
+            size_of::<hairloom_core::runtime::far_lod::FarLodParams>(),
+        ),
         (hair, "StrandRun", size_of::<StrandRun>()),
         (hair, "HairUniforms", size_of::<HairUniforms>()),
         (body, "BodyUniforms", size_of::<BodyUniforms>()),

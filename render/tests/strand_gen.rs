@@ -504,3 +504,94 @@ fn gpu_thick_hairs_match_the_cpu_mirror() {
     eprintln!("{count} thick hairs: max |GPU − CPU mirror| = {worst:.3e} (bound {bound:.3e})");
     assert!(worst <= bound, "{worst} > {bound}");
 }
+
+/// Far hair's deferred level choice (`far_lod.wgsl`, eq. 16) against its mirror
+/// (`hairloom_core::runtime::far_lod`): frame after frame under a still camera at three
+/// distances, the GPU chooses the levels the CPU does, settles, and goes coarser with
+/// distance.
+#[test]
+fn gpu_far_levels_match_the_cpu_mirror_and_settle() {
+    use hairloom_core::runtime::far_lod::{
+        FarLodParams, measured_hairs, next_levels, thick_widths,
+    };
+    use hairloom_core::runtime::thick_hair::FarHair;
+    use hairloom_render::renderer::far_lod::FarLodRenderer;
+    use hairloom_render::renderer::strand_gen::ThickGenRenderer;
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let document = common::sample("head_long_wavy");
+    let runtime = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 16,
+            ..RuntimeOptions::default()
+        },
+    );
+    let n = 9u32;
+    let far = FarHair::build(&runtime, n as usize).expect("hierarchy");
+    let generator = StrandGenRenderer::new(&context);
+    let thick_gen = ThickGenRenderer::new(&context);
+    let far_lod = FarLodRenderer::new(&context);
+    let hair = generator.upload(&context, &runtime).expect("upload");
+    let mirror = StrandGen {
+        textures: &runtime.textures,
+        filtering: Filtering::Exact,
+    };
+    let styling: Vec<&StylingParams> = std::iter::once(&runtime.styling.global)
+        .chain(runtime.styling.groups.iter().map(|g| &g.params))
+        .collect();
+    let (lo, hi) = runtime.textures.hair_bounds().expect("hair");
+    let centre = (lo + hi) * 0.5;
+    let mut mean_levels = Vec::new();
+    for distance_m in [0.8f32, 4.0, 20.0] {
+        let eye = centre + glam::Vec3::new(0.3, 0.1, 1.0).normalize() * distance_m;
+        let params = FarLodParams {
+            eye: eye.extend(1.0).to_array(),
+            pixel_at_unit: 2.0 * 15f32.to_radians().tan() / 1080.0,
+            width_threshold_px: 2.0,
+            vertex_count: n,
+            count: 0,
+        };
+        let mut levels = vec![0u32; far.blocks.len()];
+        let mut differing = 0usize;
+        for frame in 0..10 {
+            let gpu = far_lod
+                .step(
+                    &context, &generator, &thick_gen, &hair, &far, &levels, params,
+                )
+                .expect("far lod");
+            let hairs = measured_hairs(&far, &levels);
+            let vertices = mirror.thick_main(&runtime.strand_roots(), &hairs, n, &styling);
+            let widths = thick_widths(
+                &vertices,
+                &hairs,
+                &levels,
+                &FarLodParams {
+                    count: hairs.len() as u32,
+                    ..params
+                },
+            );
+            let cpu = next_levels(&levels, &widths, &far, params.width_threshold_px);
+            // A width within f32 rounding of ε_w may fall either side: allow a handful.
+            differing += gpu.iter().zip(&cpu).filter(|(g, c)| g != c).count();
+            if frame == 9 {
+                assert_eq!(
+                    gpu, levels,
+                    "{distance_m} m: still changing after 10 frames"
+                );
+            }
+            levels = gpu;
+        }
+        assert!(
+            differing <= far.blocks.len() / 100 + 1,
+            "{distance_m} m: GPU and CPU chose differently {differing} times"
+        );
+        mean_levels.push(levels.iter().map(|&l| l as f64).sum::<f64>() / levels.len() as f64);
+    }
+    eprintln!("mean level at 0.8, 4 and 20 m: {mean_levels:?}");
+    assert!(
+        mean_levels.windows(2).all(|w| w[1] > w[0]),
+        "{mean_levels:?}"
+    );
+}

@@ -3,6 +3,7 @@
 //! the WGSL ones) and its renderer in `render/src/renderer/X.rs`.
 
 pub mod atlas;
+pub mod far_lod;
 pub mod frame_plan;
 pub mod gpu_types;
 pub mod hair;

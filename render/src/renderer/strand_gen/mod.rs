@@ -34,9 +34,11 @@ use crate::device::GpuContext;
 use crate::resources::Tracked;
 
 /// The WGSL source: `shaders/shared/strand_run.wgsl`, `shaders/shared/strand_vertex.wgsl`,
-/// then `shaders/strand_gen.wgsl` (validated by naga in `cargo test`).
+/// `shaders/shared/thick_hair.wgsl`, then `shaders/strand_gen.wgsl` (validated by naga in
+/// `cargo test`).
 pub const SHADER_SOURCE: &str = concat!(
     include_str!("../../../../shaders/shared/strand_run.wgsl"),
+    include_str!("../../../../shaders/shared/thick_hair.wgsl"),
     include_str!("../../../../shaders/shared/strand_vertex.wgsl"),
     include_str!("../../../../shaders/strand_gen.wgsl")
 );

@@ -33,6 +33,11 @@ impl GpuFarHair {
     pub fn bytes(&self) -> u64 {
         self.thick_hairs.size()
     }
+
+    /// The thick-hair records (`ThickHairGpu`, at least one).
+    pub fn thick_hairs(&self) -> &wgpu::Buffer {
+        &self.thick_hairs
+    }
 }
 
 /// Thick hairs read back: per vertex the centre and `along`, and two half-axes.
