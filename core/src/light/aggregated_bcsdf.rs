@@ -10,7 +10,8 @@
 //! tables are), the shaded fibre's own lobes by `|θ_o|` (as `hair_bsdf` evaluates them, so
 //! that one fibre alone shades as near hair does):
 //!
-//! `f = S(φ) · [ a_F^{n−1} Σ_p M̂_p(θ_h) N̂_p(θ_i, φ) + A_B̂ M_B̂(θ_h) I_B(φ)/π ]`
+//! `f = S(φ) · [ E[a_F^k] Σ_p M̂_p(θ_h) N̂_p(θ_o, φ) + A_B̂ M_B̂(θ_h) I_B(φ)/π ]`,
+//! `k` the (random) count of fibres before the shaded one, of mean `n − 1`:
 //!
 //! - **R̂, T̂T, TRT and the residual lobe** (the paper's R̂, T̂, D̂): the shaded fibre's lobes
 //!   averaged over the incident offset `h` (a thick hair's shading point is some fibre at some

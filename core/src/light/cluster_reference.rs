@@ -135,11 +135,12 @@ impl FibreCluster {
         };
         let width_in = self.width_across(across_light);
         let cos_cone = cone_rad.cos();
+        // Particles start on a line across the light, well outside the ellipse.
+        let side = DVec2::new(-across_light.y, across_light.x);
+        let outside = across_light * 4.0 * self.semi_major_m.max(self.semi_minor_m);
         for _ in 0..particles {
-            let side = DVec2::new(-across_light.y, across_light.x);
             let offset = (rng.next_f64() - 0.5) * width_in;
-            let far = 4.0 * self.semi_major_m.max(self.semi_minor_m);
-            let mut position = side * offset - across_light * far;
+            let mut position = side * offset - outside;
             let mut direction = start;
             let mut weight = [1.0; 3];
             let mut skip = usize::MAX;
@@ -226,16 +227,6 @@ impl FibreCluster {
     }
 }
 
-/// A direction from its angle to the cross-section plane `theta` and its azimuth `phi` in it
-/// (from `y` toward `z`).
-pub fn cluster_direction(theta: f64, phi: f64) -> DVec3 {
-    DVec3::new(
-        theta.sin(),
-        theta.cos() * phi.cos(),
-        theta.cos() * phi.sin(),
-    )
-}
-
 /// The thick hair's fibre frame for an eye along `view` (the preview's: `x` along the hair,
 /// `z` the view across it, `y = z × x`) and `w` in it.
 pub fn in_ribbon_frame(view: DVec3, w: DVec3) -> DVec3 {
@@ -252,15 +243,16 @@ pub fn major_angle_in_ribbon_frame(view: DVec3) -> f64 {
     axis.z.atan2(axis.y)
 }
 
-/// Half-angle of the cone the tests count leaving light in.
-pub const CONE_RAD: f64 = 0.25;
-
 #[cfg(test)]
 mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     use super::*;
     use crate::light::aggregated_bcsdf::{AggregatedTables, ClusterShape};
+    use crate::light::hair_bsdf::direction;
+
+    /// Half-angle of the cone the tests count leaving light in.
+    const CONE_RAD: f64 = 0.25;
     use crate::light::material::Fibre;
     use crate::model::scene::{HairMaterial, Pigment};
 
@@ -351,12 +343,12 @@ mod tests {
             {
                 let cluster = FibreCluster::random(semi_major * r, semi_minor * r, members, r, 7)
                     .expect("fits");
-                let light = cluster_direction(0.2, FRAC_PI_2 + 0.4);
+                let light = direction(0.2, FRAC_PI_2 + 0.4);
                 // Front-lit (the eye near the light), side-lit and back-lit views.
                 let views = [
-                    cluster_direction(-0.1, FRAC_PI_2 + 0.1),
-                    cluster_direction(-0.2, 0.2),
-                    cluster_direction(-0.3, -FRAC_PI_2 - 0.2),
+                    direction(-0.1, FRAC_PI_2 + 0.1),
+                    direction(-0.2, 0.2),
+                    direction(-0.3, -FRAC_PI_2 - 0.2),
                 ];
                 let reference =
                     cluster.radiance(&bsdf, sigma_a, light, &views, CONE_RAD, 60_000, 11);
@@ -400,7 +392,7 @@ mod tests {
             ..HairMaterial::default()
         });
         let bsdf = HairBsdf::new(&fibre);
-        let light = cluster_direction(0.3, 1.0);
+        let light = direction(0.3, 1.0);
         // Cones of 90° about ±x cover every direction once.
         let shares = cluster.gather(
             &bsdf,

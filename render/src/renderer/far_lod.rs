@@ -82,13 +82,7 @@ impl FarLodRenderer {
             vertex_count: n,
             ..params
         };
-        let selection = thick_gen.upload(
-            context,
-            FarHair {
-                thick_hairs: measured,
-                blocks: Vec::new(),
-            },
-        );
+        let selection = ThickGenRenderer::upload_records(context, &measured);
         let vertices = u64::from(count.max(1) * n);
         let storage = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -179,7 +173,7 @@ impl FarLodRenderer {
             &self.widths,
             &[
                 (0, &uniform),
-                (1, selection.thick_hairs()),
+                (1, &selection),
                 (2, &positions),
                 (3, &sections),
                 (4, &levels_buffer),

@@ -107,25 +107,34 @@ impl ThickGenRenderer {
         }
     }
 
-    /// Uploads `table` (an empty table uploads one unused record: bindings cannot be empty).
+    /// Uploads `table`.
     pub fn upload(&self, context: &GpuContext, table: FarHair) -> GpuFarHair {
-        let mut records = table.thick_hairs.clone();
-        if records.is_empty() {
-            records.push(ThickHairGpu::default());
-        }
-        let thick_hairs = context.resources.buffer_init(
-            &context.device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("far_hair_thick_hairs"),
-                contents: bytemuck::cast_slice(&records),
-                usage: wgpu::BufferUsages::STORAGE,
-            },
-        );
+        let thick_hairs = Self::upload_records(context, &table.thick_hairs);
         GpuFarHair { table, thick_hairs }
     }
 
-    /// Records the generation of `far.table.thick_hairs[first..][..count]` at `vertex_count`
-    /// vertices each into `output` from vertex `output_offset` on, as one compute pass.
+    /// Thick-hair records as `thick_main` reads them (none uploads one unused record:
+    /// bindings cannot be empty).
+    pub fn upload_records(context: &GpuContext, records: &[ThickHairGpu]) -> Tracked<wgpu::Buffer> {
+        let placeholder = [ThickHairGpu::default()];
+        let records = if records.is_empty() {
+            &placeholder[..]
+        } else {
+            records
+        };
+        context.resources.buffer_init(
+            &context.device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("far_hair_thick_hairs"),
+                contents: bytemuck::cast_slice(records),
+                usage: wgpu::BufferUsages::STORAGE,
+            },
+        )
+    }
+
+    /// Records the generation of `thick_hairs[first..][..count]` (records as
+    /// [`Self::upload_records`] makes them) at `vertex_count` vertices each into `output` from
+    /// vertex `output_offset` on, as one compute pass.
     #[expect(
         clippy::too_many_arguments,
         reason = "one dispatch's resources, passed through unchanged"
@@ -136,7 +145,7 @@ impl ThickGenRenderer {
         context: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         hair: &GpuHair,
-        far: &GpuFarHair,
+        thick_hairs: &wgpu::Buffer,
         params: ThickGenParams,
         filtering: Filtering,
         output: ThickOutput,
@@ -152,7 +161,7 @@ impl ThickGenRenderer {
         let mut entries = generator.source_entries(0, hair, &strand_params);
         for (binding, buffer) in [
             (4, output.positions),
-            (12, &*far.thick_hairs),
+            (12, thick_hairs),
             (13, output.sections),
             (14, &thick_params),
         ] {
@@ -216,7 +225,7 @@ impl ThickGenRenderer {
             context,
             &mut encoder,
             hair,
-            far,
+            far.thick_hairs(),
             ThickGenParams {
                 first,
                 count,
