@@ -28,30 +28,7 @@ fn pass_vertex(ribbon: RibbonVertex) -> ShadowVertex {
     return out;
 }
 
-struct OpacityOutput {
-    @location(0) layers0: vec4<f32>,
-    @location(1) layers1: vec4<f32>,
-    @location(2) layers2: vec4<f32>,
-    @location(3) layers3: vec4<f32>,
-}
-
 @fragment
 fn fs_opacity(in: ShadowVertex) -> OpacityOutput {
-    let slot = hair.batch.z;
-    let view = scene.shadows[slot];
-    let layers = scene.counts.y;
-    let z = light_distance(in.clip.z, view.params);
-    let start = first_hair_distance(slot, vec2<i32>(in.clip.xy));
-    var values = array<vec4<f32>, 4>();
-    for (var k = 0u; k < layers; k++) {
-        if z <= layer_end(k, layers, start, view.layers.x) {
-            values[k / 4u][k % 4u] = in.coverage;
-        }
-    }
-    var out: OpacityOutput;
-    out.layers0 = values[0];
-    out.layers1 = values[1];
-    out.layers2 = values[2];
-    out.layers3 = values[3];
-    return out;
+    return opacity_output(in.clip, in.coverage, hair.batch.z);
 }

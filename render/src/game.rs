@@ -106,6 +106,9 @@ pub struct GameFrameStats {
     /// Bytes of this frame's generation scratch buffer (0 when the ribbons generate their
     /// own vertices).
     pub scratch_bytes: u64,
+    /// Far hair: bundles drawn as thick hairs, and the thick hairs' segments.
+    pub far_bundles: usize,
+    pub far_segments: u32,
 }
 
 /// The scene the game path draws for `scene`: the same lights, material and effects, but
@@ -206,6 +209,13 @@ impl GameHair {
         let scene = game_scene(scene);
         let active = ActiveEffects::new(&scene, !self.asset.body().is_empty());
         check_effect_limits(&self.context.device.limits(), &active)?;
+        if active.far_hair {
+            // Refused where it is not drawn (the mesh-shader path), before anything is made;
+            // a bundle without its far-hair file builds the hierarchy here.
+            self.hair_source()
+                .check(&self.context, self.vertex_count, true)?;
+            self.asset.ensure_far_hair(&self.context)?;
+        }
         let input = self.generator.path().ribbon_input();
         self.renderers.sync(&self.context, &active, &scene, input);
         self.scene = scene;
@@ -337,6 +347,10 @@ impl GameHair {
             GenerationPath::ComputePerStrand => binding.min(2 * row).max(2) as usize,
             GenerationPath::VertexShader | GenerationPath::MeshShader => usize::MAX / 2,
         };
+        let far_levels = {
+            let hair = self.asset.source(&self.generator, self.filtering, self.lod);
+            self.renderers.far_levels(&self.scene, &hair, &camera)
+        };
         let mut plan = plan_frame(
             &self.asset.gpu().bundles,
             self.asset.gpu().per_bundle,
@@ -344,6 +358,7 @@ impl GameHair {
             &camera.lod(),
             &self.lod,
             binding_vertices,
+            &far_levels,
         );
         let mut stats = GameFrameStats {
             strands: plan.strands,
@@ -351,6 +366,8 @@ impl GameHair {
             culled_bundles: plan.culled_bundles,
             strands_over_limit: 0,
             scratch_bytes: 0,
+            far_bundles: 0,
+            far_segments: 0,
         };
         if plan.batches.len() > 1 {
             let first = plan.batches.swap_remove(0);
@@ -383,8 +400,27 @@ impl GameHair {
             FrameRecorder::new(context, &self.renderers, &frame, self.asset.body(), &hair);
         recorder.generate(encoder, 0);
         recorder.shadow_views(encoder);
+        stats.far_bundles = plan.far_bundles;
+        stats.far_segments = frame.far.as_ref().map_or(0, |f| f.segments());
         self.frame = Some(frame);
+        // Far hair: the next frame's levels from this frame's widths (a failed measurement
+        // keeps the levels as they are).
+        let hair = self.asset.source(&self.generator, self.filtering, self.lod);
+        let _kept = self.renderers.advance_far_levels(
+            &self.context,
+            &self.scene,
+            &hair,
+            &camera,
+            self.vertex_count,
+            &plan,
+        );
         stats
+    }
+
+    /// Far hair's hierarchy as the bundle carries it (`LoadedBundle::far_hair`), so that a
+    /// scene naming far hair does not build it again.
+    pub fn set_far_hair(&mut self, table: hairloom_core::runtime::thick_hair::FarHair) {
+        self.asset.set_far_hair(&self.context, table);
     }
 
     fn hair_source(&self) -> HairSource<'_> {

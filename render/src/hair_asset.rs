@@ -22,7 +22,8 @@ use hairloom_core::runtime::strand_gen::Filtering;
 use crate::device::GpuContext;
 use crate::frame::HairSource;
 use crate::renderer::preview_body::GpuBody;
-use crate::renderer::strand_gen::{GpuHair, StrandGenError, StrandGenRenderer};
+use crate::renderer::strand_gen::{GpuFarHair, GpuHair, StrandGenError, StrandGenRenderer};
+use hairloom_core::runtime::thick_hair::FarHair;
 
 /// Why an asset could not be put on the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -31,6 +32,8 @@ pub enum HairAssetError {
     NoHair,
     #[error(transparent)]
     Upload(#[from] StrandGenError),
+    #[error("far hair's hierarchy: {0}")]
+    FarHair(#[from] hairloom_core::runtime::thick_hair::ThickHairError),
 }
 
 /// The CPU side of a change, ready for the GPU.
@@ -88,6 +91,10 @@ pub struct HairAsset {
     gpu: GpuHair,
     body: GpuBody,
     bounds: (Vec3, Vec3),
+    /// Far hair's hierarchy (seed 001), once a scene asked for it or a bundle carried it.
+    /// Kept through a restyle or a reshape (its thick hairs are generated from the textures
+    /// every frame, so they follow); made again after a rebuild.
+    far: Option<GpuFarHair>,
 }
 
 impl HairAsset {
@@ -104,6 +111,7 @@ impl HairAsset {
             hair,
             gpu,
             bounds,
+            far: None,
         })
     }
 
@@ -183,6 +191,27 @@ impl HairAsset {
         &self.hair
     }
 
+    /// Far hair's hierarchy as a bundle carries it (`LoadedBundle::far_hair`).
+    pub fn set_far_hair(&mut self, context: &GpuContext, table: FarHair) {
+        self.far = Some(GpuFarHair::upload(context, table));
+    }
+
+    /// Builds far hair's hierarchy from the strands at full detail where the asset has none
+    /// yet (as an export does: the costly part, seconds on a large groom), and uploads it.
+    pub fn ensure_far_hair(&mut self, context: &GpuContext) -> Result<(), HairAssetError> {
+        if self.far.is_none() {
+            let vertex_count = (1usize << self.hair.lod.max_vertices_log2.min(8)) + 1;
+            let table = FarHair::build(&self.hair, vertex_count)?;
+            self.far = Some(GpuFarHair::upload(context, table));
+        }
+        Ok(())
+    }
+
+    /// Far hair's hierarchy on the GPU, where made.
+    pub fn far_hair(&self) -> Option<&GpuFarHair> {
+        self.far.as_ref()
+    }
+
     pub fn gpu(&self) -> &GpuHair {
         &self.gpu
     }
@@ -208,6 +237,7 @@ impl HairAsset {
             hair: &self.gpu,
             filtering,
             lod,
+            far: self.far.as_ref(),
         }
     }
 }

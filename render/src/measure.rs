@@ -152,7 +152,9 @@ pub fn effect_configurations(
 pub fn toggled_effects(
     effects: &hairloom_core::model::scene::Effects,
 ) -> Vec<(&'static str, hairloom_core::model::scene::Effects)> {
-    use hairloom_core::model::scene::{Coverage, MultipleScattering, SelfShadowing, Shading};
+    use hairloom_core::model::scene::{
+        Coverage, FarHair, MultipleScattering, SelfShadowing, Shading,
+    };
     let mut list = Vec::new();
     let mut e = effects.clone();
     e.shading = match e.shading {
@@ -181,6 +183,12 @@ pub fn toggled_effects(
         Coverage::WidthOit => Coverage::Msaa,
     };
     list.push(("width-oit", e));
+    let mut e = effects.clone();
+    e.far_hair = match e.far_hair {
+        FarHair::Strands => FarHair::Aggregated,
+        FarHair::Aggregated => FarHair::Strands,
+    };
+    list.push(("far-hair", e));
     list
 }
 

@@ -172,6 +172,8 @@ impl PreviewRenderer {
             scratch_bytes: frame.scratch_bytes,
             strands: plan.strands,
             vertices: plan.vertices,
+            far_bundles: plan.far_bundles,
+            far_segments: frame.far_segments,
         })
     }
 
@@ -188,17 +190,27 @@ impl PreviewRenderer {
 
     /// The bundle-level work of a frame: which strands at which detail, in batches. (The
     /// mesh path's task shaders plan the same on the GPU; this plan then only counts.)
+    /// Bundles far hair draws (the scene's `far_hair`) have no strands in it: their levels
+    /// are the last frame's choice (eq. 16), and [`Self::render`] draws their thick hairs.
     pub fn plan(&self, scene: &PreviewScene, width: u32, height: u32) -> FramePlan {
         match &scene.hair {
             HairSource::Generated { hair, lod, .. } => {
                 let max_log2 = scene.vertex_count.saturating_sub(1).max(1).ilog2();
+                let camera = Self::frame_camera(scene, width, height);
+                let far_levels = {
+                    let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+                    state
+                        .renderers
+                        .far_levels(scene.lighting, &scene.hair, &camera)
+                };
                 plan_frame(
                     &hair.bundles,
                     hair.per_bundle,
                     max_log2,
-                    &Self::frame_camera(scene, width, height).lod(),
+                    &camera.lod(),
                     lod,
                     batch_vertex_limit(scene.vertex_count),
+                    &far_levels,
                 )
             }
             HairSource::Vertices(vertices) => stored_plan(
@@ -209,6 +221,51 @@ impl PreviewRenderer {
                 stored_plan(*strand_count, scene.vertex_count)
             }
         }
+    }
+
+    /// Far hair's level choice (eq. 16) run without drawing until a still camera's levels
+    /// stop changing (at most one level per bundle per step, so as many steps as the deepest
+    /// hierarchy has levels): what a still picture draws. Returns the steps taken (0 without
+    /// far hair).
+    pub fn settle_far_levels(
+        &self,
+        context: &GpuContext,
+        scene: &PreviewScene,
+        width: u32,
+        height: u32,
+    ) -> Result<usize, PreviewError> {
+        let active = self.active_effects(context, scene)?;
+        if !active.far_hair {
+            return Ok(0);
+        }
+        scene.hair.check(context, scene.vertex_count, true)?;
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let renderers = &mut state.renderers;
+        renderers.sync(context, &active, scene.lighting, scene.hair.ribbon_input());
+        let camera = Self::frame_camera(scene, width, height);
+        let HairSource::Generated { far: Some(far), .. } = &scene.hair else {
+            return Ok(0);
+        };
+        let deepest = far.table.blocks.iter().map(Vec::len).max().unwrap_or(0);
+        for step in 0..=deepest {
+            let levels = renderers.far_levels(scene.lighting, &scene.hair, &camera);
+            let plan = FramePlan {
+                far_levels: levels.clone(),
+                ..FramePlan::default()
+            };
+            renderers.advance_far_levels(
+                context,
+                scene.lighting,
+                &scene.hair,
+                &camera,
+                scene.vertex_count,
+                &plan,
+            )?;
+            if renderers.far_levels(scene.lighting, &scene.hair, &camera) == levels {
+                return Ok(step);
+            }
+        }
+        Ok(deepest + 1)
     }
 
     /// What runs for `scene`, checked against the adapter's limits before anything is made.
@@ -234,7 +291,9 @@ impl PreviewRenderer {
         timer: Option<&PassTimer>,
     ) -> Result<EncodedFrame, PreviewError> {
         let active = self.active_effects(context, scene)?;
-        scene.hair.check(context, scene.vertex_count)?;
+        scene
+            .hair
+            .check(context, scene.vertex_count, active.far_hair)?;
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         let state = &mut *state;
         let renderers = &mut state.renderers;
@@ -244,6 +303,7 @@ impl PreviewRenderer {
         if let Some(oit) = &mut renderers.oit {
             oit.ensure_targets(context, view.width, view.height);
         }
+        let camera = Self::frame_camera(scene, view.width, view.height);
         let inputs = FrameInputs {
             hair: scene.hair,
             body: scene.body,
@@ -251,7 +311,7 @@ impl PreviewRenderer {
             strand_width_m: scene.strand_width_m,
             scene: scene.lighting,
             hair_bounds: scene.hair_bounds,
-            camera: Self::frame_camera(scene, view.width, view.height),
+            camera,
         };
         let frame = prepare(context, renderers, &inputs, plan);
         let mut encoder = context
@@ -263,7 +323,18 @@ impl PreviewRenderer {
             FrameRecorder::new(context, renderers, &frame, scene.body, &scene.hair).timed(timer);
         recorder.shadow_views(&mut encoder);
         recorder.view(&mut encoder, view, scene.lighting.background);
+        let far_segments = frame.far.as_ref().map_or(0, |f| f.segments());
+        // Far hair: the next frame's levels, from the widths this frame's drew.
+        renderers.advance_far_levels(
+            context,
+            scene.lighting,
+            &scene.hair,
+            &camera,
+            scene.vertex_count,
+            plan,
+        )?;
         Ok(EncodedFrame {
+            far_segments,
             encoder,
             color: view.color().clone(),
             scratch_bytes: frame.scratch_bytes,
@@ -273,6 +344,8 @@ impl PreviewRenderer {
 
 struct EncodedFrame {
     encoder: wgpu::CommandEncoder,
+    /// Far hair's thick-hair segments drawn (0 without far hair).
+    far_segments: u32,
     /// The view's resolved colour target.
     color: wgpu::Texture,
     scratch_bytes: u64,
@@ -289,6 +362,9 @@ pub struct FrameTiming {
     /// Strands and vertices drawn after culling and LOD.
     pub strands: usize,
     pub vertices: usize,
+    /// Far hair: bundles drawn as thick hairs, and their segments.
+    pub far_bundles: usize,
+    pub far_segments: u32,
 }
 
 /// Stored vertices: one run over every strand, one batch.
@@ -302,7 +378,7 @@ fn stored_plan(strand_count: usize, vertex_count: u32) -> FramePlan {
         } else {
             vec![runs]
         },
-        culled_bundles: 0,
+        ..FramePlan::default()
     }
 }
 

@@ -6,16 +6,17 @@ use std::collections::BTreeSet;
 
 use glam::Vec3;
 use hairloom_core::model::scene::{
-    Coverage, Effects, MultipleScattering, Scene, SelfShadowing, Shading,
+    Coverage, Effects, FarHair, MultipleScattering, Scene, SelfShadowing, Shading,
 };
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::thick_hair::FarHair as FarTable;
 use hairloom_render::device::headless_for_test;
 use hairloom_render::frame::Phase;
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::preview_body::GpuBody;
-use hairloom_render::renderer::strand_gen::StrandGenRenderer;
+use hairloom_render::renderer::strand_gen::{GpuFarHair, StrandGenRenderer};
 
 /// Every label an optional effect may own, by effect.
 const OPACITY_SHADOW_MAPS: &[&str] = &["opacity_layers", "hair_shadow_opacity"];
@@ -33,6 +34,17 @@ const WIDTH_OIT: &[&str] = &[
     "oit_composite",
     "preview_hair_oit",
 ];
+const FAR_HAIR: &[&str] = &[
+    "far_hair_aggregated_tables",
+    "far_hair_depth",
+    "far_hair",
+    "thick_gen",
+    "thick_widths",
+    "next_levels",
+];
+/// Far hair into the lights' opacity maps (with self-shadowing).
+const FAR_HAIR_SHADOWS: &[&str] = &["far_hair_shadow_opacity"];
+const FAR_HAIR_DEEP_SHADOWS: &[&str] = &["far_hair_shadow_opacity", "far_hair_shadow_depth"];
 
 fn effect_labels() -> BTreeSet<&'static str> {
     [
@@ -41,6 +53,8 @@ fn effect_labels() -> BTreeSet<&'static str> {
         BODY_SHADOWS,
         DUAL_SCATTERING,
         WIDTH_OIT,
+        FAR_HAIR,
+        FAR_HAIR_DEEP_SHADOWS,
     ]
     .concat()
     .into_iter()
@@ -67,6 +81,14 @@ fn expected(effects: &Effects) -> BTreeSet<&'static str> {
     if effects.coverage == Coverage::WidthOit {
         labels.extend(WIDTH_OIT);
     }
+    if effects.far_hair == FarHair::Aggregated {
+        labels.extend(FAR_HAIR);
+        match effects.self_shadowing {
+            SelfShadowing::None => {}
+            SelfShadowing::OpacityShadowMaps => labels.extend(FAR_HAIR_SHADOWS),
+            SelfShadowing::DeepOpacityMaps => labels.extend(FAR_HAIR_DEEP_SHADOWS),
+        }
+    }
     labels
 }
 
@@ -81,6 +103,9 @@ fn expected_renderers(effects: &Effects) -> BTreeSet<&'static str> {
     }
     if effects.coverage == Coverage::WidthOit {
         names.insert("width coverage");
+    }
+    if effects.far_hair == FarHair::Aggregated {
+        names.insert("far hair");
     }
     names
 }
@@ -104,6 +129,7 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
     );
     let generator = StrandGenRenderer::new(&context);
     let gpu_hair = generator.upload(&context, &hair).expect("upload");
+    let far = GpuFarHair::upload(&context, FarTable::build(&hair, 9).expect("hierarchy"));
     let body = GpuBody::upload(&context, &hair.body);
     let renderer = PreviewRenderer::new(&context);
     let (lo, hi) = hair.textures.hair_bounds().expect("hair");
@@ -134,6 +160,11 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
             e.multiple_scattering = MultipleScattering::DualScattering;
         }),
         alone(|e| e.coverage = Coverage::WidthOit),
+        alone(|e| e.far_hair = FarHair::Aggregated),
+        alone(|e| {
+            e.far_hair = FarHair::Aggregated;
+            e.self_shadowing = SelfShadowing::OpacityShadowMaps;
+        }),
         base.effects.all(),
         Effects {
             opacity_layers: 16,
@@ -154,6 +185,7 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
                 hair: &gpu_hair,
                 filtering: Filtering::Exact,
                 lod: LodSettings::default(),
+                far: Some(&far),
             },
             17,
             (lo, hi),
@@ -210,6 +242,9 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
             })
             .collect();
         let mut wanted = Vec::new();
+        if effects.far_hair == FarHair::Aggregated {
+            wanted.push(Phase::Generation);
+        }
         if effects.self_shadowing != SelfShadowing::None || effects.body_shadows {
             wanted.push(Phase::ShadowViews);
         }
@@ -222,7 +257,7 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
     }
     // All effects with 16 layers hold more than none; back to none frees it all again.
     let (first, last) = (bytes_by_scene[0], *bytes_by_scene.last().expect("scenes"));
-    assert!(bytes_by_scene[9] > bytes_by_scene[8] && bytes_by_scene[8] > first);
+    assert!(bytes_by_scene[11] > bytes_by_scene[10] && bytes_by_scene[10] > first);
     assert_eq!(first, last, "turning every effect off frees what they made");
 }
 
@@ -288,6 +323,7 @@ fn each_effect_is_measured_switched_on_and_off() {
     );
     let generator = StrandGenRenderer::new(&context);
     let gpu_hair = generator.upload(&context, &hair).expect("upload");
+    let far = GpuFarHair::upload(&context, FarTable::build(&hair, 9).expect("hierarchy"));
     let body = GpuBody::upload(&context, &hair.body);
     let (lo, hi) = hair.textures.hair_bounds().expect("hair");
     let lighting = Scene {
@@ -304,6 +340,7 @@ fn each_effect_is_measured_switched_on_and_off() {
             hair: &gpu_hair,
             filtering: Filtering::Exact,
             lod: LodSettings::default(),
+            far: Some(&far),
         },
         9,
         (lo, hi),
@@ -322,7 +359,8 @@ fn each_effect_is_measured_switched_on_and_off() {
             "self-shadowing",
             "body-shadows",
             "dual-scattering",
-            "width-oit"
+            "width-oit",
+            "far-hair"
         ]
     );
     for cost in &costs {
@@ -331,6 +369,7 @@ fn each_effect_is_measured_switched_on_and_off() {
     }
     // Switching self-shadowing off (the scene has it on) frees its maps: less memory.
     assert!(costs[2].live_bytes < costs[0].live_bytes, "{costs:?}");
-    // Switching width-based coverage on adds its targets.
+    // Switching width-based coverage on adds its targets, far hair its tables.
     assert!(costs[5].live_bytes > costs[0].live_bytes, "{costs:?}");
+    assert!(costs[6].live_bytes > costs[0].live_bytes, "{costs:?}");
 }

@@ -117,6 +117,7 @@ fn game_runtime_draws_what_the_preview_draws() {
             hair: &gpu_hair,
             filtering: Filtering::Exact,
             lod,
+            far: None,
         },
         (1 << VERTICES_LOG2) + 1,
         (lo, hi),

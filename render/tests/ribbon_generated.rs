@@ -67,7 +67,7 @@ fn vertex_shader_generation_matches_compute_and_the_cpu_mirror() {
     // one batch.
     let (lo, hi) = runtime.textures.hair_bounds().expect("hair");
     let (camera, lod) = common::morphing_lod(lo, hi);
-    let mut plan = plan_frame(&hair.bundles, 16, 5, &camera, &lod, usize::MAX / 2);
+    let mut plan = plan_frame(&hair.bundles, 16, 5, &camera, &lod, usize::MAX / 2, &[]);
     assert_eq!(plan.batches.len(), 1);
     // And a run of 2-vertex strands (the tangent's other rule) at the end.
     let last = *plan.batches[0].last().expect("runs");

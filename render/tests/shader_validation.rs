@@ -44,6 +44,10 @@ fn embedded() -> Vec<(String, String)> {
             ));
         }
         sources.push((format!("preview_body {key:?}"), body_shader(&key)));
+        sources.push((
+            format!("far_hair {key:?}"),
+            hairloom_render::renderer::shader_composer::far_hair_shader(&key),
+        ));
     }
     for kind in [
         SelfShadowing::OpacityShadowMaps,
@@ -55,6 +59,10 @@ fn embedded() -> Vec<(String, String)> {
                 hair_shadow_shader(kind, input),
             ));
         }
+        sources.push((
+            format!("far_hair_shadow {kind:?}"),
+            hairloom_render::renderer::shader_composer::far_hair_shadow_shader(kind),
+        ));
     }
     for samples in [1, 4] {
         sources.push((
@@ -143,10 +151,14 @@ fn gpu_structs_match_their_wgsl() {
         &hairloom_render::renderer::shader_composer::ShaderKey::all()[0],
         hairloom_render::renderer::shader_composer::RibbonInput::Mesh,
     );
-    let (hair, body, mesh) = (
+    let far_shader = hairloom_render::renderer::shader_composer::far_hair_shader(
+        &hairloom_render::renderer::shader_composer::ShaderKey::all()[0],
+    );
+    let (hair, body, mesh, far) = (
         hair_shader.as_str(),
         body_shader.as_str(),
         mesh_shader.as_str(),
+        far_shader.as_str(),
     );
     for (source, name, rust_size) in [
         (
@@ -167,6 +179,8 @@ fn gpu_structs_match_their_wgsl() {
         ),
         (hair, "StrandRun", size_of::<StrandRun>()),
         (hair, "HairUniforms", size_of::<HairUniforms>()),
+        // Far hair binds the strands' view uniforms as its own.
+        (far, "FarView", size_of::<HairUniforms>()),
         (body, "BodyUniforms", size_of::<BodyUniforms>()),
         (hair, "SceneUniforms", size_of::<SceneUniforms>()),
         (hair, "SceneLight", size_of::<GpuLight>()),

@@ -220,7 +220,7 @@ fn lod_runs_match_the_cpu_mirror_with_morphing() {
     // A camera far enough for partial strand counts, several vertex levels and morphing.
     let (lo, hi) = textures.hair_bounds().expect("hair");
     let (camera, lod) = common::morphing_lod(lo, hi);
-    let plan = plan_frame(&hair.bundles, 32, 5, &camera, &lod, 4000);
+    let plan = plan_frame(&hair.bundles, 32, 5, &camera, &lod, 4000, &[]);
     let runs: Vec<_> = plan.batches.iter().flatten().collect();
     assert!(
         plan.strands > 0 && plan.strands < roots.len(),
@@ -432,7 +432,7 @@ fn hair_above_the_adapter_limits_is_refused_by_name() {
 #[test]
 fn gpu_thick_hairs_match_the_cpu_mirror() {
     use hairloom_core::runtime::thick_hair::{FarHair, build_hierarchy};
-    use hairloom_render::renderer::strand_gen::ThickGenRenderer;
+    use hairloom_render::renderer::strand_gen::{GpuFarHair, ThickGenRenderer};
     let Some(context) = headless_for_test(module_path!()) else {
         return;
     };
@@ -461,7 +461,7 @@ fn gpu_thick_hairs_match_the_cpu_mirror() {
     let generator = StrandGenRenderer::new(&context);
     let thick_gen = ThickGenRenderer::new(&context);
     let hair = generator.upload(&context, &runtime).expect("upload");
-    let far = thick_gen.upload(&context, table.clone());
+    let far = GpuFarHair::upload(&context, table.clone());
     let count = table.thick_hairs.len() as u32;
     let readback = thick_gen
         .generate(

@@ -167,6 +167,7 @@ fn mesh_shaders_are_refused_by_name_where_the_device_lacks_them() {
             hair: &hair,
             filtering: Filtering::Exact,
             lod: LodSettings::default(),
+            far: None,
         },
         9,
         (lo, hi),

@@ -174,6 +174,22 @@ pub enum Coverage {
     WidthOit,
 }
 
+/// How hair far from the camera is drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FarHair {
+    /// Every bundle as strands, thinned and thickened by strand LOD (seed 000 eq. 7-8).
+    #[default]
+    Strands,
+    /// Seed 001: a bundle whose strands would be thinner than `far_width_px` draws the thick
+    /// hairs of its hierarchy instead, shaded by the aggregated BCSDF, its level chosen each
+    /// frame from the widths measured in the last (eq. 16).
+    Aggregated,
+}
+
+/// Range of ε_w, the widest a drawn thick hair may look, in pixels.
+pub const FAR_WIDTH_RANGE_PX: (f32, f32) = (0.5, 32.0);
+
 /// The effects a scene asks for; each one absent has no GPU passes or resources.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -195,6 +211,11 @@ pub struct Effects {
     /// points, one of [`FIBRE_OFFSET_CHOICES`]): an accuracy switch of the Marschner model,
     /// measured in `hairloom bench shading`.
     pub fibre_offsets: u32,
+    /// Far hair (seed 001) or strands everywhere.
+    pub far_hair: FarHair,
+    /// ε_w: the widest a thick hair may look where far hair draws it, in pixels (seed 001
+    /// uses 2); within [`FAR_WIDTH_RANGE_PX`].
+    pub far_width_px: f32,
 }
 
 /// Gauss-Legendre point counts the shaders have.
@@ -212,19 +233,22 @@ impl Default for Effects {
             multiple_scattering: MultipleScattering::DualScattering,
             coverage: Coverage::Msaa,
             fibre_offsets: 3,
+            far_hair: FarHair::Strands,
+            far_width_px: 2.0,
         }
     }
 }
 
 /// The names of the optional effects, as `hairloom render --effects` and the Scene panel
 /// use them.
-pub const EFFECT_NAMES: [&str; 6] = [
+pub const EFFECT_NAMES: [&str; 7] = [
     "marschner",
     "opacity-shadow-maps",
     "deep-opacity-maps",
     "body-shadows",
     "dual-scattering",
     "width-oit",
+    "far-aggregated",
 ];
 
 impl Effects {
@@ -237,6 +261,7 @@ impl Effects {
             body_shadows: false,
             multiple_scattering: MultipleScattering::None,
             coverage: Coverage::Msaa,
+            far_hair: FarHair::Strands,
             ..self.clone()
         }
     }
@@ -249,6 +274,7 @@ impl Effects {
             body_shadows: true,
             multiple_scattering: MultipleScattering::DualScattering,
             coverage: Coverage::WidthOit,
+            far_hair: FarHair::Aggregated,
             ..self.clone()
         }
     }
@@ -272,6 +298,9 @@ impl Effects {
         }
         if self.coverage == Coverage::WidthOit {
             names.push("width-oit");
+        }
+        if self.far_hair == FarHair::Aggregated {
+            names.push("far-aggregated");
         }
         names
     }
@@ -309,6 +338,7 @@ impl Effects {
                     effects.multiple_scattering = MultipleScattering::DualScattering
                 }
                 "width-oit" => effects.coverage = Coverage::WidthOit,
+                "far-aggregated" => effects.far_hair = FarHair::Aggregated,
                 other => {
                     return Err(format!(
                         "--effects: unknown effect {other:?}; the effects are none, all, {}",
@@ -510,6 +540,8 @@ impl Effects {
         if let Some(depth) = self.opacity_depth_m {
             check_range("effects.opacity_depth_m", depth, 1e-6, 1e3)?;
         }
+        let (lo, hi) = FAR_WIDTH_RANGE_PX;
+        check_range("effects.far_width_px", self.far_width_px, lo, hi)?;
         let (lo, hi) = SHADOW_RESOLUTION_RANGE;
         if !(lo..=hi).contains(&self.shadow_resolution) {
             return Err(invalid(
@@ -659,6 +691,14 @@ mod tests {
                 Box::new(|s| s.cameras[0].fov_deg = 180.0),
                 "cameras[0].fov_deg",
             ),
+            (
+                Box::new(|s| s.effects.far_width_px = f32::NAN),
+                "effects.far_width_px",
+            ),
+            (
+                Box::new(|s| s.effects.far_width_px = 0.0),
+                "effects.far_width_px",
+            ),
         ];
         for (change, path) in cases {
             let mut scene = Scene::default();
@@ -682,7 +722,8 @@ mod tests {
                 "deep-opacity-maps",
                 "body-shadows",
                 "dual-scattering",
-                "width-oit"
+                "width-oit",
+                "far-aggregated"
             ]
         );
         let some = effects

@@ -13,6 +13,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+use crate::runtime::frame_plan::BundleBounds;
 use crate::runtime::gpu_types::ThickHairGpu;
 use crate::runtime::strand_gen::ThickVertex;
 use crate::runtime::thick_hair::FarHair;
@@ -52,6 +53,49 @@ pub fn measured_hairs(far: &FarHair, levels: &[u32]) -> Vec<ThickHairGpu> {
         }
     }
     out
+}
+
+/// The thick hairs a frame draws for bundles drawing `levels`: each bundle's current level,
+/// where it is 1 or more (level 0 draws the bundle's strands).
+pub fn drawn_hairs(far: &FarHair, levels: &[u32]) -> Vec<ThickHairGpu> {
+    let mut out = Vec::new();
+    for (block, block_levels) in far.blocks.iter().enumerate() {
+        let level = levels.get(block).copied().unwrap_or(0) as usize;
+        if level == 0 {
+            continue;
+        }
+        if let Some(entry) = block_levels.get(level - 1) {
+            out.extend_from_slice(&far.thick_hairs[entry.first as usize..][..entry.count as usize]);
+        }
+    }
+    out
+}
+
+/// Where the level choice starts when there is no last frame to measure (a first frame, a
+/// still render): per bundle, the coarsest level whose widest fitted diameter fits half of
+/// `threshold_px` at the bundle's nearest point to the eye ([`FarHair::level_for`]). Half:
+/// the fit's diameter is the members' spread, and the corner strands a frame measures span
+/// up to about twice that; eq. 16 then corrects the guess within a few frames.
+pub fn first_levels(
+    far: &FarHair,
+    bundles: &[BundleBounds],
+    eye: Vec3,
+    pixel_at_unit: f32,
+    threshold_px: f32,
+) -> Vec<u32> {
+    (0..far.blocks.len())
+        .map(|block| {
+            let Some(bounds) = bundles.get(block) else {
+                return 0;
+            };
+            let distance = (bounds.centre.distance(eye) - bounds.radius_m).max(0.0);
+            far.level_for(
+                block,
+                f64::from(pixel_at_unit * distance),
+                0.5 * f64::from(threshold_px),
+            ) as u32
+        })
+        .collect()
 }
 
 /// How wide a thick hair's vertex looks in pixels: its ellipse across the view
@@ -257,6 +301,36 @@ mod tests {
                 }
             }
             settled_at.push(last.iter().map(|&l| l as f64).sum::<f64>() / blocks as f64);
+            // A first frame's guess from the stored widest diameters is close (at most a
+            // little wider than ε_w), and the choice settles from it too, within ε_w.
+            let pixel_at_unit = 2.0 * (15f32.to_radians()).tan() / 1080.0;
+            let mut levels = first_levels(
+                &far,
+                &hair.bundle_bounds(),
+                eye,
+                pixel_at_unit,
+                THRESHOLD_PX,
+            );
+            let guessed = measure(&hair, &far, &levels, eye);
+            assert!(
+                guessed.iter().all(|w| w[0] <= 1.5 * THRESHOLD_PX),
+                "{guessed:?}"
+            );
+            for _ in 0..12 {
+                levels = frame(&hair, &far, &levels, eye);
+            }
+            assert_eq!(frame(&hair, &far, &levels, eye), levels, "{distance_m} m");
+            let settled = measure(&hair, &far, &levels, eye);
+            assert!(settled.iter().all(|w| w[0] <= THRESHOLD_PX), "{settled:?}");
+            assert_eq!(
+                drawn_hairs(&far, &levels).len(),
+                levels
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &l)| l > 0)
+                    .map(|(b, &l)| far.blocks[b][l as usize - 1].count as usize)
+                    .sum::<usize>()
+            );
         }
         // Farther away, coarser.
         assert!(

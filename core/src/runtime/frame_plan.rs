@@ -95,6 +95,11 @@ pub struct FramePlan {
     pub strands: usize,
     pub vertices: usize,
     pub culled_bundles: usize,
+    /// Bundles in view that far hair draws as thick hairs instead of strands.
+    pub far_bundles: usize,
+    /// The far-hair level of every bundle the plan was made with (empty: strands everywhere);
+    /// the frame draws the thick hairs of exactly these.
+    pub far_levels: Vec<u32>,
 }
 
 impl FramePlan {
@@ -195,6 +200,8 @@ pub fn bundle_lod(
 /// Eq. 7-12 for every bundle of `per_bundle` strands (roots bundle-major, as
 /// `RuntimeTextures::strand_roots` makes them), full detail `2^max_vertices_log2 + 1`
 /// vertices: culling, strand counts with thickness compensation, vertex levels with morphing.
+/// A bundle whose entry in `far_levels` is 1 or more draws far hair's thick hairs instead
+/// (`crate::runtime::far_lod`) and has no strands here; an empty slice is strands everywhere.
 pub fn plan_frame(
     bundles: &[BundleBounds],
     per_bundle: u32,
@@ -202,14 +209,22 @@ pub fn plan_frame(
     camera: &LodCamera,
     settings: &LodSettings,
     batch_vertices: usize,
+    far_levels: &[u32],
 ) -> FramePlan {
-    let mut plan = FramePlan::default();
+    let mut plan = FramePlan {
+        far_levels: far_levels.to_vec(),
+        ..FramePlan::default()
+    };
     let mut batch: Vec<StrandRun> = Vec::new();
     let (mut vertex_offset, mut segment_offset) = (0u32, 0u32);
     for (index, bounds) in bundles.iter().enumerate() {
         if settings.cull && !sphere_in_view(&camera.view_projection, bounds.centre, bounds.radius_m)
         {
             plan.culled_bundles += 1;
+            continue;
+        }
+        if far_levels.get(index).is_some_and(|&level| level > 0) {
+            plan.far_bundles += 1;
             continue;
         }
         let BundleLod {
@@ -318,7 +333,7 @@ mod tests {
     fn less_detail_draws_fewer_strands_and_vertices_thicker() {
         let camera = camera(2.0, false);
         let plan_at =
-            |settings: &LodSettings| plan_frame(&bundles(), 64, 5, &camera, settings, 1 << 20);
+            |settings: &LodSettings| plan_frame(&bundles(), 64, 5, &camera, settings, 1 << 20, &[]);
         // LOD off by the artist: the detail bias turns it on.
         let off = LodSettings {
             enabled: false,
@@ -362,7 +377,7 @@ mod tests {
             enabled: false,
             ..LodSettings::default()
         };
-        let plan = plan_frame(&bundles(), 64, 5, &camera(0.5, false), &settings, 1000);
+        let plan = plan_frame(&bundles(), 64, 5, &camera(0.5, false), &settings, 1000, &[]);
         assert_eq!(plan.strands, 40 * 64);
         assert_eq!(plan.vertices, 40 * 64 * 33);
         // 30 strands of 33 vertices fit a batch of 1000.
@@ -386,7 +401,7 @@ mod tests {
             enabled: false,
             ..LodSettings::default()
         };
-        let plan = plan_frame(&thinned, 64, 5, &camera(0.3, false), &off, 1 << 20);
+        let plan = plan_frame(&thinned, 64, 5, &camera(0.3, false), &off, 1 << 20, &[]);
         // ⌈0.35 · 64⌉ = 23 (0.35 in f32 is a hair above 0.35).
         assert_eq!(plan.strands, 38 * 64 + 23);
         let roots = check_runs(&plan, 1 << 20);
@@ -400,10 +415,10 @@ mod tests {
             "bundle 1 grows nothing, bundle 2 starts at 2 · 64"
         );
         let on = LodSettings::default();
-        let near = plan_frame(&thinned, 64, 5, &camera(0.3, false), &on, 1 << 20);
+        let near = plan_frame(&thinned, 64, 5, &camera(0.3, false), &on, 1 << 20, &[]);
         assert_eq!(near.strands, plan.strands, "close up, LOD keeps the share");
-        let far = plan_frame(&thinned, 64, 5, &camera(20.0, false), &on, 1 << 20);
-        let full_far = plan_frame(&bundles(), 64, 5, &camera(20.0, false), &on, 1 << 20);
+        let far = plan_frame(&thinned, 64, 5, &camera(20.0, false), &on, 1 << 20, &[]);
+        let full_far = plan_frame(&bundles(), 64, 5, &camera(20.0, false), &on, 1 << 20, &[]);
         let first = |p: &FramePlan| {
             p.batches
                 .iter()
@@ -418,9 +433,33 @@ mod tests {
     #[test]
     fn distance_drops_strands_and_vertices_and_culling_drops_bundles() {
         let settings = LodSettings::default();
-        let near = plan_frame(&bundles(), 64, 5, &camera(0.3, false), &settings, 1 << 20);
-        let far = plan_frame(&bundles(), 64, 5, &camera(20.0, false), &settings, 1 << 20);
-        let away = plan_frame(&bundles(), 64, 5, &camera(0.3, true), &settings, 1 << 20);
+        let near = plan_frame(
+            &bundles(),
+            64,
+            5,
+            &camera(0.3, false),
+            &settings,
+            1 << 20,
+            &[],
+        );
+        let far = plan_frame(
+            &bundles(),
+            64,
+            5,
+            &camera(20.0, false),
+            &settings,
+            1 << 20,
+            &[],
+        );
+        let away = plan_frame(
+            &bundles(),
+            64,
+            5,
+            &camera(0.3, true),
+            &settings,
+            1 << 20,
+            &[],
+        );
         assert_eq!(near.strands, 40 * 64, "close up, everything");
         assert!(
             far.strands < near.strands / 4 && far.strands >= 40,
@@ -433,8 +472,37 @@ mod tests {
         check_runs(&far, 1 << 20);
         // A strand larger than the batch: nothing, not a hang.
         assert_eq!(
-            plan_frame(&bundles(), 64, 5, &camera(0.3, false), &settings, 10).strands,
+            plan_frame(&bundles(), 64, 5, &camera(0.3, false), &settings, 10, &[]).strands,
             0
         );
+    }
+
+    #[test]
+    fn bundles_far_hair_draws_have_no_strands() {
+        let settings = LodSettings::default();
+        let camera = camera(0.5, false);
+        let all = plan_frame(&bundles(), 64, 5, &camera, &settings, 1 << 20, &[]);
+        let mut levels = vec![0u32; 40];
+        for level in levels.iter_mut().step_by(3) {
+            *level = 2;
+        }
+        let far = plan_frame(&bundles(), 64, 5, &camera, &settings, 1 << 20, &levels);
+        let far_count = levels.iter().filter(|&&l| l > 0).count();
+        assert_eq!(far.far_bundles, far_count);
+        let roots = check_runs(&far, 1 << 20);
+        assert!(roots.iter().all(|r| levels[(r / 64) as usize] == 0));
+        let kept: Vec<u32> = check_runs(&all, 1 << 20)
+            .into_iter()
+            .filter(|r| levels[(r / 64) as usize] == 0)
+            .collect();
+        assert_eq!(roots, kept);
+        // Levels shorter than the bundles leave the rest as strands.
+        let short = plan_frame(&bundles(), 64, 5, &camera, &settings, 1 << 20, &[1]);
+        let first_bundle = check_runs(&all, 1 << 20)
+            .iter()
+            .filter(|&&r| r < 64)
+            .count();
+        assert_eq!(short.far_bundles, 1);
+        assert_eq!(short.strands, all.strands - first_bundle);
     }
 }

@@ -7,7 +7,7 @@
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::motion::Motion;
 use hairloom_core::model::scene::{
-    Coverage, Effects, FIBRE_OFFSET_CHOICES, HairMaterial, Light, LightSource, MAX_LIGHTS,
+    Coverage, Effects, FIBRE_OFFSET_CHOICES, FarHair, HairMaterial, Light, LightSource, MAX_LIGHTS,
     MultipleScattering, OPACITY_LAYER_CHOICES, Pigment, Scene, SelfShadowing, Shading,
 };
 use hairloom_render::measure::EffectCost;
@@ -215,6 +215,28 @@ impl ScenePanel {
                     state,
                     "width-oit",
                     effects.coverage == Coverage::WidthOit,
+                ));
+                ui.end_row();
+
+                let mut far = effects.far_hair == FarHair::Aggregated;
+                let response = ui
+                    .checkbox(&mut far, "Far hair (aggregated)")
+                    .on_hover_text(
+                        "bundles whose strands would be thinner than the far width draw a few \
+                         thick hairs each, shaded as the clusters they stand for (seed 001); \
+                         building the hierarchy takes a moment the first time",
+                    );
+                edit_scene(state, &response, "Scene: far hair", |s| {
+                    s.effects.far_hair = if far {
+                        FarHair::Aggregated
+                    } else {
+                        FarHair::Strands
+                    }
+                });
+                ui.weak(self.cost_label(
+                    state,
+                    "far-hair",
+                    effects.far_hair == FarHair::Aggregated,
                 ));
                 ui.end_row();
             });

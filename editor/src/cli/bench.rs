@@ -610,6 +610,7 @@ fn gpu(
                                 hair: &hair,
                                 filtering,
                                 lod,
+                                far: None,
                             },
                             camera,
                         )?;

@@ -119,9 +119,13 @@ enum Command {
         view: String,
         /// Override the scene's optional effects for this render: none, all, or a list of
         /// marschner, opacity-shadow-maps, deep-opacity-maps, body-shadows, dual-scattering,
-        /// width-oit (those on, the rest off).
+        /// width-oit, far-aggregated (those on, the rest off).
         #[arg(long)]
         effects: Option<String>,
+        /// Camera distance as a multiple of the distance that frames the hair (1): 10 sees
+        /// the head at a tenth of the size (far hair, LOD).
+        #[arg(long, default_value_t = 1.0)]
+        distance: f32,
         /// Strands have 2^N + 1 vertices.
         #[arg(long, default_value_t = render::PREVIEW_VERTICES_LOG2)]
         vertices_log2: u32,
@@ -268,6 +272,7 @@ pub fn main() -> ExitCode {
             strands_per_bundle,
             view,
             effects,
+            distance,
             vertices_log2,
             precision,
             filtering,
@@ -278,6 +283,10 @@ pub fn main() -> ExitCode {
             lambda,
             time,
         }) => {
+            if !(distance.is_finite() && (0.1..=1000.0).contains(&distance)) {
+                eprintln!("error: --distance {distance} must be between 0.1 and 1000");
+                return ExitCode::from(2);
+            }
             let lod_values = [alpha_strands, alpha_vertices, lambda];
             if lod_values.iter().any(|v| !v.is_finite() || *v < 0.0) || lambda > 1.0 {
                 eprintln!(
@@ -294,6 +303,7 @@ pub fn main() -> ExitCode {
                 strands_per_bundle,
                 view,
                 effects,
+                distance,
                 vertices_log2,
                 precision: precision.into(),
                 filtering: filtering.into(),

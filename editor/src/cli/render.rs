@@ -36,6 +36,8 @@ pub struct RenderSettings {
     /// `--effects`: none, all or a list overriding the scene's effects (see
     /// [`hairloom_core::model::scene::Effects::parse_list`]).
     pub effects: Option<String>,
+    /// Camera distance as a multiple of the framing distance.
+    pub distance: f32,
     pub vertices_log2: u32,
     /// Texture precision of a project render (a runtime bundle has its own).
     pub precision: Precision,
@@ -54,6 +56,7 @@ impl Default for RenderSettings {
             strands_per_bundle: None,
             view: "three-quarter".into(),
             effects: None,
+            distance: 1.0,
             vertices_log2: PREVIEW_VERTICES_LOG2,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -178,21 +181,31 @@ impl HeadlessRenderer {
     /// Draws the shown hair seen from `direction` with a camera framing the box `frame`;
     /// returns RGBA8 pixels and a one-line description.
     pub fn draw(
-        &self,
+        &mut self,
         context: &GpuContext,
         (width, height): (u32, u32),
         frame: (Vec3, Vec3),
         direction: Vec3,
         settings: &RenderSettings,
     ) -> anyhow::Result<(Vec<u8>, String)> {
-        let asset = self
-            .asset
-            .as_ref()
-            .context("nothing to render: no hair shown")?;
+        let lighting = {
+            let asset = self
+                .asset
+                .as_mut()
+                .context("nothing to render: no hair shown")?;
+            let lighting = scene_for(asset.hair(), settings)?;
+            if lighting.effects.far_hair == hairloom_core::model::scene::FarHair::Aggregated {
+                asset
+                    .ensure_far_hair(context)
+                    .context("far hair's hierarchy")?;
+            }
+            lighting
+        };
+        let asset = self.asset.as_ref().context("nothing to render")?;
         let hair = asset.hair();
         let vertex_count = (1u32 << settings.vertices_log2.min(8)) + 1;
-        let camera = Camera::framing(frame.0, frame.1, direction);
-        let lighting = scene_for(hair, settings)?;
+        let mut camera = Camera::framing(frame.0, frame.1, direction);
+        camera.eye = camera.target + (camera.eye - camera.target) * settings.distance;
         let scene = default_scene(
             asset.body(),
             asset.source(&self.generator, settings.filtering, settings.lod),
@@ -202,11 +215,18 @@ impl HeadlessRenderer {
             &lighting,
         );
         let renderer = &self.preview;
+        // A still picture draws far hair at the levels a still camera settles on.
+        renderer.settle_far_levels(context, &scene, width, height)?;
         let plan = renderer.plan(&scene, width, height);
         let pixels = renderer.render(context, &scene, &plan, width, height)?;
         let names = lighting.effects.names();
+        let far = if plan.far_levels.is_empty() {
+            String::new()
+        } else {
+            format!(", {} bundles as far hair", plan.far_bundles)
+        };
         let summary = format!(
-            "{width}x{height}, {} of {} strands ({} vertices, LOD {}) generated on the GPU ({:?} filtering, {:?} textures), effects: {}, {}× MSAA, on {}",
+            "{width}x{height}, {} of {} strands ({} vertices, LOD {}){far} generated on the GPU ({:?} filtering, {:?} textures), effects: {}, {}× MSAA, on {}",
             plan.strands,
             asset.gpu().root_count,
             plan.vertices,

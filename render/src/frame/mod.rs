@@ -77,6 +77,9 @@ pub enum FrameError {
     /// An effect's resource would exceed what the adapter allows; nothing was made.
     #[error("{0}")]
     EffectLimit(String),
+    /// Far hair asked for where it cannot be drawn.
+    #[error("scene.effects.far_hair: {0}")]
+    FarHair(String),
 }
 
 /// Refuses effect resources the adapter cannot hold, naming the scene's field and the limit.

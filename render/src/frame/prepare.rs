@@ -12,9 +12,12 @@ use hairloom_core::runtime::strand_gen::Filtering;
 
 use super::{FrameError, FrameRenderers};
 use crate::device::GpuContext;
+use crate::renderer::far_hair::PreparedFar;
 use crate::renderer::preview_body::{BodyUniforms, GpuBody, PreparedBody};
 use crate::renderer::preview_hair::{HairUniforms, MeshLod, PreparedHair, RibbonInput};
-use crate::renderer::strand_gen::{GenerationPath, GpuHair, StrandGenRenderer, check_mesh_groups};
+use crate::renderer::strand_gen::{
+    GenerationPath, GpuFarHair, GpuHair, StrandGenRenderer, check_mesh_groups,
+};
 use crate::resources::Tracked;
 
 /// Where the strand vertices of a frame come from.
@@ -35,6 +38,8 @@ pub enum HairSource<'a> {
         hair: &'a GpuHair,
         filtering: Filtering,
         lod: LodSettings,
+        /// Far hair's hierarchy, where the hair has one (drawn when the scene asks).
+        far: Option<&'a GpuFarHair>,
     },
 }
 
@@ -48,8 +53,14 @@ impl HairSource<'_> {
     }
 
     /// Refuses, before anything is made, generation the device cannot run: a path it lacks,
-    /// mesh workgroups above its limits, hardware filtering of textures it cannot filter.
-    pub fn check(&self, context: &GpuContext, vertex_count: u32) -> Result<(), FrameError> {
+    /// mesh workgroups above its limits, hardware filtering of textures it cannot filter;
+    /// and far hair (`far_hair`: the scene asks for it) where it is not drawn.
+    pub fn check(
+        &self,
+        context: &GpuContext,
+        vertex_count: u32,
+        far_hair: bool,
+    ) -> Result<(), FrameError> {
         let HairSource::Generated {
             generator,
             hair,
@@ -57,8 +68,22 @@ impl HairSource<'_> {
             ..
         } = self
         else {
+            if far_hair {
+                return Err(FrameError::FarHair(
+                    "far hair needs generated hair (stored strands have no hierarchy); \
+                     render with generation on, or without far-aggregated"
+                        .into(),
+                ));
+            }
             return Ok(());
         };
+        if far_hair && generator.path() == GenerationPath::MeshShader {
+            return Err(FrameError::FarHair(
+                "far hair is not drawn on the mesh-shader generation path yet (its task \
+                 shaders plan every bundle as strands); use the compute or vertex-shader path"
+                    .into(),
+            ));
+        }
         StrandGenRenderer::check_path(context, generator.path()).map_err(FrameError::Generation)?;
         if generator.path() == GenerationPath::MeshShader {
             check_mesh_groups(
@@ -98,7 +123,7 @@ impl FrameCamera {
     }
 
     /// World size of one pixel at unit distance.
-    fn pixel_at_unit(&self) -> f32 {
+    pub fn pixel_at_unit(&self) -> f32 {
         2.0 * (self.fov_y_rad * 0.5).tan() / self.height_px.max(1) as f32
     }
 }
@@ -141,6 +166,8 @@ pub struct PreparedFrame {
     pub(crate) input: RibbonInput,
     /// Bytes of the frame's generation scratch (0 without one).
     pub scratch_bytes: u64,
+    /// Far hair's thick hairs this frame, where any bundle draws them.
+    pub far: Option<PreparedFar>,
 }
 
 impl PreparedFrame {
@@ -257,6 +284,7 @@ pub fn prepare(
             hair,
             filtering,
             lod,
+            ..
         } if input != RibbonInput::Buffer => renderers.hair.prepare_generated(
             context,
             &hair_views,
@@ -276,7 +304,18 @@ pub fn prepare(
             .prepare(context, &hair_views, &ranges, &strands, &runs),
     };
     let body = renderers.body.prepare(context, &body_views);
+    let far = match (&renderers.far_hair, &inputs.hair) {
+        (Some(renderer), HairSource::Generated { far: Some(far), .. }) => renderer.prepare(
+            context,
+            far,
+            &plan.far_levels,
+            inputs.vertex_count,
+            &hair_views,
+        ),
+        _ => None,
+    };
     PreparedFrame {
+        far,
         hair,
         body,
         batches: plan.batches.clone(),

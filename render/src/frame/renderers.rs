@@ -2,12 +2,15 @@
 //! lighting, hair ribbons, body) and the effect renderers, which exist only while the scene's
 //! effects name them.
 
-use hairloom_core::model::scene::{Scene, SelfShadowing};
+use hairloom_core::model::scene::{FarHair, Scene, SelfShadowing};
+use hairloom_core::runtime::far_lod::FarLodParams;
+use hairloom_core::runtime::frame_plan::FramePlan;
 
-use super::{FrameRenderer, Phase};
+use super::{FrameCamera, FrameError, FrameRenderer, HairSource, Phase};
 use crate::device::GpuContext;
 use crate::renderer::Targets;
 use crate::renderer::body_shadow::BodyShadowRenderer;
+use crate::renderer::far_hair::FarHairRenderer;
 use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::BodyRenderer;
@@ -15,7 +18,7 @@ use crate::renderer::preview_hair::{HairRenderer, RibbonInput};
 use crate::renderer::scene_lighting::{ActiveEffects, SceneLighting, binding, effects_layout};
 
 /// Which group-2 layout the lit shaders were made against.
-type EffectsLayoutKey = (SelfShadowing, bool, bool);
+type EffectsLayoutKey = (SelfShadowing, bool, bool, bool);
 
 /// One renderer per feature, made for the targets they draw into.
 pub struct FrameRenderers {
@@ -27,6 +30,10 @@ pub struct FrameRenderers {
     pub(crate) hair_shadow: Option<HairShadowRenderer>,
     pub(crate) body_shadow: Option<BodyShadowRenderer>,
     pub(crate) oit: Option<OitRenderer>,
+    pub(crate) far_hair: Option<FarHairRenderer>,
+    /// Far hair: the level each bundle draws next frame (eq. 16's choice from the widths
+    /// measured in the last; empty until a frame of far hair is planned).
+    pub(crate) far_levels: Vec<u32>,
     targets: Targets,
     /// What the last [`Self::sync`] made them for.
     pub(crate) active: ActiveEffects,
@@ -45,6 +52,8 @@ impl FrameRenderers {
             hair_shadow: None,
             body_shadow: None,
             oit: None,
+            far_hair: None,
+            far_levels: Vec::new(),
             targets,
             active: ActiveEffects::none(),
             mean_forward: [1.0; 3],
@@ -69,6 +78,7 @@ impl FrameRenderers {
             active.opacity_maps,
             active.body_shadows,
             active.dual_scattering,
+            active.far_hair,
         );
         if self
             .effects_layout
@@ -79,6 +89,9 @@ impl FrameRenderers {
             // Pipelines made with the old layout go with it.
             self.hair = HairRenderer::with_targets(context, self.targets);
             self.body = BodyRenderer::with_targets(context, self.targets);
+            if let Some(far) = &mut self.far_hair {
+                far.forget_pipelines();
+            }
         }
         let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
         self.hair.ensure(
@@ -147,7 +160,107 @@ impl FrameRenderers {
         } else {
             None
         };
+        if active.far_hair {
+            let far = self.far_hair.get_or_insert_with(|| {
+                FarHairRenderer::new(context, self.targets, &scene.material)
+            });
+            let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
+            far.ensure(
+                context,
+                active,
+                &scene.material,
+                &self.lighting.scene_layout,
+                effects_layout,
+            );
+            match &self.hair_shadow {
+                Some(hair_shadow) => {
+                    far.ensure_shadows(context, hair_shadow, &self.lighting.scene_layout)
+                }
+                None => far.forget_shadow_pipelines(),
+            }
+        } else {
+            self.far_hair = None;
+            self.far_levels.clear();
+        }
         self.active = *active;
+    }
+
+    /// The far-hair level of every bundle for a frame of `scene` seen by `camera` with `hair`
+    /// (empty: strands everywhere, when the scene draws no far hair or the hair has no
+    /// hierarchy): the choice the last frame measured ([`Self::advance_far_levels`]), or,
+    /// with none, the first guess from the stored widths. Plan the frame with these.
+    pub fn far_levels(
+        &mut self,
+        scene: &Scene,
+        hair: &HairSource,
+        camera: &FrameCamera,
+    ) -> Vec<u32> {
+        let HairSource::Generated {
+            hair,
+            far: Some(far),
+            ..
+        } = hair
+        else {
+            self.far_levels.clear();
+            return Vec::new();
+        };
+        if scene.effects.far_hair != FarHair::Aggregated {
+            self.far_levels.clear();
+            return Vec::new();
+        }
+        let blocks = &far.table.blocks;
+        if self.far_levels.len() != blocks.len() {
+            self.far_levels = FarHairRenderer::first_levels(
+                far,
+                &hair.bundles,
+                &far_lod_params(scene, camera, 0),
+            );
+        }
+        // A hair made again may have fewer levels in a bundle than it drew.
+        for (level, block) in self.far_levels.iter_mut().zip(blocks) {
+            *level = (*level).min(block.len() as u32);
+        }
+        self.far_levels.clone()
+    }
+
+    /// Eq. 16 after a frame planned as `plan` of `scene` from `camera`: the widths of the
+    /// thick hairs it drew (and the next coarser ones), measured on the GPU at
+    /// `vertex_count` vertices, choose each bundle's level for the next frame.
+    pub fn advance_far_levels(
+        &mut self,
+        context: &GpuContext,
+        scene: &Scene,
+        hair: &HairSource,
+        camera: &FrameCamera,
+        vertex_count: u32,
+        plan: &FramePlan,
+    ) -> Result<(), FrameError> {
+        let (
+            Some(renderer),
+            HairSource::Generated {
+                generator,
+                hair,
+                far: Some(far),
+                ..
+            },
+        ) = (&self.far_hair, hair)
+        else {
+            return Ok(());
+        };
+        if plan.far_levels.is_empty() {
+            return Ok(());
+        }
+        self.far_levels = renderer
+            .next_levels(
+                context,
+                generator,
+                hair,
+                far,
+                &plan.far_levels,
+                far_lod_params(scene, camera, vertex_count),
+            )
+            .map_err(FrameError::Generation)?;
+        Ok(())
     }
 
     fn effects_layout(&self) -> Option<&wgpu::BindGroupLayout> {
@@ -184,6 +297,12 @@ impl FrameRenderers {
             entries.push(view(binding::DS_PROFILE, &ds.profile_view));
             entries.push(view(binding::DS_LOBES, &ds.lobes_view));
         }
+        if let Some(far) = &self.far_hair {
+            entries.push(wgpu::BindGroupEntry {
+                binding: binding::AGG_TABLES,
+                resource: far.tables().as_entire_binding(),
+            });
+        }
         Some(
             context
                 .device
@@ -208,6 +327,9 @@ impl FrameRenderers {
         if let Some(r) = &self.oit {
             all.push(r);
         }
+        if let Some(r) = &self.far_hair {
+            all.push(r);
+        }
         all.iter().map(|r| (r.name(), r.phases())).collect()
     }
 
@@ -222,6 +344,17 @@ impl FrameRenderers {
             .into_iter()
             .filter(|phase| named.contains(phase))
             .collect()
+    }
+}
+
+/// The level choice's parameters for `scene` seen by `camera`.
+fn far_lod_params(scene: &Scene, camera: &FrameCamera, vertex_count: u32) -> FarLodParams {
+    FarLodParams {
+        eye: camera.eye.extend(1.0).to_array(),
+        pixel_at_unit: camera.pixel_at_unit(),
+        width_threshold_px: scene.effects.far_width_px,
+        vertex_count,
+        count: 0,
     }
 }
 
@@ -277,5 +410,23 @@ impl FrameRenderer for OitRenderer {
     }
     fn phases(&self) -> &'static [Phase] {
         &[Phase::Coverage, Phase::Composite]
+    }
+}
+
+impl FrameRenderer for FarHairRenderer {
+    fn name(&self) -> &'static str {
+        "far hair"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        if self.draws_shadows() {
+            &[
+                Phase::Generation,
+                Phase::ShadowViews,
+                Phase::DepthPrePass,
+                Phase::Lit,
+            ]
+        } else {
+            &[Phase::Generation, Phase::DepthPrePass, Phase::Lit]
+        }
     }
 }

@@ -21,6 +21,16 @@ use crate::resources::Tracked;
 
 pub const OPACITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
+/// A shader of another source of hair drawn into the maps: its label, source and entries
+/// (`fragment_entry` `None`: depth only).
+#[derive(Clone, Copy)]
+pub struct ShaderEntries<'a> {
+    pub label: &'a str,
+    pub source: &'a str,
+    pub vertex_entry: &'a str,
+    pub fragment_entry: Option<&'a str>,
+}
+
 pub struct HairShadowRenderer {
     pub kind: SelfShadowing,
     /// Where the ribbons' vertices come from.
@@ -42,6 +52,9 @@ pub struct HairShadowRenderer {
     )>,
     /// Deep opacity maps: the opacity pass reads the first hair's depth (group 2).
     opacity_group: Option<wgpu::BindGroup>,
+    first_hair_layout: Option<wgpu::BindGroupLayout>,
+    /// The opacity targets' states (additive), as every opacity pipeline writes them.
+    target_states: Vec<Option<wgpu::ColorTargetState>>,
 }
 
 impl HairShadowRenderer {
@@ -189,7 +202,78 @@ impl HairShadowRenderer {
             opacity_view,
             first_hair,
             opacity_group,
+            first_hair_layout,
+            target_states: targets,
         }
+    }
+
+    /// A pipeline that draws another source's hair into these maps' first-hair depth (deep
+    /// opacity maps; `None` otherwise): `source`'s `vertex_entry` and, where it alpha-tests,
+    /// its depth-only `fragment_entry`, bound as `groups` (group 0 of the source's own).
+    pub fn depth_pipeline_for(
+        &self,
+        context: &GpuContext,
+        shader: ShaderEntries,
+        groups: &[&wgpu::BindGroupLayout],
+    ) -> Option<Tracked<wgpu::RenderPipeline>> {
+        let ShaderEntries {
+            label,
+            source,
+            vertex_entry,
+            fragment_entry,
+        } = shader;
+        self.first_hair.as_ref()?;
+        Some(crate::renderer::pipeline(
+            context,
+            &PipelineSpec {
+                label,
+                source,
+                groups,
+                buffers: &[],
+                vertex_entry,
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                fragment_entry,
+                targets: &[],
+                depth: Some(shadow_depth_state(0.0)),
+                sample_count: 1,
+            },
+        ))
+    }
+
+    /// A pipeline that adds another source's hair to these maps' opacity layers: `source`'s
+    /// `vertex_entry` and `fragment_entry` (returning `OpacityOutput`), its own group 0
+    /// layout `own`, then the scene (group 1) and, for deep opacity maps, the first hair's
+    /// depth (group 2), as [`Self::opacity_pass`] binds them.
+    pub fn opacity_pipeline_for(
+        &self,
+        context: &GpuContext,
+        shader: ShaderEntries,
+        own: &wgpu::BindGroupLayout,
+        scene_layout: &wgpu::BindGroupLayout,
+    ) -> Tracked<wgpu::RenderPipeline> {
+        let ShaderEntries {
+            label,
+            source,
+            vertex_entry,
+            fragment_entry,
+        } = shader;
+        let mut groups = vec![own, scene_layout];
+        groups.extend(self.first_hair_layout.as_ref());
+        crate::renderer::pipeline(
+            context,
+            &PipelineSpec {
+                label,
+                source,
+                groups: &groups,
+                buffers: &[],
+                vertex_entry,
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                fragment_entry,
+                targets: &self.target_states,
+                depth: None,
+                sample_count: 1,
+            },
+        )
     }
 
     /// Whether these maps serve a scene with these settings.
@@ -223,11 +307,24 @@ impl HairShadowRenderer {
         runs: &[StrandRun],
         clear: bool,
     ) {
-        let (Some(pipeline), Some((_, layers, _))) = (&self.depth_pipeline, &self.first_hair)
+        let (Some(pipeline), Some(mut pass)) =
+            (&self.depth_pipeline, self.depth_pass(encoder, slot, clear))
         else {
             return;
         };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        HairRenderer::draw_with(&mut pass, pipeline, prepared, slot + 1, batch, runs);
+    }
+
+    /// Deep opacity maps' depth pass of light `slot` (`None` for opacity shadow maps),
+    /// cleared when `clear`.
+    pub fn depth_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        slot: usize,
+        clear: bool,
+    ) -> Option<wgpu::RenderPass<'static>> {
+        let (_, layers, _) = self.first_hair.as_ref()?;
+        let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("hair_shadow_depth"),
             color_attachments: &[],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
@@ -246,7 +343,8 @@ impl HairShadowRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        HairRenderer::draw_with(&mut pass, pipeline, prepared, slot + 1, batch, runs);
+        // Each pass ends (drops) before the next is begun; wgpu checks this at run time.
+        Some(pass.forget_lifetime())
     }
 
     /// The opacity pass of light `slot` for one batch; `clear` on the first batch.
@@ -264,6 +362,26 @@ impl HairShadowRenderer {
         runs: &[StrandRun],
         clear: bool,
     ) {
+        let mut pass = self.opacity_pass(encoder, scene_group, slot, clear);
+        HairRenderer::draw_with(
+            &mut pass,
+            &self.opacity_pipeline,
+            prepared,
+            slot + 1,
+            batch,
+            runs,
+        );
+    }
+
+    /// The opacity pass of light `slot`, cleared when `clear`, with the scene (group 1) and,
+    /// for deep opacity maps, the first hair's depth (group 2) bound.
+    pub fn opacity_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene_group: &wgpu::BindGroup,
+        slot: usize,
+        clear: bool,
+    ) -> wgpu::RenderPass<'static> {
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = (0..4)
             .map(|g| {
                 self.opacity_targets[slot]
@@ -295,13 +413,6 @@ impl HairShadowRenderer {
         if let Some(group) = &self.opacity_group {
             pass.set_bind_group(2, group, &[]);
         }
-        HairRenderer::draw_with(
-            &mut pass,
-            &self.opacity_pipeline,
-            prepared,
-            slot + 1,
-            batch,
-            runs,
-        );
+        pass.forget_lifetime()
     }
 }

@@ -15,9 +15,10 @@
 //! | [`oit_composite`] | `oit_composite.wgsl` | width-based coverage |
 //! | [`scene_lighting`] | `shared/scene.wgsl`, `light/dual_scattering.wgsl` | always (tables: dual scattering) |
 //! | [`viewport_blit`] | `viewport_blit.wgsl` | the editor's viewport (an egui paint callback) |
-//! | [`far_lod`], [`strand_gen`] (`ThickGenRenderer`) | `far_lod.wgsl`, `strand_gen.wgsl` (`thick_main`) | far hair (made on demand; not in frames yet) |
+//! | [`far_hair`], [`far_lod`], [`strand_gen`] (`ThickGenRenderer`) | `far_hair*.wgsl` + `light/aggregated_bcsdf.wgsl`, `far_lod.wgsl`, `strand_gen.wgsl` (`thick_main`) | far hair (`far: aggregated`) |
 
 pub mod body_shadow;
+pub mod far_hair;
 pub mod far_lod;
 pub mod hair_shadow;
 pub mod oit_composite;

@@ -13,7 +13,7 @@ use hairloom_core::light::hair_bsdf::P_MAX;
 use hairloom_core::light::material::Fibre;
 use hairloom_core::light::scene_uniforms::SceneUniforms;
 use hairloom_core::model::scene::{
-    Coverage, HairMaterial, MultipleScattering, Scene, SelfShadowing, Shading,
+    Coverage, FarHair, HairMaterial, MultipleScattering, Scene, SelfShadowing, Shading,
 };
 
 use crate::device::GpuContext;
@@ -34,6 +34,8 @@ pub struct ActiveEffects {
     pub shadow_resolution: u32,
     /// Shadow-casting lights (each has its own maps).
     pub shadow_slots: u32,
+    /// Far hair's thick hairs (seed 001) where bundles are narrow enough.
+    pub far_hair: bool,
 }
 
 impl ActiveEffects {
@@ -60,6 +62,7 @@ impl ActiveEffects {
             } else {
                 0
             },
+            far_hair: effects.far_hair == FarHair::Aggregated,
         }
     }
 
@@ -74,6 +77,7 @@ impl ActiveEffects {
             opacity_layers: 4,
             shadow_resolution: 1024,
             shadow_slots: 0,
+            far_hair: false,
         }
     }
 
@@ -97,6 +101,8 @@ pub mod binding {
     pub const TABLE_SAMPLER: u32 = 4;
     pub const DS_PROFILE: u32 = 5;
     pub const DS_LOBES: u32 = 6;
+    /// Far hair's aggregated BCSDF tables (`light/aggregated_bcsdf.wgsl`).
+    pub const AGG_TABLES: u32 = 7;
 }
 
 fn texture_entry(
@@ -176,6 +182,18 @@ pub fn effect_entries(effects: &ActiveEffects) -> Vec<wgpu::BindGroupLayoutEntry
             float,
             wgpu::TextureViewDimension::D2Array,
         ));
+    }
+    if effects.far_hair {
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: binding::AGG_TABLES,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: true },
+                has_dynamic_offset: false,
+                min_binding_size: wgpu::BufferSize::new(16),
+            },
+            count: None,
+        });
     }
     entries
 }

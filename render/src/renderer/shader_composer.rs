@@ -129,6 +129,10 @@ pub const NO_BODY_SHADOWS: &str = shader_file!("light/no_body_shadows.wgsl");
 pub const PREVIEW_HAIR: &str = shader_file!("preview_hair.wgsl");
 pub const PREVIEW_BODY: &str = shader_file!("preview_body.wgsl");
 pub const HAIR_SHADOW: &str = shader_file!("hair_shadow.wgsl");
+pub const OPACITY_OUTPUT: &str = shader_file!("light/opacity_output.wgsl");
+pub const FAR_HAIR: &str = shader_file!("far_hair.wgsl");
+pub const FAR_HAIR_LIT: &str = shader_file!("far_hair_lit.wgsl");
+pub const FAR_HAIR_SHADOW: &str = shader_file!("far_hair_shadow.wgsl");
 
 /// Far hair's shading model (`light/aggregated_bcsdf.wgsl`, after `hair_bsdf.wgsl`), with its
 /// table layout from the one definition in [`hairloom_core::light::aggregated_bcsdf`].
@@ -142,17 +146,23 @@ pub fn aggregated_bcsdf_module() -> String {
     )
 }
 
+/// Where a light's opacity layers start: the first hair's depth (deep opacity maps) or its
+/// near plane (opacity shadow maps).
+fn opacity_start(kind: SelfShadowing) -> &'static str {
+    if kind == SelfShadowing::DeepOpacityMaps {
+        OPACITY_START_DOM
+    } else {
+        OPACITY_START_OSM
+    }
+}
+
 /// The shadow modules of a lit shader: opacity-map lookups (or none) and body shadows (or none).
 fn shadow_modules(key: &ShaderKey, source: &mut String) {
     match key.opacity_maps {
         SelfShadowing::None => source.push_str(NO_OPACITY_MAPS),
         kind => {
             source.push_str(OPACITY_LAYERS);
-            source.push_str(if kind == SelfShadowing::DeepOpacityMaps {
-                OPACITY_START_DOM
-            } else {
-                OPACITY_START_OSM
-            });
+            source.push_str(opacity_start(kind));
             source.push_str(OPACITY_MAPS);
         }
     }
@@ -203,13 +213,34 @@ pub fn hair_shadow_shader(kind: SelfShadowing, input: RibbonInput) -> String {
         ribbon_modules(input).as_str(),
         SCENE,
         OPACITY_LAYERS,
-        if kind == SelfShadowing::DeepOpacityMaps {
-            OPACITY_START_DOM
-        } else {
-            OPACITY_START_OSM
-        },
+        opacity_start(kind),
+        OPACITY_OUTPUT,
         HAIR_SHADOW,
     ]
     .concat();
     with_mesh_stages(input, source)
+}
+
+/// Far hair's thick hairs, depth pre-pass and lit (`far_hair.wgsl`, `far_hair_lit.wgsl`): the
+/// scene, the fibre model and the aggregated BCSDF (whatever the strands' shading model:
+/// far hair's tables are made from the Marschner fibre), the shadow modules of `key`.
+pub fn far_hair_shader(key: &ShaderKey) -> String {
+    let mut source = [SCENE, HAIR_BSDF, &aggregated_bcsdf_module()].concat();
+    shadow_modules(key, &mut source);
+    source.push_str(FAR_HAIR);
+    source.push_str(FAR_HAIR_LIT);
+    source
+}
+
+/// Far hair's thick hairs seen from a light, for opacity maps of `kind`.
+pub fn far_hair_shadow_shader(kind: SelfShadowing) -> String {
+    [
+        SCENE,
+        OPACITY_LAYERS,
+        opacity_start(kind),
+        OPACITY_OUTPUT,
+        FAR_HAIR,
+        FAR_HAIR_SHADOW,
+    ]
+    .concat()
 }

@@ -92,6 +92,7 @@ pub fn frames(
                     hair: &hair,
                     filtering: Filtering::Exact,
                     lod,
+                    far: None,
                 },
                 vertex_count,
                 (lo, hi),

@@ -34,7 +34,7 @@ impl Viewport {
         std::thread::spawn(move || {
             let result = (|| -> anyhow::Result<Vec<EffectCost>> {
                 // On this worker thread, never the UI's: the document's own asset.
-                let asset = HairAsset::from_document(
+                let mut asset = HairAsset::from_document(
                     &context,
                     &generator,
                     &document,
@@ -44,6 +44,8 @@ impl Viewport {
                         ..RuntimeOptions::default()
                     },
                 )?;
+                // The far-hair row measures thick hairs: the hierarchy is built here.
+                asset.ensure_far_hair(&context)?;
                 let bounds = asset.bounds();
                 let (lo, hi) = camera_bounds.unwrap_or(bounds);
                 let scene = default_scene(

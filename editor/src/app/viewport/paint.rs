@@ -70,9 +70,16 @@ impl ViewportGpu {
         let Some(frame) = work.frame else {
             return;
         };
-        let Some(hair) = self.hair.as_ref() else {
+        let Some(hair) = self.hair.as_mut() else {
             return;
         };
+        if frame.lighting.effects.far_hair == hairloom_core::model::scene::FarHair::Aggregated
+            && let Err(error) = hair.ensure_far_hair(&self.context)
+        {
+            let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
+            report.upload_error = Some(format!("cannot draw far hair: {error}"));
+        }
+        let hair = &*hair;
         let scene = default_scene(
             hair.body(),
             hair.source(&self.generator, frame.filtering, frame.lod),

@@ -29,6 +29,12 @@ pub struct GpuFarHair {
 }
 
 impl GpuFarHair {
+    /// Uploads `table` (what a frame that draws far hair reads; no pipeline needed).
+    pub fn upload(context: &GpuContext, table: FarHair) -> Self {
+        let thick_hairs = ThickGenRenderer::upload_records(context, &table.thick_hairs);
+        Self { table, thick_hairs }
+    }
+
     /// Bytes of the table on the GPU.
     pub fn bytes(&self) -> u64 {
         self.thick_hairs.size()
@@ -105,12 +111,6 @@ impl ThickGenRenderer {
             pipeline,
             bind_group_layout,
         }
-    }
-
-    /// Uploads `table`.
-    pub fn upload(&self, context: &GpuContext, table: FarHair) -> GpuFarHair {
-        let thick_hairs = Self::upload_records(context, &table.thick_hairs);
-        GpuFarHair { table, thick_hairs }
     }
 
     /// Thick-hair records as `thick_main` reads them (none uploads one unused record:
