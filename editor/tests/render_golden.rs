@@ -207,6 +207,33 @@ fn effect_combinations_match_their_golden_images() {
     match_golden_images(&cases);
 }
 
+/// Far hair (seed 001) on the long sample as it moves away: near (mostly strands), then most
+/// bundles as thick hairs shaded by the aggregated BCSDF.
+#[test]
+fn far_hair_matches_its_golden_images_at_three_distances() {
+    let sample = root().join("assets/samples/head_long_wavy.hairloom");
+    let cases: Vec<_> = ["1", "2", "3"]
+        .iter()
+        .map(|distance| {
+            let mut args = vec![sample.clone().into_os_string()];
+            args.extend(os_args(&[
+                "--size",
+                SIZE,
+                "--strands-per-bundle",
+                "16",
+                "--view",
+                "front",
+                "--distance",
+                distance,
+                "--effects",
+                "marschner,deep-opacity-maps,body-shadows,dual-scattering,far-aggregated",
+            ]));
+            (format!("far/long_wavy_{distance}x"), args)
+        })
+        .collect();
+    match_golden_images(&cases);
+}
+
 #[test]
 fn the_golden_comparison_sees_a_changed_picture() {
     // The same sample from another side must fail the tolerance: the check can fail.

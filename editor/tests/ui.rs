@@ -1243,11 +1243,31 @@ fn scene_panel_switches_effects_and_edits_the_material_with_undo() {
 }
 
 #[test]
+fn the_far_hair_switch_is_one_undo_step() {
+    use hairloom_core::model::scene::FarHair;
+    let mut harness = harness();
+    harness.get_by_label("Scene").click();
+    harness.run();
+    let far = |h: &Harness<'static, HairloomApp>| h.state().state.document().scene.effects.far_hair;
+    assert_eq!(far(&harness), FarHair::Strands);
+    harness.get_by_label("Far hair (aggregated)").click();
+    harness.run();
+    assert_eq!(far(&harness), FarHair::Aggregated);
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(far(&harness), FarHair::Strands);
+}
+
+#[test]
 fn scene_panel_adds_aims_and_removes_lights() {
     let mut harness = harness();
     harness.get_by_label("Scene").click();
     harness.run();
     let lights = harness.state().state.document().scene.lights.len();
+    // The lights sit below the effects and the material: scrolled to, as an artist would.
+    harness.get_by_label("Add light").scroll_to_me();
+    harness.run();
     harness.get_by_label("Add light").click();
     harness.run();
     assert_eq!(
@@ -1271,6 +1291,12 @@ fn scene_panel_adds_aims_and_removes_lights() {
         (to_light[1] / length - 80f32.to_radians().sin()).abs() < 1e-3,
         "{to_light:?}"
     );
+    let remove = harness
+        .get_all_by_label("Remove light")
+        .next()
+        .expect("a remove button");
+    remove.scroll_to_me();
+    harness.run();
     harness
         .get_all_by_label("Remove light")
         .next()

@@ -112,6 +112,33 @@ pub enum Which {
         #[arg(long, default_value = "target/bench")]
         out: std::path::PathBuf,
     },
+    /// Far hair (seed 001 Fig. 7): each head sample as it shrinks from 50% to 0.3% of the
+    /// picture, every strand, strand LOD (seed 000) and far hair's thick hairs, each with its
+    /// ꟻLIP against the CPU path tracer on full geometry, frame time and segments drawn.
+    Far {
+        /// Samples to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("head_long_wavy"), String::from("head_curly")])]
+        samples: Vec<String>,
+        /// Picture side in pixels.
+        #[arg(long, default_value_t = 256)]
+        size: u32,
+        #[arg(long, default_value_t = 16)]
+        strands_per_bundle: u32,
+        /// Path-tracing samples per pixel of the reference.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        #[arg(long, default_value_t = 24)]
+        bounces: u32,
+        /// Time budget of each reference picture (it stops after the pass that passes it).
+        #[arg(long, default_value_t = 600.0)]
+        max_seconds: f64,
+        /// Measured GPU runs per row after one warm-up (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Folder for far.csv and the PNG grids.
+        #[arg(long, default_value = "target/bench")]
+        out: std::path::PathBuf,
+    },
     /// Many characters in one frame (the paper's Fig. 1 crowd): one uploaded bundle drawn N
     /// times with its own transform and LOD through the game runtime; frame time and GPU
     /// memory against N.
@@ -209,6 +236,27 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             runs,
             out,
         } => super::bench_shading::run(&super::bench_shading::ShadingSettings {
+            bench: super::bench_shading::ShadingBench::Shading,
+            samples,
+            size,
+            strands_per_bundle: strands_per_bundle.clamp(1, 4096),
+            samples_per_pixel: spp.max(1),
+            max_bounces: bounces,
+            max_seconds,
+            runs: runs.max(1),
+            out,
+        }),
+        Which::Far {
+            samples,
+            size,
+            strands_per_bundle,
+            spp,
+            bounces,
+            max_seconds,
+            runs,
+            out,
+        } => super::bench_shading::run(&super::bench_shading::ShadingSettings {
+            bench: super::bench_shading::ShadingBench::Far,
             samples,
             size,
             strands_per_bundle: strands_per_bundle.clamp(1, 4096),

@@ -15,7 +15,7 @@ use glam::{DVec3, Vec3};
 use hairloom_core::light::reference_render::{
     Fibres, ReferenceCamera, ReferenceSettings, render_reference,
 };
-use hairloom_core::model::scene::{Effects, Scene};
+use hairloom_core::model::scene::{Effects, FarHair, Scene};
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{DEFAULT_SAMPLE_SEED, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
@@ -49,7 +49,10 @@ pub fn configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
             "+ dual scattering",
             "marschner,deep-opacity-maps,body-shadows,dual-scattering",
         ),
-        ("+ width-based OIT", "all"),
+        (
+            "+ width-based OIT",
+            "marschner,deep-opacity-maps,body-shadows,dual-scattering,width-oit",
+        ),
     ];
     let mut configurations: Vec<(&'static str, Effects)> = list
         .iter()
@@ -71,10 +74,64 @@ pub fn configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
             },
         ));
     }
+    // Far hair (seed 001) over the full scene: thick hairs where strands would be thinner
+    // than ε_w, against the row above it with strand LOD alone.
+    configurations.push((
+        "+ far hair (aggregated)",
+        Effects {
+            far_hair: FarHair::Aggregated,
+            ..full
+        },
+    ));
     configurations
 }
 
+/// `hairloom bench far`'s framings: seed 001 Fig. 7's sweep of the hair's size on screen.
+pub const FAR_SWEEP: [(&str, f32); 8] = [
+    ("50%", 0.5),
+    ("20%", 0.2),
+    ("10%", 0.1),
+    ("5%", 0.05),
+    ("2%", 0.02),
+    ("1%", 0.01),
+    ("0.5%", 0.005),
+    ("0.3%", 0.003),
+];
+
+/// `hairloom bench far`'s methods over the full scene (deep opacity maps, body shadows, dual
+/// scattering): every strand at full detail, seed 000's strand and vertex LOD, and seed 001's
+/// far hair over that LOD.
+pub fn far_configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
+    let full = scene
+        .none()
+        .parse_list("marschner,deep-opacity-maps,body-shadows,dual-scattering")
+        .expect("the configurations parse");
+    vec![
+        (NO_LOD, full.clone()),
+        ("strands + LOD (seed 000)", full.clone()),
+        (
+            "far hair (seed 001)",
+            Effects {
+                far_hair: FarHair::Aggregated,
+                ..full
+            },
+        ),
+    ]
+}
+
+/// The configuration drawn with strand and vertex LOD off.
+const NO_LOD: &str = "strands, no LOD";
+
+/// What a run measures: the shading configurations at [`FRAMINGS`], or far hair's methods
+/// over [`FAR_SWEEP`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShadingBench {
+    Shading,
+    Far,
+}
+
 pub struct ShadingSettings {
+    pub bench: ShadingBench,
     pub samples: Vec<String>,
     pub size: u32,
     pub strands_per_bundle: u32,
@@ -103,13 +160,22 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
     let generator = StrandGenRenderer::new(&context);
     let renderer = PreviewRenderer::new(&context);
     std::fs::create_dir_all(&settings.out)?;
-    let csv_path = settings.out.join("shading.csv");
+    let far_bench = settings.bench == ShadingBench::Far;
+    let stem = if far_bench { "far" } else { "shading" };
+    let csv_path = settings.out.join(format!("{stem}.csv"));
     let mut csv = std::fs::File::create(&csv_path)?;
     writeln!(
         csv,
-        "sample,framing,configuration,flip_mean,frame_ms,reference_seconds,reference_spp"
+        "sample,framing,configuration,flip_mean,frame_ms,segments,far_bundles,reference_seconds,reference_spp"
     )?;
-    println!("Shading accuracy against time: ꟻLIP against the CPU path tracer, GPU frame time");
+    if far_bench {
+        println!(
+            "Far hair: strands, strand LOD and far hair's thick hairs as the head shrinks on \
+             screen; ꟻLIP against the CPU path tracer on full geometry, frame time, segments"
+        );
+    } else {
+        println!("Shading accuracy against time: ꟻLIP against the CPU path tracer, GPU frame time");
+    }
     println!("adapter: {}", describe(&context.adapter_info));
     println!("machine: {}", super::machine());
     println!(
@@ -121,15 +187,20 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
         settings.max_bounces
     );
     println!(
-        "{:<20} {:<7} {:<24} {:>8} {:>10}",
-        "sample", "framing", "configuration", "ꟻLIP", "frame ms"
+        "{:<20} {:<7} {:<26} {:>8} {:>10} {:>9} {:>5}",
+        "sample", "framing", "configuration", "ꟻLIP", "frame ms", "segments", "far"
     );
+    let framings: Vec<(&str, f32)> = if far_bench {
+        FAR_SWEEP.to_vec()
+    } else {
+        FRAMINGS.to_vec()
+    };
     let size = settings.size.max(16);
     for name in &settings.samples {
         let path = hairloom_core::samples::default_sample_path()
             .with_file_name(format!("{name}.hairloom"));
         let document = hairloom_core::io::project::load(&path)?.document;
-        let asset = HairAsset::from_document(
+        let mut asset = HairAsset::from_document(
             &context,
             &generator,
             &document,
@@ -139,12 +210,15 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
             },
         )
         .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        asset
+            .ensure_far_hair(&context)
+            .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
         let (lo, hi) = asset.bounds();
         let width_m = default_strand_width_m(lo, hi);
         let fibres = reference_fibres(&document, settings.strands_per_bundle, width_m as f64);
         // The framings size the hair by its largest side.
         let (center, radius) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.5);
-        for (framing, fraction) in FRAMINGS {
+        for &(framing, fraction) in &framings {
             let camera = framing_camera(center, radius, Vec3::new(0.75, 0.25, 1.0), fraction);
             let started = Instant::now();
             let reference = render_reference(
@@ -171,19 +245,30 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
             let mut row_images = vec![reference.pixels.clone()];
             let black: Vec<u8> = [0, 0, 0, 255].repeat((size * size) as usize);
             let mut flip_images = vec![black];
-            for (configuration, effects) in configurations(&document.scene.effects) {
+            let rows = if far_bench {
+                far_configurations(&document.scene.effects)
+            } else {
+                configurations(&document.scene.effects)
+            };
+            for (configuration, effects) in rows {
                 let lighting = Scene {
                     effects,
                     ..document.scene.clone()
                 };
+                let lod = LodSettings {
+                    enabled: configuration != NO_LOD,
+                    ..LodSettings::default()
+                };
                 let scene = default_scene(
                     asset.body(),
-                    asset.source(&generator, Filtering::Exact, LodSettings::default()),
+                    asset.source(&generator, Filtering::Exact, lod),
                     17,
                     (lo, hi),
                     camera,
                     &lighting,
                 );
+                // A still camera: far hair at the levels it settles on.
+                renderer.settle_far_levels(&context, &scene, size, size)?;
                 let plan = renderer.plan(&scene, size, size);
                 let pixels = renderer.render(&context, &scene, &plan, size, size)?;
                 let timing = super::bench::median_timing(
@@ -192,19 +277,29 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
                     |t| t.wall_ms,
                 )?;
                 let (mean, map) = flip(&reference.pixels, &pixels, size, background);
+                let segments = timing.vertices - timing.strands + timing.far_segments as usize;
                 println!(
-                    "{:<20} {:<7} {:<24} {:>8.4} {:>10.1}",
-                    name, framing, configuration, mean, timing.wall_ms
+                    "{:<20} {:<7} {:<26} {:>8.4} {:>10.1} {:>9} {:>5}",
+                    name,
+                    framing,
+                    configuration,
+                    mean,
+                    timing.wall_ms,
+                    segments,
+                    timing.far_bundles
                 );
                 writeln!(
                     csv,
-                    "{name},{framing},{configuration},{mean:.5},{:.2},{reference_seconds:.1},{}",
-                    timing.wall_ms, reference.samples_per_pixel
+                    "{name},{framing},{configuration},{mean:.5},{:.2},{segments},{},{reference_seconds:.1},{}",
+                    timing.wall_ms, timing.far_bundles, reference.samples_per_pixel
                 )?;
                 row_images.push(pixels);
                 flip_images.push(map);
             }
-            let grid_path = settings.out.join(format!("shading_{name}_{framing}.png"));
+            let grid_path = settings.out.join(format!(
+                "{stem}_{name}_{}.png",
+                framing.trim_end_matches('%')
+            ));
             write_grid(&grid_path, &[row_images, flip_images], size)?;
             println!(
                 "{:<20} {:<7} reference: {} spp in {reference_seconds:.1} s ({:.1} M rays) -> {}",
