@@ -168,7 +168,8 @@ impl PreviewRenderer {
             submit_timed(context, frame.encoder, timer).map_err(PreviewError::Readback)?;
         Ok(FrameTiming {
             gpu_ms,
-            wall_ms,
+            // Far hair's level measurement ran before the frame's submission.
+            wall_ms: wall_ms + frame.far_lod_ms,
             scratch_bytes: frame.scratch_bytes,
             strands: plan.strands,
             vertices: plan.vertices,
@@ -324,7 +325,9 @@ impl PreviewRenderer {
         recorder.shadow_views(&mut encoder);
         recorder.view(&mut encoder, view, scene.lighting.background);
         let far_segments = frame.far.as_ref().map_or(0, |f| f.segments());
-        // Far hair: the next frame's levels, from the widths this frame's drew.
+        // Far hair: the next frame's levels, from the widths this frame's drew (its own
+        // submission, read back: timed and counted in the frame's cost).
+        let far_lod_started = std::time::Instant::now();
         renderers.advance_far_levels(
             context,
             scene.lighting,
@@ -333,8 +336,10 @@ impl PreviewRenderer {
             scene.vertex_count,
             plan,
         )?;
+        let far_lod_ms = far_lod_started.elapsed().as_secs_f64() * 1e3;
         Ok(EncodedFrame {
             far_segments,
+            far_lod_ms,
             encoder,
             color: view.color().clone(),
             scratch_bytes: frame.scratch_bytes,
@@ -346,6 +351,8 @@ struct EncodedFrame {
     encoder: wgpu::CommandEncoder,
     /// Far hair's thick-hair segments drawn (0 without far hair).
     far_segments: u32,
+    /// Wall time of far hair's level choice for the next frame (0 without far hair).
+    far_lod_ms: f64,
     /// The view's resolved colour target.
     color: wgpu::Texture,
     scratch_bytes: u64,

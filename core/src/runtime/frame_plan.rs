@@ -100,6 +100,9 @@ pub struct FramePlan {
     /// The far-hair level of every bundle the plan was made with (empty: strands everywhere);
     /// the frame draws the thick hairs of exactly these.
     pub far_levels: Vec<u32>,
+    /// Vertices of the frame's thick hairs: the most vertex LOD (eq. 7) gives any far bundle
+    /// in view (at least 2; 0 without far bundles).
+    pub far_vertex_count: u32,
 }
 
 impl FramePlan {
@@ -225,6 +228,15 @@ pub fn plan_frame(
         }
         if far_levels.get(index).is_some_and(|&level| level > 0) {
             plan.far_bundles += 1;
+            let lod = bundle_lod(
+                index as u32,
+                bounds,
+                per_bundle,
+                max_vertices_log2,
+                camera,
+                settings,
+            );
+            plan.far_vertex_count = plan.far_vertex_count.max(lod.vertex_count.max(2));
             continue;
         }
         let BundleLod {
@@ -489,6 +501,10 @@ mod tests {
         let far = plan_frame(&bundles(), 64, 5, &camera, &settings, 1 << 20, &levels);
         let far_count = levels.iter().filter(|&&l| l > 0).count();
         assert_eq!(far.far_bundles, far_count);
+        // Thick hairs take the most vertices vertex LOD gives a far bundle.
+        let most = all.batches.iter().flatten().map(|r| r.vertex_count).max();
+        assert!(far.far_vertex_count >= 2 && Some(far.far_vertex_count) <= most);
+        assert_eq!(all.far_vertex_count, 0);
         let roots = check_runs(&far, 1 << 20);
         assert!(roots.iter().all(|r| levels[(r / 64) as usize] == 0));
         let kept: Vec<u32> = check_runs(&all, 1 << 20)

@@ -309,7 +309,11 @@ pub fn prepare(
             context,
             far,
             &plan.far_levels,
-            inputs.vertex_count,
+            if plan.far_vertex_count >= 2 {
+                plan.far_vertex_count
+            } else {
+                inputs.vertex_count
+            },
             &hair_views,
         ),
         _ => None,
