@@ -37,6 +37,8 @@
 // as the frame plan culls and plans with), and the frame's LOD camera and settings.
 @group(0) @binding(32) var<storage, read> bundle_lods: array<BundleLodGpu>;
 @group(0) @binding(33) var<uniform> lod: LodParams;
+// Far hair's level per bundle: 1 or more draws its thick hairs (far_hair.wgsl), not strands.
+@group(0) @binding(34) var<storage, read> far_levels: array<u32>;
 
 struct MeshTask {
     // The bundle's strands at its level of detail.
@@ -94,6 +96,9 @@ fn sphere_in_view(m: mat4x4<f32>, centre: vec3<f32>, radius: f32) -> bool {
 fn ts_main(@builtin(workgroup_id) group: vec3<u32>) -> @builtin(mesh_task_size) vec3<u32> {
     let index = group.y * lod.counts.w + group.x;
     if index >= lod.counts.z {
+        return vec3<u32>(0u, 1u, 1u);
+    }
+    if index < arrayLength(&far_levels) && far_levels[index] > 0u {
         return vec3<u32>(0u, 1u, 1u);
     }
     let bundle = bundle_lods[index];

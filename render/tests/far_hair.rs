@@ -1,7 +1,8 @@
 //! Far hair in whole frames (seed 001): a head seen from afar draws bundles as thick hairs
 //! shaded by the aggregated BCSDF instead of their strands, keeps the strands' look (colour
 //! and coverage within bounds), settles on its levels under a still camera, draws in the
-//! shadow views too, and is refused by name where it cannot be drawn.
+//! shadow views too, and is refused by name where it cannot be drawn. (The mesh-shader path
+//! draws it too: `tests/strand_mesh.rs`.)
 
 mod common;
 
@@ -184,28 +185,4 @@ fn far_hair_is_refused_by_name_where_it_is_not_drawn() {
         error.contains("scene.effects.far_hair") && error.contains("generated"),
         "{error}"
     );
-    // The mesh-shader path plans every bundle in its task shaders.
-    if hairloom_render::renderer::strand_gen::mesh_shaders_available(&context.device) {
-        let generator = StrandGenRenderer::with_path(&context, GenerationPath::MeshShader);
-        let gpu_hair = generator.upload(&context, &hair).expect("upload");
-        let scene = default_scene(
-            &body,
-            HairSource::Generated {
-                generator: &generator,
-                hair: &gpu_hair,
-                filtering: Filtering::Exact,
-                lod: LodSettings::default(),
-                far: None,
-            },
-            9,
-            (lo, hi),
-            Camera::framing(lo, hi, Vec3::Z),
-            &lighting,
-        );
-        let error = renderer
-            .render(&context, &scene, &plan, 32, 32)
-            .expect_err("refused")
-            .to_string();
-        assert!(error.contains("mesh-shader"), "{error}");
-    }
 }

@@ -356,3 +356,73 @@ fn task_shader_lod_matches_the_frame_plan() {
     );
     assert!(levels.len() >= 3 && morphing > 0 && partial > 0);
 }
+
+/// Far hair on the mesh-shader path: the task shaders leave the bundles that draw thick hairs
+/// out (their levels bound beside the LOD parameters), so the picture is the vertex-shader
+/// path's.
+#[test]
+fn far_hair_draws_on_the_mesh_path_as_on_compute() {
+    use hairloom_core::model::scene::{Effects, FarHair, Scene};
+    use hairloom_core::runtime::thick_hair::FarHair as FarTable;
+    use hairloom_render::renderer::strand_gen::GpuFarHair;
+    let Some(context) = mesh_context(module_path!()) else {
+        return;
+    };
+    let document = common::sample("head_short_straight");
+    let hair = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 8,
+            ..RuntimeOptions::default()
+        },
+    );
+    let body = GpuBody::upload(&context, &hair.body);
+    let (lo, hi) = hair.textures.hair_bounds().expect("hair");
+    let mut camera = Camera::framing(lo, hi, Vec3::new(0.3, 0.2, 1.0));
+    camera.eye = camera.target + (camera.eye - camera.target) * 3.0;
+    let lighting = Scene {
+        effects: Effects {
+            far_hair: FarHair::Aggregated,
+            shadow_resolution: 128,
+            ..Effects::default()
+        },
+        ..document.scene.clone()
+    };
+    let table = FarTable::build(&hair, 9).expect("hierarchy");
+    let mut pictures = Vec::new();
+    for path in [GenerationPath::VertexShader, GenerationPath::MeshShader] {
+        let generator = StrandGenRenderer::with_path(&context, path);
+        let gpu_hair = generator.upload(&context, &hair).expect("upload");
+        let far = GpuFarHair::upload(&context, table.clone());
+        let renderer = PreviewRenderer::new(&context);
+        let scene = default_scene(
+            &body,
+            HairSource::Generated {
+                generator: &generator,
+                hair: &gpu_hair,
+                filtering: Filtering::Exact,
+                lod: LodSettings::default(),
+                far: Some(&far),
+            },
+            9,
+            (lo, hi),
+            camera,
+            &lighting,
+        );
+        renderer
+            .settle_far_levels(&context, &scene, 96, 96)
+            .expect("settles");
+        let plan = renderer.plan(&scene, 96, 96);
+        assert!(plan.far_bundles > 0, "{path:?}: no far bundle");
+        let pixels = renderer
+            .render(&context, &scene, &plan, 96, 96)
+            .unwrap_or_else(|e| panic!("{path:?}: {e}"));
+        pictures.push((plan.far_levels, pixels));
+    }
+    assert_eq!(pictures[0].0, pictures[1].0, "both paths settle alike");
+    let pixels = pictures[0].1.len() / 4;
+    let (differing, drawn) = common::compare(&pictures[0].1, &pictures[1].1);
+    eprintln!("far hair: {differing} of {pixels} pixels differ ({drawn} drawn)");
+    assert!(drawn > pixels / 50, "the head is in the picture");
+    assert!(differing * 100 <= pixels, "{differing} of {pixels} differ");
+}

@@ -77,13 +77,7 @@ impl HairSource<'_> {
             }
             return Ok(());
         };
-        if far_hair && generator.path() == GenerationPath::MeshShader {
-            return Err(FrameError::FarHair(
-                "far hair is not drawn on the mesh-shader generation path yet (its task \
-                 shaders plan every bundle as strands); use the compute or vertex-shader path"
-                    .into(),
-            ));
-        }
+
         StrandGenRenderer::check_path(context, generator.path()).map_err(FrameError::Generation)?;
         if generator.path() == GenerationPath::MeshShader {
             check_mesh_groups(
@@ -297,6 +291,7 @@ pub fn prepare(
                 camera: camera.lod(),
                 settings: *lod,
                 max_vertices_log2: inputs.max_vertices_log2(),
+                far_levels: plan.far_levels.clone(),
             }),
         ),
         _ => renderers

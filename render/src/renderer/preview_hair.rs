@@ -26,6 +26,9 @@ use crate::renderer::strand_gen::{
 /// parameters (group 0).
 pub const MESH_BUNDLES_BINDING: u32 = 32;
 pub const MESH_LOD_BINDING: u32 = 33;
+/// Where it binds far hair's level per bundle (a bundle at level 1 or more draws thick hairs,
+/// not strands; one 0 when the scene has no far hair).
+pub const MESH_FAR_LEVELS_BINDING: u32 = 34;
 use crate::renderer::{
     PipelineSpec, Targets, ribbon_pipeline, uniform_entry, view_color_target, view_depth,
 };
@@ -62,11 +65,13 @@ pub struct HairUniforms {
 
 /// What the mesh path's task shaders plan a frame's LOD from: the camera, the settings and the
 /// full-detail vertex level (as the CPU frame plan does, `frame_plan::bundle_lod`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct MeshLod {
     pub camera: LodCamera,
     pub settings: LodSettings,
     pub max_vertices_log2: u32,
+    /// Far hair's level per bundle, as the frame plan has them (empty: none).
+    pub far_levels: Vec<u32>,
 }
 
 /// Formats of the weighted blended transparency targets.
@@ -174,6 +179,10 @@ impl HairRenderer {
             entries.push(wgpu::BindGroupLayoutEntry {
                 visibility: wgpu::ShaderStages::TASK,
                 ..uniform_entry(MESH_LOD_BINDING, size_of::<LodParams>(), false)
+            });
+            entries.push(wgpu::BindGroupLayoutEntry {
+                visibility: wgpu::ShaderStages::TASK,
+                ..storage(MESH_FAR_LEVELS_BINDING, 4)
             });
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("preview_hair_mesh"),
@@ -447,6 +456,20 @@ impl HairRenderer {
         // The mesh path's task shaders plan LOD themselves: one workgroup per bundle, in rows
         // the adapter's per-dimension limit allows.
         let mut mesh_tasks = [0; 2];
+        let far_levels = mesh_lod.as_ref().map(|mesh_lod| {
+            let levels: &[u32] = if mesh_lod.far_levels.is_empty() {
+                &[0]
+            } else {
+                &mesh_lod.far_levels
+            };
+            context
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("strand_mesh_far_levels"),
+                    contents: bytemuck::cast_slice(levels),
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+        });
         let lod_buffer = mesh_lod.map(|mesh_lod| {
             let bundles = hair.bundles.len() as u32;
             let row = bundles
@@ -477,6 +500,12 @@ impl HairRenderer {
             entries.push(wgpu::BindGroupEntry {
                 binding: MESH_LOD_BINDING,
                 resource: lod_buffer.as_entire_binding(),
+            });
+        }
+        if let Some(far_levels) = &far_levels {
+            entries.push(wgpu::BindGroupEntry {
+                binding: MESH_FAR_LEVELS_BINDING,
+                resource: far_levels.as_entire_binding(),
             });
         }
         let group = context
