@@ -217,6 +217,31 @@ fn bundle_seeds() -> Vec<(String, Vec<u8>)> {
             m["lod"]["max_vertices_log2"] = json!(40)
         }),
     ]);
+    // The far-hair file (format version 3): a header claiming u32::MAX thick hairs, and a
+    // first thick hair whose corner strand is u32::MAX.
+    if let Some(far_index) = files.iter().position(|(n, _)| n.starts_with("far_hair")) {
+        let far = &files[far_index].1;
+        let word = |bytes: &mut Vec<u8>, at: usize| {
+            if let Some(slot) = bytes.get_mut(at..at + 4) {
+                slot.copy_from_slice(&u32::MAX.to_le_bytes());
+            }
+        };
+        let mut huge = far.clone();
+        word(&mut huge, 16);
+        seeds.push((
+            "crafted_far_hair_thick_hairs_u32_max".into(),
+            bundle_input(far_index, &huge),
+        ));
+        let entries = far
+            .get(12..16)
+            .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize);
+        let mut corner = far.clone();
+        word(&mut corner, 24 + 16 * entries);
+        seeds.push((
+            "crafted_far_hair_corner_u32_max".into(),
+            bundle_input(far_index, &corner),
+        ));
+    }
     seeds
 }
 
