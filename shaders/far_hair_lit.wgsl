@@ -3,16 +3,11 @@
 
 // Radiance leaving the thick hair toward the viewer, tone-mapped.
 fn shade_thick(in: FarVertex) -> vec3<f32> {
-    var x = far_safe_normalize(in.tangent);
-    if dot(x, x) == 0.0 {
-        x = vec3<f32>(0.0, 1.0, 0.0);
-    }
     let wo = far_safe_normalize(far_toward_viewer(in.world));
-    var z = far_safe_normalize(wo - x * dot(wo, x));
-    if dot(z, z) == 0.0 {
-        z = far_safe_normalize(cross(x, vec3<f32>(0.0, 0.0, 1.0)));
-    }
-    let y = cross(z, x);
+    let frame = fibre_frame(in.tangent, wo);
+    let x = frame[0];
+    let y = frame[1];
+    let z = frame[2];
     let r = max(0.5 * far_view.width.x, 1e-9);
     let members = in.members_coverage.x;
     let section = far_section(in.major, in.minor, y, z, r);

@@ -82,16 +82,11 @@ fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: ve
 
 // Radiance leaving the fibre toward the viewer, tone-mapped.
 fn shade_hair(in: VertexOutput) -> vec3<f32> {
-    var x = safe_normalize(in.tangent);
-    if dot(x, x) == 0.0 {
-        x = vec3<f32>(0.0, 1.0, 0.0);
-    }
     let wo = safe_normalize(toward_viewer(in.world));
-    var z = safe_normalize(wo - x * dot(wo, x));
-    if dot(z, z) == 0.0 {
-        z = safe_normalize(cross(x, vec3<f32>(0.0, 0.0, 1.0)));
-    }
-    let y = cross(z, x);
+    let frame = fibre_frame(in.tangent, wo);
+    let x = frame[0];
+    let y = frame[1];
+    let z = frame[2];
     let sigma_a = strand_sigma_a(in.along, strand_shading_random(in.root));
     let wo_local = vec3<f32>(dot(wo, x), dot(wo, y), dot(wo, z));
     var radiance = scene.ambient.rgb * hair_color(sigma_a);

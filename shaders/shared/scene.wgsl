@@ -94,3 +94,24 @@ fn strand_sigma_a(along: f32, xi: f32) -> vec3<f32> {
     let scale = (1.0 + (scene.sigma_a.w - 1.0) * t) * (1.0 + scene.fibre.x * (2.0 * xi - 1.0));
     return scene.sigma_a.rgb * max(scale, 0.0);
 }
+
+// The fibre frame shading works in, for a strand with `tangent` seen along the unit `wo`
+// (toward the viewer), as columns: x along the fibre, z toward the viewer across it,
+// y = z × x. A zero tangent falls back to +y; a view along the fibre to z = x × +z.
+// (preview_hair.wgsl and far_hair_lit.wgsl.)
+fn fibre_frame(tangent: vec3<f32>, wo: vec3<f32>) -> mat3x3<f32> {
+    var x = vec3<f32>(0.0, 1.0, 0.0);
+    if dot(tangent, tangent) > 1e-24 {
+        x = tangent * inverseSqrt(dot(tangent, tangent));
+    }
+    var z = wo - x * dot(wo, x);
+    if !(dot(z, z) > 1e-24) {
+        z = cross(x, vec3<f32>(0.0, 0.0, 1.0));
+    }
+    if dot(z, z) > 1e-24 {
+        z = z * inverseSqrt(dot(z, z));
+    } else {
+        z = vec3<f32>(0.0);
+    }
+    return mat3x3<f32>(x, cross(z, x), z);
+}

@@ -27,7 +27,9 @@ use crate::renderer::shader_composer::{ShaderKey, far_hair_shader, far_hair_shad
 use crate::renderer::strand_gen::{
     GpuFarHair, GpuHair, StrandGenError, StrandGenRenderer, ThickGenRenderer, ThickOutput,
 };
-use crate::renderer::{PipelineSpec, Targets, uniform_entry, view_color_target, view_depth};
+use crate::renderer::{
+    PipelineSpec, Targets, storage_entry, uniform_entry, view_color_target, view_depth,
+};
 use crate::resources::Tracked;
 
 struct FarPipelines {
@@ -86,16 +88,8 @@ impl PreparedFar {
 impl FarHairRenderer {
     pub fn new(context: &GpuContext, targets: Targets, material: &HairMaterial) -> Self {
         let device = &context.device;
-        let storage = |binding: u32, size: u64| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(size),
-            },
-            count: None,
-        };
+        let storage =
+            |binding: u32, size: u64| storage_entry(binding, size, wgpu::ShaderStages::VERTEX);
         let uniforms = uniform_entry(0, size_of::<HairUniforms>(), true);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("far_hair"),

@@ -205,6 +205,24 @@ pub(crate) fn view_color_target(targets: &Targets) -> [Option<wgpu::ColorTargetS
 }
 
 /// A uniform-buffer layout entry at `binding`, read by both stages.
+/// A read-only storage buffer of at least `size` bytes seen by `visibility`.
+pub(crate) fn storage_entry(
+    binding: u32,
+    size: u64,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: wgpu::BufferSize::new(size),
+        },
+        count: None,
+    }
+}
+
 pub(crate) fn uniform_entry(
     binding: u32,
     size: usize,

@@ -30,7 +30,8 @@ pub const MESH_LOD_BINDING: u32 = 33;
 /// not strands; one 0 when the scene has no far hair).
 pub const MESH_FAR_LEVELS_BINDING: u32 = 34;
 use crate::renderer::{
-    PipelineSpec, Targets, ribbon_pipeline, uniform_entry, view_color_target, view_depth,
+    PipelineSpec, Targets, ribbon_pipeline, storage_entry, uniform_entry, view_color_target,
+    view_depth,
 };
 use crate::resources::Tracked;
 
@@ -122,16 +123,8 @@ impl HairRenderer {
     /// Drawing into targets of other formats (a game's).
     pub fn with_targets(context: &GpuContext, targets: Targets) -> Self {
         let device = &context.device;
-        let storage = |binding: u32, size: u64| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(size),
-            },
-            count: None,
-        };
+        let storage =
+            |binding: u32, size: u64| storage_entry(binding, size, wgpu::ShaderStages::VERTEX);
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("preview_hair"),
             entries: &[

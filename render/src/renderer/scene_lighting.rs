@@ -184,16 +184,11 @@ pub fn effect_entries(effects: &ActiveEffects) -> Vec<wgpu::BindGroupLayoutEntry
         ));
     }
     if effects.far_hair {
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: binding::AGG_TABLES,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: wgpu::BufferSize::new(16),
-            },
-            count: None,
-        });
+        entries.push(crate::renderer::storage_entry(
+            binding::AGG_TABLES,
+            16,
+            wgpu::ShaderStages::FRAGMENT,
+        ));
     }
     entries
 }
