@@ -112,6 +112,7 @@ bench: toolchain gpu-deps
 	./target/release/hairloom bench effects --size 800x800 --runs 1
 	./target/release/hairloom bench shading --size 320 --spp 64 --runs 1
 	./target/release/hairloom bench far --size 256 --spp 32 --runs 1
+	./target/release/hairloom bench fur --size 256 --spp 32 --runs 3
 
 # Every fuzz target (project load, glTF import, runtime bundle, KTX2) for FUZZ_SECONDS each,
 # optimised with overflow checks on (profile `fuzz`). A panic saves its input under

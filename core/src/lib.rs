@@ -12,6 +12,7 @@
 //! | [`light`] | the scene's light on the CPU: fibre material, the Marschner model, dual-scattering tables, opacity-map math, the reference path tracer |
 //! | [`runtime`] | the runtime asset ([`runtime::hair::RuntimeHair`]: textures, samples, placements, styling) and the CPU mirror of every shader |
 //! | [`cards`] | hair cards from bundles: card strips with the strands baked into an atlas |
+//! | [`fur`] | fur as shells and fins (seed 002): the strand volume, its shell and fin textures, lapped patches over any mesh |
 //! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) strand exports, Alembic grooms and card glTF |
 //! | [`samples`] | the bundled sample projects, built by code |
 //!
@@ -20,6 +21,7 @@
 
 pub mod cards;
 pub mod edit;
+pub mod fur;
 pub mod geometry;
 pub mod io;
 pub mod light;

@@ -1260,6 +1260,24 @@ fn the_far_hair_switch_is_one_undo_step() {
 }
 
 #[test]
+fn the_fur_switch_is_one_undo_step() {
+    use hairloom_core::model::scene::Fur;
+    let mut harness = harness();
+    harness.get_by_label("Scene").click();
+    harness.run();
+    let fur = |h: &Harness<'static, HairloomApp>| h.state().state.document().scene.effects.fur;
+    let before = fur(&harness);
+    harness.get_by_label("Fur (shells + fins)").click();
+    harness.run();
+    assert_ne!(fur(&harness), before);
+    assert!(matches!(fur(&harness), Fur::Off | Fur::ShellsFins));
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(fur(&harness), before);
+}
+
+#[test]
 fn scene_panel_adds_aims_and_removes_lights() {
     let mut harness = harness();
     harness.get_by_label("Scene").click();

@@ -68,6 +68,7 @@ use crate::frame::{
 use crate::hair_asset::{AssetChange, HairAsset, HairAssetError};
 use crate::preview::default_strand_width_m;
 use crate::renderer::Targets;
+use crate::renderer::fur::strand_keep;
 use crate::renderer::scene_lighting::ActiveEffects;
 use crate::renderer::strand_gen::{
     GenerationPath, StrandGenError, StrandGenRenderer, check_mesh_groups,
@@ -216,6 +217,10 @@ impl GameHair {
                 .check(&self.context, self.vertex_count, true)?;
             self.asset.ensure_far_hair(&self.context)?;
         }
+        if active.fur {
+            self.asset
+                .ensure_fur(&self.context, &scene.effects.fur_shells)?;
+        }
         let input = self.generator.path().ribbon_input();
         self.renderers.sync(&self.context, &active, &scene, input);
         self.scene = scene;
@@ -347,16 +352,20 @@ impl GameHair {
             GenerationPath::ComputePerStrand => binding.min(2 * row).max(2) as usize,
             GenerationPath::VertexShader | GenerationPath::MeshShader => usize::MAX / 2,
         };
-        let far_levels = {
+        let (far_levels, lod) = {
             let hair = self.asset.source(&self.generator, self.filtering, self.lod);
-            self.renderers.far_levels(&self.scene, &hair, &camera)
+            let lod = LodSettings {
+                strand_keep: strand_keep(&self.scene, &hair, &camera),
+                ..self.lod
+            };
+            (self.renderers.far_levels(&self.scene, &hair, &camera), lod)
         };
         let mut plan = plan_frame(
             &self.asset.gpu().bundles,
             self.asset.gpu().per_bundle,
             self.vertex_count.saturating_sub(1).max(1).ilog2(),
             &camera.lod(),
-            &self.lod,
+            &lod,
             binding_vertices,
             &far_levels,
         );

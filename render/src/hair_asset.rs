@@ -14,6 +14,7 @@ use std::sync::{Arc, Condvar, Mutex};
 use glam::Vec3;
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::document::Document;
+use hairloom_core::model::scene::FurShells;
 use hairloom_core::model::styling::StylingSet;
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
@@ -21,6 +22,8 @@ use hairloom_core::runtime::strand_gen::Filtering;
 
 use crate::device::GpuContext;
 use crate::frame::HairSource;
+use crate::preview::default_strand_width_m;
+use crate::renderer::fur::{FurStrands, GpuFur};
 use crate::renderer::preview_body::GpuBody;
 use crate::renderer::strand_gen::{GpuFarHair, GpuHair, StrandGenError, StrandGenRenderer};
 use hairloom_core::runtime::thick_hair::FarHair;
@@ -32,6 +35,8 @@ pub enum HairAssetError {
     NoHair,
     #[error(transparent)]
     Upload(#[from] StrandGenError),
+    #[error(transparent)]
+    Fur(#[from] crate::renderer::fur::FurError),
     #[error("far hair's hierarchy: {0}")]
     FarHair(#[from] hairloom_core::runtime::thick_hair::ThickHairError),
 }
@@ -95,6 +100,9 @@ pub struct HairAsset {
     /// Kept through a restyle or a reshape (its thick hairs are generated from the textures
     /// every frame, so they follow); made again after a rebuild.
     far: Option<GpuFarHair>,
+    /// Fur's textures and patches (seed 002), once a scene asked for them; made again when
+    /// the hair's root faces or the scene's fur settings change.
+    fur: Option<GpuFur>,
 }
 
 impl HairAsset {
@@ -112,6 +120,7 @@ impl HairAsset {
             gpu,
             bounds,
             far: None,
+            fur: None,
         })
     }
 
@@ -207,6 +216,40 @@ impl HairAsset {
         Ok(())
     }
 
+    /// Makes fur's textures and patches for `settings` where they are missing or were made
+    /// from other settings or another hair mesh (the costly part: not per frame).
+    pub fn ensure_fur(
+        &mut self,
+        context: &GpuContext,
+        settings: &FurShells,
+    ) -> Result<(), HairAssetError> {
+        let base = &self.hair.fur_base;
+        let grown: f64 = self
+            .hair
+            .block_density
+            .iter()
+            .map(|&d| d.clamp(0.0, 1.0) as f64 * self.hair.strands_per_bundle as f64)
+            .sum();
+        let strands = FurStrands {
+            per_m2: grown / base.area_m2().max(1e-12),
+            radius_m: 0.5 * default_strand_width_m(self.bounds.0, self.bounds.1) as f64,
+        };
+        if !self
+            .fur
+            .as_ref()
+            .is_some_and(|f| f.fits(base, settings, strands))
+        {
+            self.fur = None;
+            self.fur = Some(GpuFur::build(context, base, settings, strands)?);
+        }
+        Ok(())
+    }
+
+    /// Fur on the GPU, where made.
+    pub fn fur(&self) -> Option<&GpuFur> {
+        self.fur.as_ref()
+    }
+
     /// Far hair's hierarchy on the GPU, where made.
     pub fn far_hair(&self) -> Option<&GpuFarHair> {
         self.far.as_ref()
@@ -238,6 +281,7 @@ impl HairAsset {
             filtering,
             lod,
             far: self.far.as_ref(),
+            fur: self.fur.as_ref(),
         }
     }
 }

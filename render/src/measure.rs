@@ -153,7 +153,7 @@ pub fn toggled_effects(
     effects: &hairloom_core::model::scene::Effects,
 ) -> Vec<(&'static str, hairloom_core::model::scene::Effects)> {
     use hairloom_core::model::scene::{
-        Coverage, FarHair, MultipleScattering, SelfShadowing, Shading,
+        Coverage, FarHair, Fur, MultipleScattering, SelfShadowing, Shading,
     };
     let mut list = Vec::new();
     let mut e = effects.clone();
@@ -189,6 +189,12 @@ pub fn toggled_effects(
         FarHair::Aggregated => FarHair::Strands,
     };
     list.push(("far-hair", e));
+    let mut e = effects.clone();
+    e.fur = match e.fur {
+        Fur::Off => Fur::ShellsFins,
+        Fur::ShellsFins => Fur::Off,
+    };
+    list.push(("fur", e));
     list
 }
 

@@ -18,12 +18,13 @@ use std::sync::Mutex;
 
 use glam::{Mat4, Vec3};
 use hairloom_core::model::scene::Scene;
-use hairloom_core::runtime::frame_plan::{FramePlan, plan_frame};
+use hairloom_core::runtime::frame_plan::{FramePlan, LodSettings, plan_frame};
 
 use crate::device::{GpuContext, PassTimer, submit_timed};
 use crate::frame::{FrameCamera, FrameInputs, FrameRecorder, FrameRenderers, Phase, prepare};
 pub use crate::frame::{FrameError as PreviewError, HairSource, check_effect_limits};
 use crate::renderer::Targets;
+use crate::renderer::fur::strand_keep;
 use crate::renderer::preview_body::GpuBody;
 use crate::renderer::scene_lighting::ActiveEffects;
 use crate::renderer::strand_gen::batch_vertex_limit;
@@ -204,12 +205,16 @@ impl PreviewRenderer {
                         .renderers
                         .far_levels(scene.lighting, &scene.hair, &camera)
                 };
+                let lod = LodSettings {
+                    strand_keep: strand_keep(scene.lighting, &scene.hair, &camera),
+                    ..*lod
+                };
                 plan_frame(
                     &hair.bundles,
                     hair.per_bundle,
                     max_log2,
                     &camera.lod(),
-                    lod,
+                    &lod,
                     batch_vertex_limit(scene.vertex_count),
                     &far_levels,
                 )

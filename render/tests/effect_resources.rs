@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 
 use glam::Vec3;
 use hairloom_core::model::scene::{
-    Coverage, Effects, FarHair, MultipleScattering, Scene, SelfShadowing, Shading,
+    Coverage, Effects, FarHair, Fur, MultipleScattering, Scene, SelfShadowing, Shading,
 };
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
@@ -42,6 +42,8 @@ const FAR_HAIR: &[&str] = &[
     "thick_widths",
     "next_levels",
 ];
+/// Fur's pipelines (its textures belong to the hair asset, made where a scene asks).
+const FUR: &[&str] = &["fur_shells", "fur_fins"];
 /// Far hair into the lights' opacity maps (with self-shadowing).
 const FAR_HAIR_SHADOWS: &[&str] = &["far_hair_shadow_opacity"];
 const FAR_HAIR_DEEP_SHADOWS: &[&str] = &["far_hair_shadow_opacity", "far_hair_shadow_depth"];
@@ -55,6 +57,7 @@ fn effect_labels() -> BTreeSet<&'static str> {
         WIDTH_OIT,
         FAR_HAIR,
         FAR_HAIR_DEEP_SHADOWS,
+        FUR,
     ]
     .concat()
     .into_iter()
@@ -89,6 +92,9 @@ fn expected(effects: &Effects) -> BTreeSet<&'static str> {
             SelfShadowing::DeepOpacityMaps => labels.extend(FAR_HAIR_DEEP_SHADOWS),
         }
     }
+    if effects.fur == Fur::ShellsFins {
+        labels.extend(FUR);
+    }
     labels
 }
 
@@ -106,6 +112,9 @@ fn expected_renderers(effects: &Effects) -> BTreeSet<&'static str> {
     }
     if effects.far_hair == FarHair::Aggregated {
         names.insert("far hair");
+    }
+    if effects.fur == Fur::ShellsFins {
+        names.insert("fur");
     }
     names
 }
@@ -165,6 +174,7 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
             e.far_hair = FarHair::Aggregated;
             e.self_shadowing = SelfShadowing::OpacityShadowMaps;
         }),
+        alone(|e| e.fur = Fur::ShellsFins),
         base.effects.all(),
         Effects {
             opacity_layers: 16,
@@ -186,6 +196,7 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
                 filtering: Filtering::Exact,
                 lod: LodSettings::default(),
                 far: Some(&far),
+                fur: None,
             },
             17,
             (lo, hi),
@@ -248,7 +259,11 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
         if effects.self_shadowing != SelfShadowing::None || effects.body_shadows {
             wanted.push(Phase::ShadowViews);
         }
-        wanted.extend([Phase::Opaque, Phase::DepthPrePass, Phase::Lit]);
+        wanted.push(Phase::Opaque);
+        if effects.fur == Fur::ShellsFins {
+            wanted.push(Phase::Fur);
+        }
+        wanted.extend([Phase::DepthPrePass, Phase::Lit]);
         if effects.coverage == Coverage::WidthOit {
             wanted.extend([Phase::Coverage, Phase::Composite]);
         }
@@ -257,7 +272,7 @@ fn each_scene_has_exactly_the_resources_its_effects_need() {
     }
     // All effects with 16 layers hold more than none; back to none frees it all again.
     let (first, last) = (bytes_by_scene[0], *bytes_by_scene.last().expect("scenes"));
-    assert!(bytes_by_scene[11] > bytes_by_scene[10] && bytes_by_scene[10] > first);
+    assert!(bytes_by_scene[12] > bytes_by_scene[11] && bytes_by_scene[11] > first);
     assert_eq!(first, last, "turning every effect off frees what they made");
 }
 
@@ -341,6 +356,7 @@ fn each_effect_is_measured_switched_on_and_off() {
             filtering: Filtering::Exact,
             lod: LodSettings::default(),
             far: Some(&far),
+            fur: None,
         },
         9,
         (lo, hi),
@@ -360,7 +376,8 @@ fn each_effect_is_measured_switched_on_and_off() {
             "body-shadows",
             "dual-scattering",
             "width-oit",
-            "far-hair"
+            "far-hair",
+            "fur"
         ]
     );
     for cost in &costs {

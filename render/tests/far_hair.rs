@@ -81,6 +81,7 @@ fn a_far_head_draws_thick_hairs_that_keep_the_strands_look() {
                 filtering: Filtering::Exact,
                 lod: LodSettings::default(),
                 far: Some(&far),
+                fur: None,
             },
             9,
             (lo, hi),

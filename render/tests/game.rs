@@ -118,6 +118,7 @@ fn game_runtime_draws_what_the_preview_draws() {
             filtering: Filtering::Exact,
             lod,
             far: None,
+            fur: None,
         },
         (1 << VERTICES_LOG2) + 1,
         (lo, hi),

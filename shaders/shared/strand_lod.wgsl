@@ -86,8 +86,10 @@ fn bundle_lod(index: u32, bundle: BundleLodGpu, lod: LodParams) -> StrandRun {
     let max_e = lod.counts.y;
     var run: StrandRun;
     run.first_root = index * per_bundle;
+    // Fur's cross-fade: the share of strands kept (frame_plan.rs `bundle_lod`).
+    let keep = clamp(lod.switches.w, 0.0, 1.0);
     if lod.switches.y == 0.0 {
-        run.strand_count = bundle.grown_strands;
+        run.strand_count = min(u32(ceil(f32(bundle.grown_strands) * keep)), bundle.grown_strands);
         run.vertex_count = (1u << max_e) + 1u;
         run.gamma = 0.0;
         run.thickness = 1.0;
@@ -97,7 +99,7 @@ fn bundle_lod(index: u32, bundle: BundleLodGpu, lod: LodParams) -> StrandRun {
     let strand_level = lod_detail_level(bundle.root_size_m, lod.detail.x, distance, lod.detail.y, lod.detail.z);
     let delta = hash_to_unit(pcg_hash(index));
     let density = bundle.density;
-    run.strand_count = min(lod_strand_count(strand_level * density, per_bundle, delta), bundle.grown_strands);
+    run.strand_count = min(lod_strand_count(strand_level * density * keep, per_bundle, delta), bundle.grown_strands);
     let vertex_level = lod_detail_level(bundle.strand_length_m, lod.detail.x, distance, lod.detail.y, lod.detail.w);
     let vertices = lod_vertices(vertex_level, max_e, lod.switches.x);
     run.vertex_count = u32(vertices.x);

@@ -820,6 +820,11 @@ pub fn load_runtime_asset_from(
         body,
         source: manifest.source,
         sample_seed: None,
+        fur_base: Default::default(),
+    };
+    let hair = RuntimeHair {
+        fur_base: crate::fur::base::FurBase::from_textures(&hair.textures),
+        ..hair
     };
     let far_hair = match far_entry {
         None => None,

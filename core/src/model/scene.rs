@@ -187,6 +187,111 @@ pub enum FarHair {
     Aggregated,
 }
 
+/// Whether hair is also drawn as fur: shells and fins (seed 002).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fur {
+    #[default]
+    Off,
+    /// Seed 002: concentric shells along the hair mesh's columns, textured from a volume of
+    /// real strands laid over the root faces by lapped patches, and fins at silhouette edges;
+    /// strands near the camera, shells and fins far, cross-faded by the fur's length on
+    /// screen ([`FurShells`]).
+    ShellsFins,
+}
+
+/// Strands a fur tile holds when the scene leaves its width to the hair: enough that the
+/// repeat does not show, few enough that a strand is a texel or two wide at 128².
+pub const FUR_TILE_STRANDS: f64 = 400.0;
+
+/// How fur's shells and fins are made and when they replace the strands.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FurShells {
+    /// The strand volume the textures are sampled from.
+    pub preset: crate::fur::volume::FurPreset,
+    /// Shell layers: a power of two in [2, 64] (seed 002: 16).
+    pub shell_count: u32,
+    /// Side of each shell texture in texels, in [8, 1024] (seed 002: 128).
+    pub shell_resolution: u32,
+    /// One repeat of the fur texture on the surface; `None` sizes it to hold about
+    /// [`FUR_TILE_STRANDS`] of the hair's own strands (their density on the root faces).
+    pub tile_width_m: Option<f32>,
+    /// Where the fur looks shorter than this on screen (root to tip), only shells and fins
+    /// draw it.
+    pub shells_below_px: f32,
+    /// Where it looks longer than this, only strands; in between both, cross-faded.
+    pub strands_above_px: f32,
+}
+
+impl Default for FurShells {
+    fn default() -> Self {
+        Self {
+            preset: crate::fur::volume::FurPreset::Straight,
+            shell_count: 16,
+            shell_resolution: 128,
+            tile_width_m: None,
+            shells_below_px: 12.0,
+            strands_above_px: 48.0,
+        }
+    }
+}
+
+impl FurShells {
+    /// How much the shells show (0: strands only, 1: shells only) for fur `length_px` long
+    /// on screen: a smoothstep between the two thresholds, so it never pops.
+    pub fn shell_weight(&self, length_px: f32) -> f32 {
+        if !length_px.is_finite() {
+            return 1.0;
+        }
+        let (lo, hi) = (
+            self.shells_below_px,
+            self.strands_above_px.max(self.shells_below_px),
+        );
+        if hi <= lo {
+            return if length_px <= lo { 1.0 } else { 0.0 };
+        }
+        let t = ((length_px - lo) / (hi - lo)).clamp(0.0, 1.0);
+        1.0 - t * t * (3.0 - 2.0 * t)
+    }
+
+    pub fn validate(&self) -> Result<(), InvalidScene> {
+        if !(2..=64).contains(&self.shell_count) || !self.shell_count.is_power_of_two() {
+            return Err(invalid(
+                "effects.fur_shells.shell_count",
+                format!(
+                    "{} shells: choose a power of two in [2, 64]",
+                    self.shell_count
+                ),
+            ));
+        }
+        if !(8..=1024).contains(&self.shell_resolution) {
+            return Err(invalid(
+                "effects.fur_shells.shell_resolution",
+                format!(
+                    "{} texels is outside the valid range [8, 1024]",
+                    self.shell_resolution
+                ),
+            ));
+        }
+        if let Some(width) = self.tile_width_m {
+            check_range("effects.fur_shells.tile_width_m", width, 1e-4, 1.0)?;
+        }
+        check_range(
+            "effects.fur_shells.shells_below_px",
+            self.shells_below_px,
+            0.0,
+            1e5,
+        )?;
+        check_range(
+            "effects.fur_shells.strands_above_px",
+            self.strands_above_px,
+            self.shells_below_px,
+            1e5,
+        )
+    }
+}
+
 /// Range of ε_w, the widest a drawn thick hair may look, in pixels.
 pub const FAR_WIDTH_RANGE_PX: (f32, f32) = (0.5, 32.0);
 
@@ -216,6 +321,10 @@ pub struct Effects {
     /// ε_w: the widest a thick hair may look where far hair draws it, in pixels (seed 001
     /// uses 2); within [`FAR_WIDTH_RANGE_PX`].
     pub far_width_px: f32,
+    /// Fur as shells and fins (seed 002), or strands only. Not part of [`Effects::all`]:
+    /// fur is another look of the hair, named on its own.
+    pub fur: Fur,
+    pub fur_shells: FurShells,
 }
 
 /// Gauss-Legendre point counts the shaders have.
@@ -235,13 +344,15 @@ impl Default for Effects {
             fibre_offsets: 3,
             far_hair: FarHair::Strands,
             far_width_px: 2.0,
+            fur: Fur::Off,
+            fur_shells: FurShells::default(),
         }
     }
 }
 
 /// The names of the optional effects, as `hairloom render --effects` and the Scene panel
 /// use them.
-pub const EFFECT_NAMES: [&str; 7] = [
+pub const EFFECT_NAMES: [&str; 8] = [
     "marschner",
     "opacity-shadow-maps",
     "deep-opacity-maps",
@@ -249,6 +360,7 @@ pub const EFFECT_NAMES: [&str; 7] = [
     "dual-scattering",
     "width-oit",
     "far-aggregated",
+    "fur",
 ];
 
 impl Effects {
@@ -262,11 +374,13 @@ impl Effects {
             multiple_scattering: MultipleScattering::None,
             coverage: Coverage::Msaa,
             far_hair: FarHair::Strands,
+            fur: Fur::Off,
             ..self.clone()
         }
     }
 
-    /// Every effect on, deep opacity maps for self-shadowing.
+    /// Every effect of hair on, deep opacity maps for self-shadowing (fur stays as it is: it
+    /// is another look, not an accuracy switch).
     pub fn all(&self) -> Self {
         Self {
             shading: Shading::Marschner,
@@ -301,6 +415,9 @@ impl Effects {
         }
         if self.far_hair == FarHair::Aggregated {
             names.push("far-aggregated");
+        }
+        if self.fur == Fur::ShellsFins {
+            names.push("fur");
         }
         names
     }
@@ -339,6 +456,7 @@ impl Effects {
                 }
                 "width-oit" => effects.coverage = Coverage::WidthOit,
                 "far-aggregated" => effects.far_hair = FarHair::Aggregated,
+                "fur" => effects.fur = Fur::ShellsFins,
                 other => {
                     return Err(format!(
                         "--effects: unknown effect {other:?}; the effects are none, all, {}",
@@ -542,6 +660,7 @@ impl Effects {
         }
         let (lo, hi) = FAR_WIDTH_RANGE_PX;
         check_range("effects.far_width_px", self.far_width_px, lo, hi)?;
+        self.fur_shells.validate()?;
         let (lo, hi) = SHADOW_RESOLUTION_RANGE;
         if !(lo..=hi).contains(&self.shadow_resolution) {
             return Err(invalid(
@@ -698,6 +817,22 @@ mod tests {
             (
                 Box::new(|s| s.effects.far_width_px = 0.0),
                 "effects.far_width_px",
+            ),
+            (
+                Box::new(|s| s.effects.fur_shells.shell_count = 12),
+                "effects.fur_shells.shell_count",
+            ),
+            (
+                Box::new(|s| s.effects.fur_shells.shell_resolution = u32::MAX),
+                "effects.fur_shells.shell_resolution",
+            ),
+            (
+                Box::new(|s| s.effects.fur_shells.tile_width_m = Some(f32::INFINITY)),
+                "effects.fur_shells.tile_width_m",
+            ),
+            (
+                Box::new(|s| s.effects.fur_shells.strands_above_px = 1.0),
+                "effects.fur_shells.strands_above_px",
             ),
         ];
         for (change, path) in cases {

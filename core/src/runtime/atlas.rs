@@ -117,7 +117,7 @@ struct Chart {
 }
 
 /// Texel offsets of block corners 0-3.
-const BLOCK_CORNER_OFFSETS: [[i32; 2]; 4] = [[0, 0], [1, 0], [1, 1], [0, 1]];
+pub const BLOCK_CORNER_OFFSETS: [[i32; 2]; 4] = [[0, 0], [1, 0], [1, 1], [0, 1]];
 /// Cell step across block edge `e` (from block corner `e` to `e + 1`).
 const ACROSS_BLOCK_EDGE: [[i32; 2]; 4] = [[0, -1], [1, 0], [0, 1], [-1, 0]];
 

@@ -34,6 +34,10 @@ pub struct LodSettings {
     pub alpha_strands: f64,
     pub alpha_vertices: f64,
     pub lambda: f64,
+    /// The share of each bundle's strands drawn, in `[0, 1]` (1: all that LOD draws): fur's
+    /// cross-fade lowers it as shells take over, dropping strands in their progressive order
+    /// (so nothing pops) with no thickening.
+    pub strand_keep: f64,
 }
 
 /// Default α of strand LOD: every strand while a bundle's root face spans ≥ 20 pixels;
@@ -53,6 +57,7 @@ impl Default for LodSettings {
             alpha_strands: DEFAULT_ALPHA_STRANDS,
             alpha_vertices: DEFAULT_ALPHA_VERTICES,
             lambda: DEFAULT_LAMBDA,
+            strand_keep: 1.0,
         }
     }
 }
@@ -160,9 +165,15 @@ pub fn bundle_lod(
     camera: &LodCamera,
     settings: &LodSettings,
 ) -> BundleLod {
+    let keep = if settings.strand_keep.is_nan() {
+        1.0
+    } else {
+        settings.strand_keep.clamp(0.0, 1.0)
+    };
     if !settings.enabled {
+        let grown = density_count(bounds.density as f64, per_bundle);
         return BundleLod {
-            strands: density_count(bounds.density as f64, per_bundle),
+            strands: ((grown as f64 * keep).ceil() as u32).min(grown),
             vertex_count: (1u32 << max_vertices_log2) + 1,
             gamma: 0.0,
             thickness: 1.0,
@@ -181,8 +192,9 @@ pub fn bundle_lod(
     let delta = crate::strands::random::hash_to_unit(crate::strands::random::pcg_hash(index));
     // A thinned bundle (density < 1) drops strands at the same rate from its own count,
     // never drawing more than it grows at full detail.
+    // Fur's cross-fade keeps a share of them the same way (`strand_lod.wgsl` alike).
     let density = bounds.density as f64;
-    let strands = strand_count(strand_level * density, per_bundle, delta)
+    let strands = strand_count(strand_level * density * keep, per_bundle, delta)
         .min(density_count(density, per_bundle));
     let vertex_level = detail_level(
         bounds.strand_length_m as f64,

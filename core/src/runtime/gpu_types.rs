@@ -248,7 +248,7 @@ pub struct LodParams {
     /// strand LOD; w: α of vertex LOD.
     pub detail: [f32; 4],
     /// x: λ (morph window); y: 1 when LOD is on; z: 1 when bundles outside the view are
-    /// culled; w unused.
+    /// culled; w: the share of strands kept (`LodSettings::strand_keep`).
     pub switches: [f32; 4],
     /// x: strands per bundle; y: log2 of the full-detail segments; z: bundles; w: task
     /// workgroups per row of the draw (bundle = y × w + x).
@@ -277,7 +277,7 @@ impl LodParams {
                 settings.lambda as f32,
                 settings.enabled as u32 as f32,
                 settings.cull as u32 as f32,
-                0.0,
+                settings.strand_keep.clamp(0.0, 1.0) as f32,
             ],
             counts: [per_bundle, max_vertices_log2, bundles, row.max(1)],
         }

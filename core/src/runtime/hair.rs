@@ -86,6 +86,9 @@ pub struct RuntimeHair {
     /// Seed the sample sets were drawn from, when they were drawn here (a loaded bundle
     /// has only its stored sets).
     pub sample_seed: Option<u64>,
+    /// Where fur grows (the root faces and columns, read from the textures), for the `fur`
+    /// effect.
+    pub fur_base: crate::fur::base::FurBase,
 }
 
 /// Why a runtime asset could not be made or changed.
@@ -119,7 +122,9 @@ impl RuntimeHair {
             body: document.body.clone(),
             source: document.source.clone(),
             sample_seed: Some(options.sample_seed),
+            fur_base: Default::default(),
         };
+        hair.fur_base = crate::fur::base::FurBase::from_textures(&hair.textures);
         hair.draw_samples(options.strands_per_bundle, options.sample_seed);
         hair
     }

@@ -897,6 +897,8 @@ pub fn teapot_project(teapot_text: &str) -> Result<Project, crate::samples::teap
         azimuthal_roughness: 0.5,
         ..HairMaterial::default()
     };
+    // Seed 002's subject: strands near, shells and fins far.
+    document.scene.effects.fur = crate::model::scene::Fur::ShellsFins;
     document.source = TEAPOT_CREDIT.to_string();
     document.body = body;
     Ok(Project::new(document))

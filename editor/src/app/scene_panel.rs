@@ -7,8 +7,8 @@
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::motion::Motion;
 use hairloom_core::model::scene::{
-    Coverage, Effects, FIBRE_OFFSET_CHOICES, FarHair, HairMaterial, Light, LightSource, MAX_LIGHTS,
-    MultipleScattering, OPACITY_LAYER_CHOICES, Pigment, Scene, SelfShadowing, Shading,
+    Coverage, Effects, FIBRE_OFFSET_CHOICES, FarHair, Fur, HairMaterial, Light, LightSource,
+    MAX_LIGHTS, MultipleScattering, OPACITY_LAYER_CHOICES, Pigment, Scene, SelfShadowing, Shading,
 };
 use hairloom_render::measure::EffectCost;
 
@@ -238,6 +238,18 @@ impl ScenePanel {
                     "far-hair",
                     effects.far_hair == FarHair::Aggregated,
                 ));
+                ui.end_row();
+
+                let mut fur = effects.fur == Fur::ShellsFins;
+                let response = ui.checkbox(&mut fur, "Fur (shells + fins)").on_hover_text(
+                    "where the hair looks short on screen, shells along the hair mesh's \
+                         columns and fins at its silhouette draw it, textured from a volume \
+                         of real strands (seed 002); strands near, cross-faded by distance",
+                );
+                edit_scene(state, &response, "Scene: fur", |s| {
+                    s.effects.fur = if fur { Fur::ShellsFins } else { Fur::Off }
+                });
+                ui.weak(self.cost_label(state, "fur", effects.fur == Fur::ShellsFins));
                 ui.end_row();
             });
         ui.add_enabled_ui(effects.shading == Shading::Marschner, |ui| {

@@ -92,25 +92,8 @@ pub enum Which {
         /// Samples to measure, comma-separated.
         #[arg(long, value_delimiter = ',', default_values_t = [String::from("head_long_wavy"), String::from("head_curly"), String::from("head_short_straight")])]
         samples: Vec<String>,
-        /// Picture side in pixels.
-        #[arg(long, default_value_t = 256)]
-        size: u32,
-        #[arg(long, default_value_t = 16)]
-        strands_per_bundle: u32,
-        /// Path-tracing samples per pixel of the reference.
-        #[arg(long, default_value_t = 64)]
-        spp: u32,
-        #[arg(long, default_value_t = 24)]
-        bounces: u32,
-        /// Time budget of each reference picture (it stops after the pass that passes it).
-        #[arg(long, default_value_t = 600.0)]
-        max_seconds: f64,
-        /// Measured GPU runs per row after one warm-up (the median is reported).
-        #[arg(long, default_value_t = 3)]
-        runs: usize,
-        /// Folder for shading.csv and the PNG grids.
-        #[arg(long, default_value = "target/bench")]
-        out: std::path::PathBuf,
+        #[command(flatten)]
+        path_traced: PathTracedArgs,
     },
     /// Far hair (seed 001 Fig. 7): each head sample as it shrinks from 50% to 0.3% of the
     /// picture, every strand, strand LOD (seed 000) and far hair's thick hairs, each with its
@@ -119,25 +102,18 @@ pub enum Which {
         /// Samples to measure, comma-separated.
         #[arg(long, value_delimiter = ',', default_values_t = [String::from("head_long_wavy"), String::from("head_curly")])]
         samples: Vec<String>,
-        /// Picture side in pixels.
-        #[arg(long, default_value_t = 256)]
-        size: u32,
-        #[arg(long, default_value_t = 16)]
-        strands_per_bundle: u32,
-        /// Path-tracing samples per pixel of the reference.
-        #[arg(long, default_value_t = 64)]
-        spp: u32,
-        #[arg(long, default_value_t = 24)]
-        bounces: u32,
-        /// Time budget of each reference picture (it stops after the pass that passes it).
-        #[arg(long, default_value_t = 600.0)]
-        max_seconds: f64,
-        /// Measured GPU runs per row after one warm-up (the median is reported).
-        #[arg(long, default_value_t = 3)]
-        runs: usize,
-        /// Folder for far.csv and the PNG grids.
-        #[arg(long, default_value = "target/bench")]
-        out: std::path::PathBuf,
+        #[command(flatten)]
+        path_traced: PathTracedArgs,
+    },
+    /// Fur (seed 002): the furry teapot and a short-haired head at three sizes on screen,
+    /// strands, shells + fins, and the two cross-faded, each with its ꟻLIP against the CPU
+    /// path tracer on the strands, frame time, and the fur's memory beside seed 002's 1.6 MB.
+    Fur {
+        /// Samples to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("teapot_fur"), String::from("head_short_straight")])]
+        samples: Vec<String>,
+        #[command(flatten)]
+        path_traced: PathTracedArgs,
     },
     /// Many characters in one frame (the paper's Fig. 1 crowd): one uploaded bundle drawn N
     /// times with its own transform and LOD through the game runtime; frame time and GPU
@@ -205,6 +181,51 @@ pub enum Which {
     },
 }
 
+/// What the path-traced benches (`shading`, `far`, `fur`) share: the picture, the hair, the
+/// reference's budget and the timing runs.
+#[derive(clap::Args)]
+pub struct PathTracedArgs {
+    /// Picture side in pixels.
+    #[arg(long, default_value_t = 256)]
+    size: u32,
+    #[arg(long, default_value_t = 16)]
+    strands_per_bundle: u32,
+    /// Path-tracing samples per pixel of the reference.
+    #[arg(long, default_value_t = 64)]
+    spp: u32,
+    #[arg(long, default_value_t = 24)]
+    bounces: u32,
+    /// Time budget of each reference picture (it stops after the pass that passes it).
+    #[arg(long, default_value_t = 600.0)]
+    max_seconds: f64,
+    /// Measured GPU runs per row after one warm-up (the median is reported).
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Folder for the CSV (named after the bench) and the PNG grids.
+    #[arg(long, default_value = "target/bench")]
+    out: std::path::PathBuf,
+}
+
+impl PathTracedArgs {
+    fn settings(
+        self,
+        bench: super::bench_shading::ShadingBench,
+        samples: Vec<String>,
+    ) -> super::bench_shading::ShadingSettings {
+        super::bench_shading::ShadingSettings {
+            bench,
+            samples,
+            size: self.size,
+            strands_per_bundle: self.strands_per_bundle.clamp(1, 4096),
+            samples_per_pixel: self.spp.max(1),
+            max_bounces: self.bounces,
+            max_seconds: self.max_seconds,
+            runs: self.runs.max(1),
+            out: self.out,
+        }
+    }
+}
+
 pub fn run(which: Which) -> anyhow::Result<()> {
     match which {
         Which::Interior { repeat } => interior(repeat.max(1)),
@@ -228,44 +249,22 @@ pub fn run(which: Which) -> anyhow::Result<()> {
         Which::Cpu { project } => super::accuracy::cpu(project),
         Which::Shading {
             samples,
-            size,
-            strands_per_bundle,
-            spp,
-            bounces,
-            max_seconds,
-            runs,
-            out,
-        } => super::bench_shading::run(&super::bench_shading::ShadingSettings {
-            bench: super::bench_shading::ShadingBench::Shading,
-            samples,
-            size,
-            strands_per_bundle: strands_per_bundle.clamp(1, 4096),
-            samples_per_pixel: spp.max(1),
-            max_bounces: bounces,
-            max_seconds,
-            runs: runs.max(1),
-            out,
-        }),
+            path_traced,
+        } => super::bench_shading::run(
+            &path_traced.settings(super::bench_shading::ShadingBench::Shading, samples),
+        ),
         Which::Far {
             samples,
-            size,
-            strands_per_bundle,
-            spp,
-            bounces,
-            max_seconds,
-            runs,
-            out,
-        } => super::bench_shading::run(&super::bench_shading::ShadingSettings {
-            bench: super::bench_shading::ShadingBench::Far,
+            path_traced,
+        } => super::bench_shading::run(
+            &path_traced.settings(super::bench_shading::ShadingBench::Far, samples),
+        ),
+        Which::Fur {
             samples,
-            size,
-            strands_per_bundle: strands_per_bundle.clamp(1, 4096),
-            samples_per_pixel: spp.max(1),
-            max_bounces: bounces,
-            max_seconds,
-            runs: runs.max(1),
-            out,
-        }),
+            path_traced,
+        } => super::bench_shading::run(
+            &path_traced.settings(super::bench_shading::ShadingBench::Fur, samples),
+        ),
         Which::Effects {
             project,
             strands,
@@ -659,6 +658,7 @@ fn gpu(
                                 filtering,
                                 lod,
                                 far: None,
+                                fur: None,
                             },
                             camera,
                         )?;

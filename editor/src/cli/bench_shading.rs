@@ -15,7 +15,7 @@ use glam::{DVec3, Vec3};
 use hairloom_core::light::reference_render::{
     Fibres, ReferenceCamera, ReferenceSettings, render_reference,
 };
-use hairloom_core::model::scene::{Effects, FarHair, Scene};
+use hairloom_core::model::scene::{Effects, FarHair, Fur, FurShells, Scene};
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{DEFAULT_SAMPLE_SEED, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
@@ -119,6 +119,42 @@ pub fn far_configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
     ]
 }
 
+/// `hairloom bench fur`'s methods over the full scene: strands with LOD, shells and fins
+/// alone (seed 002 as written: whatever the distance), and the cross-fade a scene gets by
+/// default (strands near, shells and fins far).
+pub fn fur_configurations(scene: &Effects) -> Vec<(&'static str, Effects)> {
+    let full = scene
+        .none()
+        .parse_list("marschner,deep-opacity-maps,body-shadows,dual-scattering")
+        .expect("the configurations parse");
+    let shells = FurShells {
+        shells_below_px: 1e5,
+        strands_above_px: 1e5,
+        ..scene.fur_shells.clone()
+    };
+    vec![
+        ("strands + LOD", full.clone()),
+        (
+            "shells + fins (seed 002)",
+            Effects {
+                fur: Fur::ShellsFins,
+                fur_shells: shells,
+                ..full.clone()
+            },
+        ),
+        (
+            "blended",
+            Effects {
+                fur: Fur::ShellsFins,
+                ..full
+            },
+        ),
+    ]
+}
+
+/// `bench fur`'s framings: the furry object's largest side as a share of the picture.
+pub const FUR_FRAMINGS: [(&str, f32); 3] = [("near", 0.6), ("middle", 0.2), ("far", 0.05)];
+
 /// The configuration drawn with strand and vertex LOD off.
 const NO_LOD: &str = "strands, no LOD";
 
@@ -128,6 +164,8 @@ const NO_LOD: &str = "strands, no LOD";
 pub enum ShadingBench {
     Shading,
     Far,
+    /// Fur (seed 002): strands, shells and fins, and the two cross-faded, at [`FUR_FRAMINGS`].
+    Fur,
 }
 
 pub struct ShadingSettings {
@@ -161,7 +199,12 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
     let renderer = PreviewRenderer::new(&context);
     std::fs::create_dir_all(&settings.out)?;
     let far_bench = settings.bench == ShadingBench::Far;
-    let stem = if far_bench { "far" } else { "shading" };
+    let fur_bench = settings.bench == ShadingBench::Fur;
+    let stem = match settings.bench {
+        ShadingBench::Shading => "shading",
+        ShadingBench::Far => "far",
+        ShadingBench::Fur => "fur",
+    };
     let csv_path = settings.out.join(format!("{stem}.csv"));
     let mut csv = std::fs::File::create(&csv_path)?;
     writeln!(
@@ -172,6 +215,11 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
         println!(
             "Far hair: strands, strand LOD and far hair's thick hairs as the head shrinks on \
              screen; ꟻLIP against the CPU path tracer on full geometry, frame time, segments"
+        );
+    } else if fur_bench {
+        println!(
+            "Fur: strands, shells + fins and the two cross-faded as the object shrinks on \
+             screen; ꟻLIP against the CPU path tracer on the strands, frame time, memory"
         );
     } else {
         println!("Shading accuracy against time: ꟻLIP against the CPU path tracer, GPU frame time");
@@ -190,10 +238,15 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
         "{:<20} {:<7} {:<26} {:>8} {:>10} {:>9} {:>5}",
         "sample", "framing", "configuration", "ꟻLIP", "frame ms", "segments", "far"
     );
-    let framings: Vec<(&str, f32)> = if far_bench {
-        FAR_SWEEP.to_vec()
-    } else {
-        FRAMINGS.to_vec()
+    let framings: Vec<(&str, f32)> = match settings.bench {
+        ShadingBench::Shading => FRAMINGS.to_vec(),
+        ShadingBench::Far => FAR_SWEEP.to_vec(),
+        ShadingBench::Fur => FUR_FRAMINGS.to_vec(),
+    };
+    let rows_of = |effects: &Effects| match settings.bench {
+        ShadingBench::Shading => configurations(effects),
+        ShadingBench::Far => far_configurations(effects),
+        ShadingBench::Fur => fur_configurations(effects),
     };
     let size = settings.size.max(16);
     for name in &settings.samples {
@@ -213,6 +266,24 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
         asset
             .ensure_far_hair(&context)
             .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        if fur_bench {
+            let started = Instant::now();
+            asset
+                .ensure_fur(&context, &document.scene.effects.fur_shells)
+                .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+            let fur = asset.fur().expect("made above");
+            println!(
+                "{name}: fur made in {:.2} s: {} patches, {} shells of {}², {:.2} MB on the GPU \
+                 (all levels, strand directions, patches; seed 002's own set for these \
+                 settings: {:.2} MB)",
+                started.elapsed().as_secs_f64(),
+                fur.patch_count,
+                fur.layer_count,
+                document.scene.effects.fur_shells.shell_resolution,
+                fur.bytes() as f64 / 1e6,
+                fur.seed_bytes as f64 / 1e6,
+            );
+        }
         let (lo, hi) = asset.bounds();
         let width_m = default_strand_width_m(lo, hi);
         let fibres = reference_fibres(&document, settings.strands_per_bundle, width_m as f64);
@@ -245,12 +316,7 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
             let mut row_images = vec![reference.pixels.clone()];
             let black: Vec<u8> = [0, 0, 0, 255].repeat((size * size) as usize);
             let mut flip_images = vec![black];
-            let rows = if far_bench {
-                far_configurations(&document.scene.effects)
-            } else {
-                configurations(&document.scene.effects)
-            };
-            for (configuration, effects) in rows {
+            for (configuration, effects) in rows_of(&document.scene.effects) {
                 let lighting = Scene {
                     effects,
                     ..document.scene.clone()
@@ -310,10 +376,9 @@ pub fn run(settings: &ShadingSettings) -> anyhow::Result<()> {
                 grid_path.display()
             );
         }
-        if far_bench {
-            let rows = far_configurations(&document.scene.effects);
+        if far_bench || fur_bench {
             println!("{name}: dolly from 60 % to 2 % of the picture in {DOLLY_FRAMES} frames");
-            for (configuration, effects) in rows {
+            for (configuration, effects) in rows_of(&document.scene.effects) {
                 let lighting = Scene {
                     effects,
                     ..document.scene.clone()

@@ -314,6 +314,7 @@ pub fn main() -> ExitCode {
                     alpha_strands,
                     alpha_vertices,
                     lambda,
+                    strand_keep: 1.0,
                 },
                 time_s: time,
             };

@@ -199,6 +199,11 @@ impl HeadlessRenderer {
                     .ensure_far_hair(context)
                     .context("far hair's hierarchy")?;
             }
+            if lighting.effects.fur == hairloom_core::model::scene::Fur::ShellsFins {
+                asset
+                    .ensure_fur(context, &lighting.effects.fur_shells)
+                    .context("fur's shells and fins")?;
+            }
             lighting
         };
         let asset = self.asset.as_ref().context("nothing to render")?;

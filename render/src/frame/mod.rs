@@ -36,6 +36,10 @@ pub enum Phase {
     ShadowViews,
     /// The opaque body, clearing the view.
     Opaque,
+    /// Fur (seed 002): fins near the silhouette, then shells from the innermost out, blended
+    /// over the body; shells write depth where their alpha test passes, so strands behind
+    /// them are hidden.
+    Fur,
     /// The hair's depth alone, so that the lit pass shades each visible sample once.
     DepthPrePass,
     /// The lit hair where it is nearest.
@@ -47,10 +51,11 @@ pub enum Phase {
 }
 
 impl Phase {
-    pub const ORDER: [Phase; 7] = [
+    pub const ORDER: [Phase; 8] = [
         Phase::Generation,
         Phase::ShadowViews,
         Phase::Opaque,
+        Phase::Fur,
         Phase::DepthPrePass,
         Phase::Lit,
         Phase::Coverage,

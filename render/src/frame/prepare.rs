@@ -13,6 +13,7 @@ use hairloom_core::runtime::strand_gen::Filtering;
 use super::{FrameError, FrameRenderers};
 use crate::device::GpuContext;
 use crate::renderer::far_hair::PreparedFar;
+use crate::renderer::fur::{GpuFur, PreparedFur, strand_keep};
 use crate::renderer::preview_body::{BodyUniforms, GpuBody, PreparedBody};
 use crate::renderer::preview_hair::{HairUniforms, MeshLod, PreparedHair, RibbonInput};
 use crate::renderer::strand_gen::{
@@ -40,6 +41,8 @@ pub enum HairSource<'a> {
         lod: LodSettings,
         /// Far hair's hierarchy, where the hair has one (drawn when the scene asks).
         far: Option<&'a GpuFarHair>,
+        /// Fur's textures and patches, where made (drawn when the scene asks).
+        fur: Option<&'a GpuFur>,
     },
 }
 
@@ -162,6 +165,8 @@ pub struct PreparedFrame {
     pub scratch_bytes: u64,
     /// Far hair's thick hairs this frame, where any bundle draws them.
     pub far: Option<PreparedFar>,
+    /// Fur's shells and fins this frame, where the fur is far enough to show them.
+    pub fur: Option<PreparedFur>,
 }
 
 impl PreparedFrame {
@@ -289,7 +294,10 @@ pub fn prepare(
             &runs,
             (input == RibbonInput::Mesh).then(|| MeshLod {
                 camera: camera.lod(),
-                settings: *lod,
+                settings: LodSettings {
+                    strand_keep: strand_keep(inputs.scene, &inputs.hair, camera),
+                    ..*lod
+                },
                 max_vertices_log2: inputs.max_vertices_log2(),
                 far_levels: plan.far_levels.clone(),
             }),
@@ -313,8 +321,15 @@ pub fn prepare(
         ),
         _ => None,
     };
+    let fur = match (&renderers.fur, &inputs.hair) {
+        (Some(renderer), HairSource::Generated { fur: Some(fur), .. }) => {
+            renderer.prepare(context, fur, &inputs.scene.effects.fur_shells, camera)
+        }
+        _ => None,
+    };
     PreparedFrame {
         far,
+        fur,
         hair,
         body,
         batches: plan.batches.clone(),

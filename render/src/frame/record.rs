@@ -204,6 +204,9 @@ impl<'a> FrameRecorder<'a> {
             let mut pass = begin(encoder);
             self.bind_lighting(&mut pass);
             renderers.body.draw(&mut pass, &frame.body, self.body);
+            if let (Some(fur), Some(prepared)) = (&renderers.fur, &frame.fur) {
+                fur.draw(&mut pass, prepared);
+            }
         }
         for (lit, pipeline) in [
             (false, renderers.hair.depth_pipeline()),
@@ -269,6 +272,9 @@ impl<'a> FrameRecorder<'a> {
         self.bind_lighting(pass);
         if draw_body {
             renderers.body.draw(pass, &frame.body, self.body);
+        }
+        if let (Some(fur), Some(prepared)) = (&renderers.fur, &frame.fur) {
+            fur.draw(pass, prepared);
         }
         let far = renderers.far_hair.as_ref().zip(frame.far.as_ref());
         for (lit, pipeline) in [

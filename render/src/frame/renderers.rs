@@ -11,6 +11,7 @@ use crate::device::GpuContext;
 use crate::renderer::Targets;
 use crate::renderer::body_shadow::BodyShadowRenderer;
 use crate::renderer::far_hair::FarHairRenderer;
+use crate::renderer::fur::FurRenderer;
 use crate::renderer::hair_shadow::HairShadowRenderer;
 use crate::renderer::oit_composite::OitRenderer;
 use crate::renderer::preview_body::BodyRenderer;
@@ -31,6 +32,7 @@ pub struct FrameRenderers {
     pub(crate) body_shadow: Option<BodyShadowRenderer>,
     pub(crate) oit: Option<OitRenderer>,
     pub(crate) far_hair: Option<FarHairRenderer>,
+    pub(crate) fur: Option<FurRenderer>,
     /// Far hair: the level each bundle draws next frame (eq. 16's choice from the widths
     /// measured in the last; empty until a frame of far hair is planned).
     pub(crate) far_levels: Vec<u32>,
@@ -53,6 +55,7 @@ impl FrameRenderers {
             body_shadow: None,
             oit: None,
             far_hair: None,
+            fur: None,
             far_levels: Vec::new(),
             targets,
             active: ActiveEffects::none(),
@@ -91,6 +94,9 @@ impl FrameRenderers {
             self.body = BodyRenderer::with_targets(context, self.targets);
             if let Some(far) = &mut self.far_hair {
                 far.forget_pipelines();
+            }
+            if let Some(fur) = &mut self.fur {
+                fur.forget_pipelines();
             }
         }
         let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
@@ -181,6 +187,15 @@ impl FrameRenderers {
         } else {
             self.far_hair = None;
             self.far_levels.clear();
+        }
+        if active.fur {
+            let fur = self
+                .fur
+                .get_or_insert_with(|| FurRenderer::new(context, self.targets));
+            let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
+            fur.ensure(context, active, &self.lighting.scene_layout, effects_layout);
+        } else {
+            self.fur = None;
         }
         self.active = *active;
     }
@@ -330,6 +345,9 @@ impl FrameRenderers {
         if let Some(r) = &self.far_hair {
             all.push(r);
         }
+        if let Some(r) = &self.fur {
+            all.push(r);
+        }
         all.iter().map(|r| (r.name(), r.phases())).collect()
     }
 
@@ -410,6 +428,15 @@ impl FrameRenderer for OitRenderer {
     }
     fn phases(&self) -> &'static [Phase] {
         &[Phase::Coverage, Phase::Composite]
+    }
+}
+
+impl FrameRenderer for FurRenderer {
+    fn name(&self) -> &'static str {
+        "fur"
+    }
+    fn phases(&self) -> &'static [Phase] {
+        &[Phase::Fur]
     }
 }
 

@@ -16,10 +16,12 @@
 //! | [`scene_lighting`] | `shared/scene.wgsl`, `light/dual_scattering.wgsl` | always (tables: dual scattering) |
 //! | [`viewport_blit`] | `viewport_blit.wgsl` | the editor's viewport (an egui paint callback) |
 //! | [`far_hair`], [`far_lod`], [`strand_gen`] (`ThickGenRenderer`) | `far_hair*.wgsl` + `light/aggregated_bcsdf.wgsl`, `far_lod.wgsl`, `strand_gen.wgsl` (`thick_main`) | far hair (`far: aggregated`) |
+//! | [`fur`] | `fur.wgsl` + `light/*` | fur (`fur: shells_fins`, seed 002) |
 
 pub mod body_shadow;
 pub mod far_hair;
 pub mod far_lod;
+pub mod fur;
 pub mod hair_shadow;
 pub mod oit_composite;
 pub mod preview_body;

@@ -13,7 +13,7 @@ use hairloom_core::light::hair_bsdf::P_MAX;
 use hairloom_core::light::material::Fibre;
 use hairloom_core::light::scene_uniforms::SceneUniforms;
 use hairloom_core::model::scene::{
-    Coverage, FarHair, HairMaterial, MultipleScattering, Scene, SelfShadowing, Shading,
+    Coverage, FarHair, Fur, HairMaterial, MultipleScattering, Scene, SelfShadowing, Shading,
 };
 
 use crate::device::GpuContext;
@@ -36,6 +36,8 @@ pub struct ActiveEffects {
     pub shadow_slots: u32,
     /// Far hair's thick hairs (seed 001) where bundles are narrow enough.
     pub far_hair: bool,
+    /// Fur's shells and fins (seed 002).
+    pub fur: bool,
 }
 
 impl ActiveEffects {
@@ -63,6 +65,7 @@ impl ActiveEffects {
                 0
             },
             far_hair: effects.far_hair == FarHair::Aggregated,
+            fur: effects.fur == Fur::ShellsFins,
         }
     }
 
@@ -78,6 +81,7 @@ impl ActiveEffects {
             shadow_resolution: 1024,
             shadow_slots: 0,
             far_hair: false,
+            fur: false,
         }
     }
 

@@ -133,6 +133,7 @@ pub const OPACITY_OUTPUT: &str = shader_file!("light/opacity_output.wgsl");
 pub const FAR_HAIR: &str = shader_file!("far_hair.wgsl");
 pub const FAR_HAIR_LIT: &str = shader_file!("far_hair_lit.wgsl");
 pub const FAR_HAIR_SHADOW: &str = shader_file!("far_hair_shadow.wgsl");
+pub const FUR: &str = shader_file!("fur.wgsl");
 
 /// Far hair's shading model (`light/aggregated_bcsdf.wgsl`, after `hair_bsdf.wgsl`), with its
 /// table layout from the one definition in [`hairloom_core::light::aggregated_bcsdf`].
@@ -178,6 +179,15 @@ fn shadow_modules(key: &ShaderKey, source: &mut String) {
 pub fn hair_shader(key: &ShaderKey, input: RibbonInput) -> String {
     let mut source = ribbon_modules(input);
     source.push_str(SCENE);
+    shading_modules(key, &mut source);
+    shadow_modules(key, &mut source);
+    source.push_str(PREVIEW_HAIR);
+    with_mesh_stages(input, source)
+}
+
+/// The shading model's modules of `key` (Kajiya-Kay, or Marschner with or without dual
+/// scattering): `hair_single` and `hair_radiance`.
+fn shading_modules(key: &ShaderKey, source: &mut String) {
     match key.shading {
         Shading::KajiyaKay => {
             source.push_str(KAJIYA_KAY);
@@ -193,9 +203,16 @@ pub fn hair_shader(key: &ShaderKey, input: RibbonInput) -> String {
             }
         }
     }
+}
+
+/// Fur's shells and fins (`fur.wgsl`): the scene, the hair's shading model and the shadow
+/// modules of `key`, so fur and strands are one material.
+pub fn fur_shader(key: &ShaderKey) -> String {
+    let mut source = SCENE.to_string();
+    shading_modules(key, &mut source);
     shadow_modules(key, &mut source);
-    source.push_str(PREVIEW_HAIR);
-    with_mesh_stages(input, source)
+    source.push_str(FUR);
+    source
 }
 
 /// The body's colour pass for `key` (shading model and dual scattering do not apply).

@@ -93,6 +93,7 @@ pub fn frames(
                     filtering: Filtering::Exact,
                     lod,
                     far: None,
+                    fur: None,
                 },
                 vertex_count,
                 (lo, hi),

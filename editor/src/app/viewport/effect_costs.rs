@@ -46,6 +46,11 @@ impl Viewport {
                 )?;
                 // The far-hair row measures thick hairs: the hierarchy is built here.
                 asset.ensure_far_hair(&context)?;
+                // The fur row measures shells and fins: their textures are made here (a hair
+                // with no root faces has none, and its fur row draws strands alone).
+                asset
+                    .ensure_fur(&context, &document.scene.effects.fur_shells)
+                    .ok();
                 let bounds = asset.bounds();
                 let (lo, hi) = camera_bounds.unwrap_or(bounds);
                 let scene = default_scene(

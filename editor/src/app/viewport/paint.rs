@@ -79,6 +79,12 @@ impl ViewportGpu {
             let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
             report.upload_error = Some(format!("cannot draw far hair: {error}"));
         }
+        if frame.lighting.effects.fur == hairloom_core::model::scene::Fur::ShellsFins
+            && let Err(error) = hair.ensure_fur(&self.context, &frame.lighting.effects.fur_shells)
+        {
+            let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
+            report.upload_error = Some(format!("cannot draw fur: {error}"));
+        }
         let hair = &*hair;
         let scene = default_scene(
             hair.body(),
