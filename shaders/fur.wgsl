@@ -49,6 +49,8 @@ struct FurFin {
 @group(0) @binding(5) var shell_direction: texture_2d_array<f32>;
 @group(0) @binding(6) var fin_texture: texture_2d<f32>;
 @group(0) @binding(7) var fur_sampler: sampler;
+// The fin texture repeats along the edge but not from skin to tips.
+@group(0) @binding(8) var fin_sampler: sampler;
 
 struct FurVertex {
     @builtin(position) clip: vec4<f32>,
@@ -241,7 +243,7 @@ fn fs_shell(in: FurVertex) -> @location(0) vec4<f32> {
 @fragment
 fn fs_fin(in: FurVertex) -> @location(0) vec4<f32> {
     // Row 0 of the fin texture is the skin, as v = 0 is here.
-    let texel = textureSample(fin_texture, fur_sampler, in.uv);
+    let texel = textureSample(fin_texture, fin_sampler, in.uv);
     let alpha = texel.a * in.height_fade.y * fur.blend.y;
     if alpha < fur.blend.z {
         discard;

@@ -12,6 +12,7 @@
 use std::sync::{Arc, Condvar, Mutex};
 
 use glam::Vec3;
+use hairloom_core::fur::base::FurBase;
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::document::Document;
 use hairloom_core::model::scene::FurShells;
@@ -37,6 +38,8 @@ pub enum HairAssetError {
     Upload(#[from] StrandGenError),
     #[error(transparent)]
     Fur(#[from] crate::renderer::fur::FurError),
+    #[error("{0}")]
+    FurFailed(String),
     #[error("far hair's hierarchy: {0}")]
     FarHair(#[from] hairloom_core::runtime::thick_hair::ThickHairError),
 }
@@ -103,6 +106,8 @@ pub struct HairAsset {
     /// Fur's textures and patches (seed 002), once a scene asked for them; made again when
     /// the hair's root faces or the scene's fur settings change.
     fur: Option<GpuFur>,
+    /// The last fur that could not be made: what it was made from, and why.
+    fur_failure: Option<(FurShells, FurStrands, FurBase, String)>,
 }
 
 impl HairAsset {
@@ -121,6 +126,7 @@ impl HairAsset {
             bounds,
             far: None,
             fur: None,
+            fur_failure: None,
         })
     }
 
@@ -234,15 +240,35 @@ impl HairAsset {
             per_m2: grown / base.area_m2().max(1e-12),
             radius_m: 0.5 * default_strand_width_m(self.bounds.0, self.bounds.1) as f64,
         };
-        if !self
+        if self
             .fur
             .as_ref()
             .is_some_and(|f| f.fits(base, settings, strands))
         {
-            self.fur = None;
-            self.fur = Some(GpuFur::build(context, base, settings, strands)?);
+            return Ok(());
         }
-        Ok(())
+        // A fur that could not be made is not tried again every frame for the same hair and
+        // settings: the same error comes back at once.
+        if let Some((failed_settings, failed_strands, failed_base, message)) = &self.fur_failure
+            && failed_settings == settings
+            && *failed_strands == strands
+            && failed_base == base
+        {
+            return Err(HairAssetError::FurFailed(message.clone()));
+        }
+        self.fur = None;
+        match GpuFur::build(context, base, settings, strands) {
+            Ok(fur) => {
+                self.fur = Some(fur);
+                self.fur_failure = None;
+                Ok(())
+            }
+            Err(error) => {
+                self.fur_failure =
+                    Some((settings.clone(), strands, base.clone(), error.to_string()));
+                Err(error.into())
+            }
+        }
     }
 
     /// Fur on the GPU, where made.

@@ -138,12 +138,17 @@ impl LappedSurface {
                 DirectionField::PerVertex(v) => Some(v[vertex]),
             }
         };
+        // A direction with under 5 % of its length along the surface (fur standing up, or
+        // rounding) has none there.
         let vertex_directions = (0..positions.len())
             .map(|v| {
                 field_at(v)
                     .and_then(|d| {
                         let n = vertex_normals[v];
-                        (d - n * d.dot(n)).try_normalize()
+                        let along = d - n * d.dot(n);
+                        (along.length() > 0.05 * d.length())
+                            .then(|| along.try_normalize())
+                            .flatten()
                     })
                     .unwrap_or(DVec3::ZERO)
             })
@@ -176,6 +181,9 @@ impl LappedSurface {
             out
         };
 
+        // With no direction anywhere the cover is isotropic: each patch turned at random.
+        let isotropic = matches!(params.direction, DirectionField::Isotropic)
+            || vertex_directions.iter().all(|d| *d == DVec3::ZERO);
         let tile = params.tile_width_m;
         let mut random = SplitMix64::new(params.seed);
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
@@ -203,7 +211,7 @@ impl LappedSurface {
             // The patch's own orientation: the field at the seed or, isotropic, a random one.
             let fallback = any_perpendicular(seed_normal);
             let seed_tangent = match params.direction {
-                DirectionField::Isotropic => {
+                _ if isotropic => {
                     let angle = random.next_f64() * std::f64::consts::TAU;
                     let other = seed_normal.cross(fallback);
                     fallback * angle.cos() + other * angle.sin()
@@ -230,7 +238,6 @@ impl LappedSurface {
                     + harmonics[1].0 * (3.0 * angle + harmonics[1].1).sin();
                 d.length() <= radius_tiles * wobble
             };
-            let isotropic = matches!(params.direction, DirectionField::Isotropic);
             let frame_of = |f: usize| -> (DVec3, DVec3) {
                 let normal = faces[f].normal.unwrap_or(seed_normal);
                 let transported = (seed_tangent - normal * seed_tangent.dot(normal))

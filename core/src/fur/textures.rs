@@ -40,6 +40,11 @@ pub const FIN_HEIGHT: u32 = 64;
 pub const MAX_SHELL_LAYERS: u32 = 64;
 /// The largest shell texture side.
 pub const MAX_SHELL_RESOLUTION: u32 = 1024;
+/// The most texels of all level-0 shells together (64 layers of 512², 16 of 1024²): bounds
+/// the sampler's memory (40 bytes a texel while sampling).
+pub const MAX_SHELL_TEXELS: u64 = 1 << 24;
+/// The most strand samples the samplers take (their time), whatever the volume.
+const MAX_STRAND_SAMPLES: f64 = 2e7;
 
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FurTextureError {
@@ -47,6 +52,14 @@ pub enum FurTextureError {
     LayerCount(u32),
     #[error("fur shells: resolution is {0}, it must be in [8, 1024]")]
     Resolution(u32),
+    #[error(
+        "fur shells: {layers} layers of {resolution}² are {texels} texels, over the limit of 16 777 216"
+    )]
+    TooManyTexels {
+        layers: u32,
+        resolution: u32,
+        texels: u64,
+    },
 }
 
 /// Square RGBA8 layers, layer-major, row-major within a layer.
@@ -147,6 +160,18 @@ impl Accumulator {
     }
 }
 
+/// `spacing_m`, or wider where the volume's strands are so long that it would take more than
+/// [`MAX_STRAND_SAMPLES`] samples.
+fn bounded_spacing(volume: &FurVolume, spacing_m: f64) -> f64 {
+    let total_m: f64 = volume
+        .strands
+        .iter()
+        .flat_map(|s| s.points.windows(2).map(|p| p[0].distance(p[1])))
+        .filter(|l| l.is_finite())
+        .sum();
+    spacing_m.max(total_m / MAX_STRAND_SAMPLES)
+}
+
 /// Points along every strand no further apart than `spacing_m`, with the strand's tangent
 /// there and the arc length each point stands for.
 fn strand_samples(
@@ -188,13 +213,23 @@ impl ShellTextures {
         if !(8..=MAX_SHELL_RESOLUTION).contains(&params.resolution) {
             return Err(FurTextureError::Resolution(params.resolution));
         }
+        let texels = params.layer_count as u64 * (params.resolution as u64).pow(2);
+        if texels > MAX_SHELL_TEXELS {
+            return Err(FurTextureError::TooManyTexels {
+                layers: params.layer_count,
+                resolution: params.resolution,
+                texels,
+            });
+        }
         let tile = volume.params.tile_width_m;
         let length = volume.params.length_m;
         let side = params.resolution as usize;
         let layers = params.layer_count as usize;
         let texel_m = tile / side as f64;
         let spacing_m = length / (layers - 1) as f64;
-        let sigma_xy = (0.6 * texel_m).max(volume.params.strand_radius_m);
+        // At most two texels wide, so the filter's reach stays a few texels however thick
+        // the strands.
+        let sigma_xy = (0.6 * texel_m).max(volume.params.strand_radius_m.min(2.0 * texel_m));
         let sigma_z = 0.5 * spacing_m;
         let radius = volume.params.strand_radius_m;
         let mut grid = vec![Accumulator::default(); layers * side * side];
@@ -203,7 +238,7 @@ impl ShellTextures {
         let norm_z = 1.0 / ((std::f64::consts::TAU).sqrt() * sigma_z);
         strand_samples(
             volume,
-            (0.5 * texel_m).min(0.25 * spacing_m),
+            bounded_spacing(volume, (0.5 * texel_m).min(0.25 * spacing_m)),
             |point, tangent, ds, tint| {
                 // Seen along the skin normal, the strands inside one shell's slab (thickness
                 // Δ) cover their projected area: a piece of length ds at angle θ to the normal
@@ -353,41 +388,45 @@ impl FinTexture {
         );
         let du = tile / w as f64;
         let dz = length / h as f64;
-        let sigma_u = (0.6 * du).max(volume.params.strand_radius_m);
+        let sigma_u = (0.6 * du).max(volume.params.strand_radius_m.min(2.0 * du));
         let sigma_z = 0.6 * dz;
         let radius = volume.params.strand_radius_m;
         let mut grid = vec![Accumulator::default(); w * h];
         let reach_u = (3.0 * sigma_u / du).ceil() as i64;
         let reach_z = (3.0 * sigma_z / dz).ceil() as i64;
         let norm = 1.0 / (std::f64::consts::TAU * sigma_u * sigma_z);
-        strand_samples(volume, 0.5 * du.min(dz), |point, tangent, ds, tint| {
-            if wrap(point.y, tile) >= slab {
-                return;
-            }
-            // Seen along y, a strand piece covers 2r·ds·|sin| of its angle to the view.
-            let sin_view = (1.0 - tangent.y * tangent.y).max(0.0).sqrt();
-            let area = 2.0 * radius * ds * sin_view;
-            let u = wrap(point.x, tile) / du - 0.5;
-            let z = point.z / dz - 0.5;
-            let (cu, cz) = (u.round() as i64, z.round() as i64);
-            for j in -reach_z..=reach_z {
-                let row = cz + j;
-                if row < 0 || row >= h as i64 {
-                    continue;
+        strand_samples(
+            volume,
+            bounded_spacing(volume, 0.5 * du.min(dz)),
+            |point, tangent, ds, tint| {
+                if wrap(point.y, tile) >= slab {
+                    return;
                 }
-                for i in -reach_u..=reach_u {
-                    let du_m = ((cu + i) as f64 - u) * du;
-                    let dz_m = (row as f64 - z) * dz;
-                    let g = norm
-                        * (-0.5
-                            * (du_m * du_m / (sigma_u * sigma_u)
-                                + dz_m * dz_m / (sigma_z * sigma_z)))
-                            .exp();
-                    let column = (cu + i).rem_euclid(w as i64) as usize;
-                    grid[row as usize * w + column].add(area * g, tint, tangent);
+                // Seen along y, a strand piece covers 2r·ds·|sin| of its angle to the view.
+                let sin_view = (1.0 - tangent.y * tangent.y).max(0.0).sqrt();
+                let area = 2.0 * radius * ds * sin_view;
+                let u = wrap(point.x, tile) / du - 0.5;
+                let z = point.z / dz - 0.5;
+                let (cu, cz) = (u.round() as i64, z.round() as i64);
+                for j in -reach_z..=reach_z {
+                    let row = cz + j;
+                    if row < 0 || row >= h as i64 {
+                        continue;
+                    }
+                    for i in -reach_u..=reach_u {
+                        let du_m = ((cu + i) as f64 - u) * du;
+                        let dz_m = (row as f64 - z) * dz;
+                        let g = norm
+                            * (-0.5
+                                * (du_m * du_m / (sigma_u * sigma_u)
+                                    + dz_m * dz_m / (sigma_z * sigma_z)))
+                                .exp();
+                        let column = (cu + i).rem_euclid(w as i64) as usize;
+                        grid[row as usize * w + column].add(area * g, tint, tangent);
+                    }
                 }
-            }
-        });
+            },
+        );
         Self {
             width: w as u32,
             height: h as u32,

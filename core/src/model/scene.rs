@@ -241,7 +241,7 @@ impl FurShells {
     /// How much the shells show (0: strands only, 1: shells only) for fur `length_px` long
     /// on screen: a smoothstep between the two thresholds, so it never pops.
     pub fn shell_weight(&self, length_px: f32) -> f32 {
-        if !length_px.is_finite() {
+        if length_px.is_nan() {
             return 1.0;
         }
         let (lo, hi) = (
@@ -252,7 +252,9 @@ impl FurShells {
             return if length_px <= lo { 1.0 } else { 0.0 };
         }
         let t = ((length_px - lo) / (hi - lo)).clamp(0.0, 1.0);
-        1.0 - t * t * (3.0 - 2.0 * t)
+        let weight = 1.0 - t * t * (3.0 - 2.0 * t);
+        // Thresholds that are not numbers (a scene nobody validated): strands alone.
+        if weight.is_nan() { 0.0 } else { weight }
     }
 
     pub fn validate(&self) -> Result<(), InvalidScene> {
@@ -262,6 +264,18 @@ impl FurShells {
                 format!(
                     "{} shells: choose a power of two in [2, 64]",
                     self.shell_count
+                ),
+            ));
+        }
+        let texels = self.shell_count as u64 * (self.shell_resolution as u64).pow(2);
+        if texels > crate::fur::textures::MAX_SHELL_TEXELS {
+            return Err(invalid(
+                "effects.fur_shells.shell_resolution",
+                format!(
+                    "{} shells of {}² are {texels} texels, over the limit of {}",
+                    self.shell_count,
+                    self.shell_resolution,
+                    crate::fur::textures::MAX_SHELL_TEXELS
                 ),
             ));
         }

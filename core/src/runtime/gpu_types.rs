@@ -277,7 +277,12 @@ impl LodParams {
                 settings.lambda as f32,
                 settings.enabled as u32 as f32,
                 settings.cull as u32 as f32,
-                settings.strand_keep.clamp(0.0, 1.0) as f32,
+                // NaN keeps every strand, as the CPU plan does.
+                if settings.strand_keep.is_nan() {
+                    1.0
+                } else {
+                    settings.strand_keep.clamp(0.0, 1.0) as f32
+                },
             ],
             counts: [per_bundle, max_vertices_log2, bundles, row.max(1)],
         }

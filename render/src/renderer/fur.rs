@@ -46,12 +46,14 @@ const _: () = assert!(size_of::<FurUniforms>() == 128);
 /// Why fur could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum FurError {
-    #[error(
-        "fur: no root faces to grow on (a runtime bundle does not carry the hair mesh's root faces yet; draw fur from the project)"
-    )]
+    #[error("fur: no root faces to grow on (no bundle with layers grows hair)")]
     NoSurface,
     #[error("fur: {0}")]
     Surface(#[from] LappedError),
+    #[error("fur: {0}")]
+    Settings(String),
+    #[error("{0}")]
+    Limit(String),
     #[error(transparent)]
     Volume(#[from] FurVolumeError),
     #[error(transparent)]
@@ -111,11 +113,14 @@ impl GpuFur {
         settings: &FurShells,
         strands: FurStrands,
     ) -> Result<Self, FurError> {
+        settings
+            .validate()
+            .map_err(|e| FurError::Settings(e.to_string()))?;
         if base.triangles.is_empty() {
             return Err(FurError::NoSurface);
         }
         let per_m2 = if strands.per_m2.is_finite() && strands.per_m2 > 0.0 {
-            strands.per_m2
+            strands.per_m2.min(1e9)
         } else {
             1e6
         };
@@ -127,6 +132,21 @@ impl GpuFur {
             Some(width) => width as f64,
             None => (FUR_TILE_STRANDS / per_m2).sqrt().clamp(0.002, 0.5),
         };
+        // The surface first: a mesh it cannot cover fails before the volume is grown.
+        let geometry = FurGeometry::build(
+            base,
+            tile_width_m,
+            3.0 * tile_width_m,
+            FurPreset::Straight.params().seed,
+        )?;
+        let corner_bytes = (geometry.corners.len() * size_of::<FurCornerGpu>()) as u64;
+        let limit = context.device.limits().max_storage_buffer_binding_size;
+        if corner_bytes > limit {
+            return Err(FurError::Limit(format!(
+                "fur: {} root triangles need {corner_bytes} bytes of corners, above this adapter's max_storage_buffer_binding_size of {limit}",
+                base.triangles.len()
+            )));
+        }
         volume_params.tile_width_m = tile_width_m;
         volume_params.strand_count = (per_m2 * tile_width_m * tile_width_m * density_share)
             .round()
@@ -153,12 +173,6 @@ impl GpuFur {
             FIN_WIDTH,
             FIN_HEIGHT,
         );
-        let geometry = FurGeometry::build(
-            base,
-            volume_params.tile_width_m,
-            3.0 * volume_params.tile_width_m,
-            volume_params.seed,
-        )?;
         let layer_count = settings.shell_count;
         let fibres_through = (per_m2
             * 2.0
@@ -359,7 +373,11 @@ fn upload_layers(
 
 struct FurPipelines {
     key: ShaderKey,
+    /// Shells alone draw the fur: they write depth.
     shells: Tracked<wgpu::RenderPipeline>,
+    /// Shells fading in over the strands: depth-tested only, so faint shells never hide the
+    /// strands behind them.
+    fading_shells: Tracked<wgpu::RenderPipeline>,
     fins: Tracked<wgpu::RenderPipeline>,
 }
 
@@ -367,6 +385,7 @@ struct FurPipelines {
 pub struct FurRenderer {
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
+    fin_sampler: wgpu::Sampler,
     targets: Targets,
     pipelines: Option<FurPipelines>,
 }
@@ -392,9 +411,23 @@ pub struct PreparedFur {
 pub fn strand_keep(scene: &Scene, hair: &HairSource, camera: &FrameCamera) -> f64 {
     match hair {
         HairSource::Generated { fur: Some(fur), .. } if scene.effects.fur == Fur::ShellsFins => {
-            1.0 - scene.effects.fur_shells.shell_weight(fur.length_px(camera)) as f64
+            let weight = scene.effects.fur_shells.shell_weight(fur.length_px(camera)) as f64;
+            if weight.is_nan() {
+                1.0
+            } else {
+                1.0 - weight.clamp(0.0, 1.0)
+            }
         }
         _ => 1.0,
+    }
+}
+
+fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
     }
 }
 
@@ -426,29 +459,29 @@ impl FurRenderer {
                 texture(4, wgpu::TextureViewDimension::D2Array),
                 texture(5, wgpu::TextureViewDimension::D2Array),
                 texture(6, wgpu::TextureViewDimension::D2),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 7,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                sampler_entry(7),
+                sampler_entry(8),
             ],
         });
         // The fur tile repeats across each patch (seed 002: texture wrapping); the fin's
-        // height does not.
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("fur"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            address_mode_w: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
+        // height (v) does not.
+        let make_sampler = |label, address_mode_v| {
+            device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                address_mode_u: wgpu::AddressMode::Repeat,
+                address_mode_v,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..Default::default()
+            })
+        };
+        let sampler = make_sampler("fur", wgpu::AddressMode::Repeat);
+        let fin_sampler = make_sampler("fur_fin", wgpu::AddressMode::ClampToEdge);
         Self {
             layout,
             sampler,
+            fin_sampler,
             targets,
             pipelines: None,
         }
@@ -491,8 +524,17 @@ impl FurRenderer {
         // test it (seed 002 §2.3).
         let shells =
             crate::renderer::pipeline(context, &spec("fur_shells", "vs_shell", "fs_shell", true));
+        let fading_shells = crate::renderer::pipeline(
+            context,
+            &spec("fur_shells_fading", "vs_shell", "fs_shell", false),
+        );
         let fins = crate::renderer::pipeline(context, &spec("fur_fins", "vs_fin", "fs_fin", false));
-        self.pipelines = Some(FurPipelines { key, shells, fins });
+        self.pipelines = Some(FurPipelines {
+            key,
+            shells,
+            fading_shells,
+            fins,
+        });
     }
 
     /// Drops the pipelines (their group-2 layout changed).
@@ -575,6 +617,10 @@ impl FurRenderer {
                         binding: 7,
                         resource: wgpu::BindingResource::Sampler(&self.sampler),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 8,
+                        resource: wgpu::BindingResource::Sampler(&self.fin_sampler),
+                    },
                 ],
             });
         Some(PreparedFur {
@@ -599,7 +645,11 @@ impl FurRenderer {
             pass.set_pipeline(&pipelines.fins);
             pass.draw(0..6, 0..prepared.fins);
         }
-        pass.set_pipeline(&pipelines.shells);
+        pass.set_pipeline(if prepared.weight >= 1.0 {
+            &pipelines.shells
+        } else {
+            &pipelines.fading_shells
+        });
         pass.draw(0..prepared.corners, 0..prepared.shells);
     }
 }

@@ -64,7 +64,9 @@ impl ActiveEffects {
             } else {
                 0
             },
-            far_hair: effects.far_hair == FarHair::Aggregated,
+            // Fur draws far hair its own way (shells): with both named, fur wins and far hair's
+            // thick hairs are not drawn over the shells.
+            far_hair: effects.far_hair == FarHair::Aggregated && effects.fur != Fur::ShellsFins,
             fur: effects.fur == Fur::ShellsFins,
         }
     }
