@@ -213,7 +213,9 @@ impl ShellTextures {
         if !(8..=MAX_SHELL_RESOLUTION).contains(&params.resolution) {
             return Err(FurTextureError::Resolution(params.resolution));
         }
-        let texels = params.layer_count as u64 * (params.resolution as u64).pow(2);
+        let texels = (params.resolution as u64)
+            .saturating_pow(2)
+            .saturating_mul(params.layer_count as u64);
         if texels > MAX_SHELL_TEXELS {
             return Err(FurTextureError::TooManyTexels {
                 layers: params.layer_count,

@@ -267,7 +267,9 @@ impl FurShells {
                 ),
             ));
         }
-        let texels = self.shell_count as u64 * (self.shell_resolution as u64).pow(2);
+        let texels = (self.shell_resolution as u64)
+            .saturating_pow(2)
+            .saturating_mul(self.shell_count as u64);
         if texels > crate::fur::textures::MAX_SHELL_TEXELS {
             return Err(invalid(
                 "effects.fur_shells.shell_resolution",
