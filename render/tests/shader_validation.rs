@@ -48,6 +48,10 @@ fn embedded() -> Vec<(String, String)> {
             format!("far_hair {key:?}"),
             hairloom_render::renderer::shader_composer::far_hair_shader(&key),
         ));
+        sources.push((
+            format!("fur {key:?}"),
+            hairloom_render::renderer::shader_composer::fur_shader(&key),
+        ));
     }
     for kind in [
         SelfShadowing::OpacityShadowMaps,
