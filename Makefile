@@ -24,7 +24,7 @@ USD_CORE := usd-core==26.11
 # The Alembic C++ library's Python bindings, to read .abc grooms back.
 ALEMBIC3D := alembic3d==1.8.12.1
 
-.PHONY: run test deps gpu-deps mesh-deps toolchain lint samples bench fuzz
+.PHONY: run test deps gpu-deps mesh-deps blender-deps toolchain lint samples bench fuzz
 
 toolchain:
 	@command -v $(CARGO) >/dev/null || { \
@@ -68,6 +68,26 @@ deps: gpu-deps
 	@$(VALIDATE_VENV)/bin/python -c 'import pxr, alembic3d' 2>/dev/null || \
 	  { python3 -m venv $(VALIDATE_VENV) && $(VALIDATE_VENV)/bin/pip install -q --disable-pip-version-check $(USD_CORE) $(ALEMBIC3D); }
 
+# Blender (PyPI bpy) for the import check of our strand exports, in its own venv: bpy 5.3
+# needs Python 3.13 (pyenv's where it exists), bpy 5.0.1 runs on Debian's 3.11. Where neither
+# exists or the install fails, the check says it skipped; where bpy installed, `make test`
+# requires it (HAIRLOOM_REQUIRE_BLENDER).
+BPY_VENV := target/bpy-venv
+blender-deps:
+	@$(BPY_VENV)/bin/python -c 'import bpy' 2>/dev/null || { \
+	  rm -rf $(BPY_VENV); spec=""; \
+	  for py in python3.13 $$(ls -d $$HOME/.pyenv/versions/3.13*/bin/python3.13 2>/dev/null) python3.11 python3; do \
+	    case "$$($$py -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)" in \
+	      3.13) spec='bpy==5.3.*';; 3.11) spec='bpy==5.0.1';; *) continue;; esac; break; \
+	  done; \
+	  if [ -n "$$spec" ] && $$py -m venv $(BPY_VENV) && \
+	     $(BPY_VENV)/bin/pip install -q --disable-pip-version-check "$$spec"; then \
+	    echo "installed $$spec for the Blender import check"; \
+	  else \
+	    rm -rf $(BPY_VENV); \
+	    echo "warning: Blender (PyPI bpy) did not install (needs Python 3.11 or 3.13 and PyPI); the Blender import check will say it skipped"; \
+	  fi; }
+
 RENDER_OUT ?= out/$(notdir $(SAMPLE:.hairloom=.png))
 
 # With a display: the editor on the bundled sample. Without one: render the sample headless
@@ -88,9 +108,10 @@ run: toolchain gpu-deps
 # render/tests/game_window.rs opens in a window is built as a program first.
 # The mesh-shader tests, and the game runtime (whose default is mesh shaders where the
 # device has them), run again on Mesa 25's lavapipe, where the mesh tests must not skip.
-test: toolchain deps mesh-deps
+test: toolchain deps mesh-deps blender-deps
 	$(CARGO) build -p hairloom-render --example game
-	$(CARGO) test --workspace --all-targets
+	if $(BPY_VENV)/bin/python -c 'import bpy' 2>/dev/null; then export HAIRLOOM_REQUIRE_BLENDER=1; fi; \
+	  $(CARGO) test --workspace --all-targets
 	$(CARGO) test --workspace --doc
 	VK_ICD_FILENAMES=$(MESA_BACKPORT)/lvp_icd.json \
 	  LD_LIBRARY_PATH=$(MESA_BACKPORT)/root/usr/lib/x86_64-linux-gnu \

@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use hairloom_core::Document;
-use hairloom_core::io::alembic::{groom::Groom, groom_file};
+use hairloom_core::io::alembic::{AlembicTarget, groom::Groom, groom_file};
 use hairloom_core::io::import::{ImportOptions, import_file};
 use hairloom_core::io::project::write_atomic;
 use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
 use hairloom_core::io::strand_files::{
-    ScalpMesh, StrandExportSize, glb_lines, hair_file, usda_file,
+    ScalpMesh, StrandExportSize, StrandLook, glb_lines, hair_file, usda_file,
 };
 use hairloom_core::runtime::hair::{LodEntry, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, runtime_strands};
@@ -195,20 +195,22 @@ pub fn generate_strands(
     Ok(Some(strands))
 }
 
-/// Writes `strands`, grown from `document`, in the format `file`'s extension names; returns
-/// a one-line summary.
+/// Writes `strands`, grown from `document`, in the format `file`'s extension names (an
+/// Alembic groom in `alembic`'s axes and units); returns a one-line summary.
 pub fn write_strand_file(
     strands: &[Strand],
     document: &Document,
     file: &Path,
+    alembic: AlembicTarget,
 ) -> anyhow::Result<String> {
     check_strand_file(file)?;
+    let look = || StrandLook::new(strands, STRAND_WIDTH_M, &document.scene.material);
     let bytes = match file.extension().and_then(|e| e.to_str()) {
-        Some("hair") => hair_file(strands, STRAND_WIDTH_M, [0.35, 0.22, 0.12]),
+        Some("hair") => hair_file(strands, &look()),
         Some("usda") => {
-            usda_file(strands, &ScalpMesh::of(&document.hair_mesh), STRAND_WIDTH_M).into_bytes()
+            usda_file(strands, &ScalpMesh::of(&document.hair_mesh), &look()).into_bytes()
         }
-        Some("abc") => groom_file(&Groom::new(document, strands, STRAND_WIDTH_M))
+        Some("abc") => groom_file(&Groom::new(document, strands, STRAND_WIDTH_M), alembic)
             .map_err(anyhow::Error::msg)?,
         _ => glb_lines(strands),
     };
@@ -223,17 +225,32 @@ pub fn write_strand_file(
     ))
 }
 
+/// How `hairloom export` grows and writes strands.
+#[derive(Clone, Copy, Debug)]
+pub struct ExportOptions {
+    pub strands_per_bundle: u32,
+    pub vertices_log2: u32,
+    pub precision: Precision,
+    pub curve: StrandCurve,
+    /// The application `.abc` files are written for (axes and units).
+    pub alembic: AlembicTarget,
+}
+
 /// `hairloom export`: the runtime bundle and/or strand files of a project, with a progress
 /// line on a terminal's standard error.
 pub fn run(
     project_path: &Path,
     runtime: Option<&Path>,
     strand_files: &[PathBuf],
-    strands_per_bundle: u32,
-    vertices_log2: u32,
-    precision: Precision,
-    curve: StrandCurve,
+    options: &ExportOptions,
 ) -> anyhow::Result<()> {
+    let ExportOptions {
+        strands_per_bundle,
+        vertices_log2,
+        precision,
+        curve,
+        alembic,
+    } = *options;
     if runtime.is_none() && strand_files.is_empty() {
         bail!(
             "nothing to export: give --runtime DIR, --strands FILE.{{hair,usda,glb,abc}} and/or --cards DIR"
@@ -267,7 +284,7 @@ pub fn run(
         };
         bar.finish();
         for file in strand_files {
-            println!("{}", write_strand_file(&strands, document, file)?);
+            println!("{}", write_strand_file(&strands, document, file, alembic)?);
         }
     }
     Ok(())

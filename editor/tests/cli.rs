@@ -285,7 +285,8 @@ fn exports_of_every_sample_pass_third_party_validators() {
         };
         let (strands, points, segments) = (count(4), count(8), count(16));
         assert_eq!(points, strands * (segments + 1));
-        assert_eq!(hair.len(), 128 + points * 12);
+        // Points, then a thickness and an RGB colour per point.
+        assert_eq!(hair.len(), 128 + points * (12 + 4 + 12));
         usdas.push(files[1].clone());
         glbs.push(files[2].clone());
         abcs.push(files[3].clone());

@@ -448,6 +448,34 @@ fn exports_write_a_loadable_runtime_bundle_and_strand_files() {
 }
 
 #[test]
+fn a_groom_exports_for_the_client_picked_in_the_file_menu() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let groom = dir.path().join("hair.abc");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Chosen(groom.clone())]),
+    );
+    harness.get_by_label("File").click();
+    harness.run();
+    menu_item(&harness, "Export groom (.abc) for").click();
+    harness.run();
+    menu_item(&harness, "Unreal (z up, cm)").click();
+    for _ in 0..4 {
+        harness.step();
+    }
+    wait_for_export(&mut harness);
+    assert_eq!(
+        harness.state().alembic_target,
+        hairloom_core::io::alembic::AlembicTarget::Unreal
+    );
+    let bytes = std::fs::read(&groom).expect("abc written");
+    let says = |text: &str| bytes.windows(text.len()).any(|w| w == text.as_bytes());
+    assert!(says(
+        "Hair groom for unreal: strands and guides, centimetres, z up"
+    ));
+}
+
+#[test]
 fn importing_a_scalp_is_one_undo_step() {
     let glb =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/head/LeePerrySmith.glb");

@@ -151,9 +151,9 @@ pub fn strand_export_input(strands_per_bundle: u32, vertices_log2: u32, project:
 const FUZZ_GENERATED_POINTS: u64 = 20_000;
 
 fn strand_export(input: &[u8]) {
-    use hairloom_core::io::alembic::{groom::Groom, groom_file};
+    use hairloom_core::io::alembic::{AlembicTarget, groom::Groom, groom_file};
     use hairloom_core::io::strand_files::{
-        ScalpMesh, StrandExportSize, glb_lines, hair_file, usda_file,
+        ScalpMesh, StrandExportSize, StrandLook, glb_lines, hair_file, usda_file,
     };
     use hairloom_core::strands::reference::{StrandOptions, generate};
     let [pick, log2, project @ ..] = input else {
@@ -183,10 +183,14 @@ fn strand_export(input: &[u8]) {
         strands.iter().map(|s| s.points.len() as u64).sum::<u64>() <= size.points,
         "the export holds more points than its size said"
     );
-    let _ = hair_file(&strands, 1e-4, [0.3, 0.2, 0.1]);
-    let _ = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), 1e-4);
+    let look = StrandLook::new(&strands, 1e-4, &document.scene.material);
+    let _ = hair_file(&strands, &look);
+    let _ = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), &look);
     let _ = glb_lines(&strands);
-    let _ = groom_file(&Groom::new(document, &strands, 1e-4));
+    let groom = Groom::new(document, &strands, 1e-4);
+    for target in AlembicTarget::ALL {
+        let _ = groom_file(&groom, target);
+    }
 }
 
 /// The manifest of a runtime bundle's files, for crafting cases.

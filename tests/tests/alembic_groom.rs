@@ -3,7 +3,7 @@
 //! guides each strand names really are its bundle's corner columns.
 
 use hairloom_core::io::alembic::groom::{GUIDE_POINTS_PER_LAYER, Groom};
-use hairloom_core::io::alembic::{GROOM_VERSION, groom_animation, groom_file, to_file_axes};
+use hairloom_core::io::alembic::{AlembicTarget, GROOM_VERSION, groom_animation, groom_file};
 use hairloom_core::io::project;
 use hairloom_core::model::document::Document;
 use hairloom_core::model::styling::StylingGroup;
@@ -192,174 +192,203 @@ fn groom_reads_back_with_every_attribute() {
         },
     );
     let groom = Groom::new(&document, &strands, WIDTH_M);
-    let (hair, guides, archive_metadata) =
-        read_file(groom_file(&groom).expect("a consistent groom"));
-    assert!(
-        archive_metadata.contains("_ai_Application=Hairloom"),
-        "{archive_metadata}"
-    );
+    for target in [AlembicTarget::Unreal, AlembicTarget::Blender] {
+        let (hair, guides, archive_metadata) =
+            read_file(groom_file(&groom, target).expect("a consistent groom"));
+        assert!(
+            archive_metadata.contains("_ai_Application=Hairloom"),
+            "{archive_metadata}"
+        );
 
-    // Strands: counts, points (in the file's z-up axes), bounds.
-    assert_eq!(hair.counts.len(), strands.len());
-    assert!(
-        hair.counts
-            .iter()
-            .zip(&strands)
-            .all(|(&c, s)| c as usize == s.points.len())
-    );
-    let expected: Vec<[f32; 3]> = strands
-        .iter()
-        .flat_map(|s| {
-            s.points
+        // Strands: counts, points (in the target's axes and units), bounds.
+        assert_eq!(hair.counts.len(), strands.len());
+        assert!(
+            hair.counts
                 .iter()
-                .map(|p| to_file_axes(p.as_vec3().to_array()))
-        })
-        .collect();
-    assert_eq!(hair.points, expected);
-    for k in 0..3 {
-        let lo = hair
-            .points
-            .iter()
-            .map(|p| p[k])
-            .fold(f32::INFINITY, f32::min);
-        let hi = hair
-            .points
-            .iter()
-            .map(|p| p[k])
-            .fold(f32::NEG_INFINITY, f32::max);
-        assert_eq!(
-            (hair.bounds[k], hair.bounds[k + 3]),
-            (f64::from(lo), f64::from(hi))
+                .zip(&strands)
+                .all(|(&c, s)| c as usize == s.points.len())
         );
-    }
-    // z up: the file's z range is the model's vertical (y) range.
-    let model_y = strands
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.y as f32));
-    let (lo_y, hi_y) = model_y.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), y| {
-        (lo.min(y), hi.max(y))
-    });
-    assert_eq!(
-        (hair.bounds[2], hair.bounds[5]),
-        (f64::from(lo_y), f64::from(hi_y))
-    );
-    assert_eq!(hair.width, vec![WIDTH_M]);
-    assert!(
-        f32s(&hair, "groom_width", "uni")
+        let expected: Vec<[f32; 3]> = strands
             .iter()
-            .all(|&w| w == WIDTH_M)
-    );
-    assert!(i32s(&hair, "groom_guide", "uni").iter().all(|&g| g == 0));
-    let uvs = f32s(&hair, "groom_root_uv", "uni");
-    assert_eq!(uvs.len(), 2 * strands.len());
-    assert!(
-        strands
-            .iter()
-            .enumerate()
-            .all(|(i, s)| uvs[2 * i] == s.root_uv.x as f32 && uvs[2 * i + 1] == s.root_uv.y as f32)
-    );
-    let groups = i32s(&hair, "groom_group_id", "uni");
-    assert!(
-        strands
-            .iter()
-            .zip(&groups)
-            .all(|(s, &g)| g == i32::from(s.bundle < 40))
-    );
-    for (name, value) in [
-        ("groom_version_major", GROOM_VERSION.0),
-        ("groom_version_minor", GROOM_VERSION.1),
-    ] {
-        assert_eq!(
-            hair.user.get(name),
-            Some(&format!("I16([{value}])")),
-            "{name}"
-        );
-    }
-    assert!(hair.user["groom_tool"].contains("Hairloom"));
-
-    // Guides: one curve per (group, column), ids before the strands', flagged as guides.
-    assert!(i32s(&guides, "groom_guide", "uni").iter().all(|&g| g == 1));
-    let guide_ids = i32s(&guides, "groom_id", "uni");
-    let strand_ids = i32s(&hair, "groom_id", "uni");
-    assert_eq!(
-        guide_ids,
-        (0..guides.counts.len() as i32).collect::<Vec<_>>()
-    );
-    assert_eq!(strand_ids[0], guides.counts.len() as i32);
-    let guide_groups = i32s(&guides, "groom_group_id", "uni");
-    assert!(guide_groups.contains(&1) && guide_groups.contains(&0));
-
-    // Each strand's guides are in its group, their weights sum to one, and blending the
-    // guides' roots by them puts the strand's root inside its root face.
-    let closest = i32s(&hair, "groom_closest_guides", "uni");
-    let weights = f32s(&hair, "groom_guide_weights", "uni");
-    let mut guide_start = vec![0usize];
-    for &c in &guides.counts {
-        guide_start.push(guide_start.last().copied().unwrap_or(0) + c as usize);
-    }
-    for (i, strand) in strands.iter().enumerate() {
-        let ids = &closest[3 * i..3 * i + 3];
-        let w = &weights[3 * i..3 * i + 3];
-        assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{w:?}");
-        assert!(ids.iter().all(|&g| guide_groups[g as usize] == groups[i]));
-        let root = glam::Vec3::from(to_file_axes(strand.points[0].as_vec3().to_array()));
-        let blended: glam::Vec3 = ids
-            .iter()
-            .zip(w)
-            .map(|(&g, &w)| glam::Vec3::from(guides.points[guide_start[g as usize]]) * w)
-            .sum();
-        let bundle = &document.hair_mesh.bundles[strand.bundle as usize];
-        let edge = bundle
-            .vertices
-            .windows(2)
-            .map(|c| {
-                (document.hair_mesh.columns[c[0] as usize].positions[0]
-                    - document.hair_mesh.columns[c[1] as usize].positions[0])
-                    .length()
+            .flat_map(|s| {
+                s.points
+                    .iter()
+                    .map(|p| target.to_file(p.as_vec3().to_array()))
             })
-            .fold(0.0, f64::max) as f32;
-        assert!(
-            (blended - root).length() <= 0.5 * edge,
-            "strand {i}: guides blend to {blended}, root {root}, face edge {edge}"
-        );
-    }
-    // One guide per (group, column) of the bundles that grow hair: counted from the
-    // document, per group.
-    for group in [0, 1] {
-        let mut columns: Vec<u32> = document
-            .hair_mesh
-            .bundles
-            .iter()
-            .enumerate()
-            .filter(|(b, bundle)| {
-                !bundle.removed && bundle.layers > 0 && i32::from(*b < 40) == group
-            })
-            .flat_map(|(_, bundle)| bundle.vertices.iter().copied())
             .collect();
-        columns.sort_unstable();
-        columns.dedup();
-        let guides_in_group = guide_groups.iter().filter(|&&g| g == group).count();
-        assert_eq!(guides_in_group, columns.len(), "group {group}");
-    }
-    // Each guide is its column's curve, GUIDE_POINTS_PER_LAYER points per layer, from the
-    // column's root.
-    let roots: Vec<[f32; 3]> = document
-        .hair_mesh
-        .columns
-        .iter()
-        .map(|c| to_file_axes(c.positions[0].as_vec3().to_array()))
-        .collect();
-    for (g, &start) in guide_start[..guides.counts.len()].iter().enumerate() {
-        assert!(
-            roots.contains(&guides.points[start]),
-            "guide {g} does not start at a column root"
+        assert_eq!(hair.points, expected);
+        for k in 0..3 {
+            let lo = hair
+                .points
+                .iter()
+                .map(|p| p[k])
+                .fold(f32::INFINITY, f32::min);
+            let hi = hair
+                .points
+                .iter()
+                .map(|p| p[k])
+                .fold(f32::NEG_INFINITY, f32::max);
+            assert_eq!(
+                (hair.bounds[k], hair.bounds[k + 3]),
+                (f64::from(lo), f64::from(hi))
+            );
+        }
+        // Up is the file's z for Unreal, y for the others: its range is the model's
+        // vertical (y) range in the target's units.
+        let scale = target.units_per_m();
+        let up = if target.z_up() { 2 } else { 1 };
+        let model_y = strands
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.y as f32 * scale));
+        let (lo_y, hi_y) = model_y.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), y| {
+            (lo.min(y), hi.max(y))
+        });
+        assert_eq!(
+            (hair.bounds[up], hair.bounds[up + 3]),
+            (f64::from(lo_y), f64::from(hi_y))
         );
-        assert_eq!((guides.counts[g] - 1) % GUIDE_POINTS_PER_LAYER as i32, 0);
+        // Widths per point, in file units, tapering from the root width to 40 % at the
+        // tip, as `width` and as `groom_width`; a colour per point.
+        assert_eq!(hair.width.len(), hair.points.len());
+        assert_eq!(hair.width, f32s(&hair, "groom_width", "vtx"));
+        let mut start = 0;
+        for &count in &hair.counts {
+            let widths = &hair.width[start..start + count as usize];
+            assert!((widths[0] - WIDTH_M * scale).abs() <= 1e-6 * WIDTH_M * scale);
+            let tip = widths[widths.len() - 1];
+            assert!((tip - 0.4 * WIDTH_M * scale).abs() <= 1e-6 * WIDTH_M * scale);
+            assert!(widths.windows(2).all(|w| w[1] < w[0]), "{widths:?}");
+            start += count as usize;
+        }
+        let colors = f32s(&hair, "groom_color", "vtx");
+        assert_eq!(colors.len(), 3 * hair.points.len());
+        assert!(
+            colors
+                .iter()
+                .all(|c| c.is_finite() && (0.0..=1.0).contains(c))
+        );
+        assert!(
+            colors.chunks(3).any(|a| a != &colors[..3]),
+            "colour varies along and between strands"
+        );
+        assert!(i32s(&hair, "groom_guide", "uni").iter().all(|&g| g == 0));
+        let uvs = f32s(&hair, "groom_root_uv", "uni");
+        assert_eq!(uvs.len(), 2 * strands.len());
+        assert!(
+            strands
+                .iter()
+                .enumerate()
+                .all(|(i, s)| uvs[2 * i] == s.root_uv.x as f32
+                    && uvs[2 * i + 1] == s.root_uv.y as f32)
+        );
+        let groups = i32s(&hair, "groom_group_id", "uni");
+        assert!(
+            strands
+                .iter()
+                .zip(&groups)
+                .all(|(s, &g)| g == i32::from(s.bundle < 40))
+        );
+        for (name, value) in [
+            ("groom_version_major", GROOM_VERSION.0),
+            ("groom_version_minor", GROOM_VERSION.1),
+        ] {
+            assert_eq!(
+                hair.user.get(name),
+                Some(&format!("I16([{value}])")),
+                "{name}"
+            );
+        }
+        assert!(hair.user["groom_tool"].contains("Hairloom"));
+
+        // Guides: one curve per (group, column), ids before the strands', flagged as guides.
+        assert!(i32s(&guides, "groom_guide", "uni").iter().all(|&g| g == 1));
+        let guide_ids = i32s(&guides, "groom_id", "uni");
+        let strand_ids = i32s(&hair, "groom_id", "uni");
+        assert_eq!(
+            guide_ids,
+            (0..guides.counts.len() as i32).collect::<Vec<_>>()
+        );
+        assert_eq!(strand_ids[0], guides.counts.len() as i32);
+        let guide_groups = i32s(&guides, "groom_group_id", "uni");
+        assert!(guide_groups.contains(&1) && guide_groups.contains(&0));
+
+        // Each strand's guides are in its group, their weights sum to one, and blending the
+        // guides' roots by them puts the strand's root inside its root face.
+        let closest = i32s(&hair, "groom_closest_guides", "uni");
+        let weights = f32s(&hair, "groom_guide_weights", "uni");
+        let mut guide_start = vec![0usize];
+        for &c in &guides.counts {
+            guide_start.push(guide_start.last().copied().unwrap_or(0) + c as usize);
+        }
+        for (i, strand) in strands.iter().enumerate() {
+            let ids = &closest[3 * i..3 * i + 3];
+            let w = &weights[3 * i..3 * i + 3];
+            assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-5, "{w:?}");
+            assert!(ids.iter().all(|&g| guide_groups[g as usize] == groups[i]));
+            let root = glam::Vec3::from(target.to_file(strand.points[0].as_vec3().to_array()));
+            let blended: glam::Vec3 = ids
+                .iter()
+                .zip(w)
+                .map(|(&g, &w)| glam::Vec3::from(guides.points[guide_start[g as usize]]) * w)
+                .sum();
+            let bundle = &document.hair_mesh.bundles[strand.bundle as usize];
+            let edge = bundle
+                .vertices
+                .windows(2)
+                .map(|c| {
+                    (document.hair_mesh.columns[c[0] as usize].positions[0]
+                        - document.hair_mesh.columns[c[1] as usize].positions[0])
+                        .length()
+                })
+                .fold(0.0, f64::max) as f32;
+            assert!(
+                (blended - root).length() <= 0.5 * edge * scale,
+                "strand {i}: guides blend to {blended}, root {root}, face edge {edge}"
+            );
+        }
+        // One guide per (group, column) of the bundles that grow hair: counted from the
+        // document, per group.
+        for group in [0, 1] {
+            let mut columns: Vec<u32> = document
+                .hair_mesh
+                .bundles
+                .iter()
+                .enumerate()
+                .filter(|(b, bundle)| {
+                    !bundle.removed && bundle.layers > 0 && i32::from(*b < 40) == group
+                })
+                .flat_map(|(_, bundle)| bundle.vertices.iter().copied())
+                .collect();
+            columns.sort_unstable();
+            columns.dedup();
+            let guides_in_group = guide_groups.iter().filter(|&&g| g == group).count();
+            assert_eq!(guides_in_group, columns.len(), "group {group}");
+        }
+        // Each guide is its column's curve, GUIDE_POINTS_PER_LAYER points per layer, from the
+        // column's root.
+        let roots: Vec<[f32; 3]> = document
+            .hair_mesh
+            .columns
+            .iter()
+            .map(|c| target.to_file(c.positions[0].as_vec3().to_array()))
+            .collect();
+        for (g, &start) in guide_start[..guides.counts.len()].iter().enumerate() {
+            assert!(
+                roots.contains(&guides.points[start]),
+                "guide {g} does not start at a column root"
+            );
+            assert_eq!((guides.counts[g] - 1) % GUIDE_POINTS_PER_LAYER as i32, 0);
+        }
     }
     // A groom whose arrays disagree is refused by name, not written.
     let mut broken = groom.clone();
     broken.strands.root_uv.pop();
-    assert!(groom_file(&broken).is_err_and(|e| e.contains("root_uv")));
+    let error = groom_file(&broken, AlembicTarget::Unreal).expect_err("refused");
+    assert!(error.contains("root_uv"), "{error}");
+    let mut broken = groom.clone();
+    broken.strands.widths_m[3] = f32::NAN;
+    let error = groom_file(&broken, AlembicTarget::Blender).expect_err("refused");
+    assert!(error.contains("width NaN"), "{error}");
 }
 
 /// An animated groom stores the first frame where `ogawa-rs` reads it (it reads only the
@@ -384,22 +413,24 @@ fn animated_groom_reads_back_its_first_frame_and_refuses_mismatched_frames() {
     {
         p[0] += 0.01;
     }
-    let bytes = groom_animation(&[first.clone(), moved.clone()], 24.0).expect("animation");
+    let bytes = groom_animation(&[first.clone(), moved.clone()], 24.0, AlembicTarget::Maya)
+        .expect("animation");
     let (hair, _, metadata) = read_file(bytes);
     assert!(metadata.contains("_ai_DCC_FPS=24.000000"), "{metadata}");
     let expected: Vec<[f32; 3]> = first
         .strands
         .points
         .iter()
-        .map(|&p| to_file_axes(p))
+        .map(|&p| AlembicTarget::Maya.to_file(p))
         .collect();
     assert_eq!(hair.points, expected);
 
     let mut fewer = moved;
     fewer.strands.vertex_counts.pop();
-    assert!(groom_animation(&[first.clone(), fewer], 24.0).is_err());
-    assert!(groom_animation(&[], 24.0).is_err());
-    assert!(groom_animation(&[first], f64::NAN).is_err());
+    let target = AlembicTarget::default();
+    assert!(groom_animation(&[first.clone(), fewer], 24.0, target).is_err());
+    assert!(groom_animation(&[], 24.0, target).is_err());
+    assert!(groom_animation(&[first], f64::NAN, target).is_err());
 }
 
 /// Past 253 distinct metadata strings (and for any longer than 255 bytes) the writer puts

@@ -7,8 +7,10 @@ For each file: two ICurves objects, `hair` and `guides`, that the library recogn
 (by schemaObjTitle, as Unreal does); linear curves whose vertex counts add up to the points;
 self bounds that hold every point; and the groom attributes (Epic's "Alembic for Grooms" 1.5):
 per-curve groom_guide (0 on strands, 1 on guides), groom_id (unique), groom_group_id,
-groom_root_uv, groom_width, and on strands groom_closest_guides naming guide ids of the same
-group with groom_guide_weights summing to one; groom_version_major/minor in user properties."""
+groom_root_uv, and on strands groom_closest_guides naming guide ids of the same group with
+groom_guide_weights summing to one; per-point groom_width (and width) tapering from root to
+tip, and on strands a per-point groom_color in [0, 1]; groom_version_major/minor in user
+properties."""
 import sys
 
 from alembic3d import Abc, AbcGeom
@@ -53,12 +55,25 @@ for path in sys.argv[1:]:
             if version != [1, 5]:
                 problems.append(f"{child.getName()}: groom version {version}")
             attributes = arrays(schema.getArbGeomParams())
+            per_point = {"groom_width", "groom_color"}
             for name, values in attributes.items():
-                if values[0] != "uni" or len(values[1]) != len(counts):
-                    problems.append(f"{child.getName()}.{name}: {len(values[1])} values at scope {values[0]} for {len(counts)} curves")
-            widths = schema.getWidthsParam().getExpandedValue().getVals()
-            if len(widths) != 1 or not widths[0] > 0:
-                problems.append(f"{child.getName()}: width {list(widths)}")
+                scope, expected = ("vtx", len(points)) if name in per_point else ("uni", len(counts))
+                if values[0] != scope or len(values[1]) != expected:
+                    problems.append(f"{child.getName()}.{name}: {len(values[1])} values at scope {values[0]} for {expected} at {scope}")
+            widths = list(schema.getWidthsParam().getExpandedValue().getVals())
+            if len(widths) != len(points) or not all(w > 0 for w in widths):
+                problems.append(f"{child.getName()}: {len(widths)} widths for {len(points)} points")
+            else:
+                start = 0
+                for count in counts:
+                    if not all(a > b for a, b in zip(widths[start:start + count], widths[start + 1:start + count])):
+                        problems.append(f"{child.getName()}: widths do not taper from root to tip")
+                        break
+                    start += count
+            if child.getName() == "hair":
+                colors = attributes.get("groom_color", (None, []))[1]
+                if not colors or not all(0.0 <= c[k] <= 1.0 for c in colors for k in range(3)):
+                    problems.append("hair: no groom_color in [0, 1] per point")
             samples = schema.getNumSamples()
             if samples > 1:
                 # An animation: the last sample moved, holds the same curves, and its bounds too.

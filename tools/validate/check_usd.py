@@ -36,6 +36,22 @@ for path in sys.argv[1:]:
         and all(e[0][k] <= p[k] <= e[1][k] for p in s for k in range(3))
         for e, s in zip(extents, samples)
     )
+    # Widths and colour per point: widths taper from root to tip, colours in [0, 1].
+    widths = curves.GetWidthsAttr().Get()
+    colors = primvars.GetPrimvar("displayColor").Get()
+    look_ok = (
+        widths is not None
+        and colors is not None
+        and curves.GetWidthsInterpolation() == UsdGeom.Tokens.vertex
+        and primvars.GetPrimvar("displayColor").GetInterpolation() == UsdGeom.Tokens.vertex
+        and len(widths) == len(colors) == len(points)
+        and all(0.0 <= c[k] <= 1.0 for c in colors for k in range(3))
+    )
+    if look_ok:
+        start = 0
+        for count in counts:
+            look_ok = look_ok and widths[start] > widths[start + count - 1] > 0
+            start += count
     # The scalp the curves grow from: a mesh whose face-varying st holds every root uv.
     scalp = UsdGeom.Mesh(stage.GetPrimAtPath("/Scalp"))
     scalp_ok = scalp.GetPrim().IsValid()
@@ -69,6 +85,7 @@ for path in sys.argv[1:]:
         and all(c >= 2 for c in counts)
         and UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y
         and animated_ok
+        and look_ok
     )
     print(f"{path}: usd-core {Usd.GetVersion()}: {len(counts)} curves, {len(points)} points, {len(samples)} time sample(s){'' if ok else ' INCONSISTENT'}")
     failed |= not ok

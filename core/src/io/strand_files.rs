@@ -3,7 +3,42 @@
 //! them is the caller's job (atomically, see [`crate::io::project::write_atomic`]).
 
 use crate::model::mesh::HairMesh;
-use crate::strands::reference::Strand;
+use crate::model::scene::HairMaterial;
+use crate::strands::reference::{Strand, root_indices, strands_per_bundle_of};
+
+/// How exported strands look, the same in every format: each point's width (the root
+/// width tapering to the tip as the renderers draw it) and colour (linear RGB, from the
+/// hair material with each strand's own variation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StrandLook {
+    pub root_width_m: f32,
+    /// One per point of the strands, in order.
+    pub widths_m: Vec<f32>,
+    /// One per point of the strands, in order.
+    pub colors: Vec<[f32; 3]>,
+}
+
+impl StrandLook {
+    pub fn new(strands: &[Strand], root_width_m: f32, material: &HairMaterial) -> Self {
+        let roots = root_indices(strands, strands_per_bundle_of(strands));
+        Self {
+            root_width_m,
+            widths_m: strands
+                .iter()
+                .flat_map(|s| tapered_widths_m(s.points.len(), root_width_m))
+                .collect(),
+            colors: crate::light::material::strand_point_colors(material, strands, &roots),
+        }
+    }
+}
+
+/// The widths of a curve of `count` points whose root is `root_width_m` wide, tapering as
+/// [`crate::strands::strand_width_m`] says.
+pub fn tapered_widths_m(count: usize, root_width_m: f32) -> impl Iterator<Item = f32> {
+    let last = count.saturating_sub(1).max(1) as f64;
+    (0..count)
+        .map(move |k| crate::strands::strand_width_m(root_width_m as f64, k as f64 / last) as f32)
+}
 
 /// Points one strand export may hold (every strand × its vertices). Strands are generated
 /// in memory before they are written (24 B per point as f64, plus the file's own bytes: 12
@@ -81,10 +116,10 @@ impl StrandExportSize {
     }
 }
 
-/// Cem Yuksel's `.hair` format (cyHair): a 128-byte header then the point array (and a
-/// segments array when strands differ in vertex count). Thickness and colour are defaults
-/// in the header.
-pub fn hair_file(strands: &[Strand], thickness_m: f32, color: [f32; 3]) -> Vec<u8> {
+/// Cem Yuksel's `.hair` format (cyHair): a 128-byte header, then the segments array (when
+/// strands differ in vertex count), the points, and each point's thickness and colour from
+/// `look`. The header's defaults are the root width and the first point's colour.
+pub fn hair_file(strands: &[Strand], look: &StrandLook) -> Vec<u8> {
     let point_count: usize = strands.iter().map(|s| s.points.len()).sum();
     let uniform = strands
         .windows(2)
@@ -93,17 +128,19 @@ pub fn hair_file(strands: &[Strand], thickness_m: f32, color: [f32; 3]) -> Vec<u
         .first()
         .map(|s| s.points.len().saturating_sub(1))
         .unwrap_or(0) as u32;
-    // Array bits: 1 segments, 2 points, 4 thickness, 8 transparency, 16 colour.
-    let arrays: u32 = if uniform { 2 } else { 1 | 2 };
-    let mut out = Vec::with_capacity(128 + point_count * 12);
+    // Array bits: 1 segments, 2 points, 4 thickness, 8 transparency, 16 colour. The look's
+    // arrays go in only when they cover every point (a caller's mismatch keeps the defaults).
+    let per_point = look.widths_m.len() == point_count && look.colors.len() == point_count;
+    let arrays: u32 = if uniform { 2 } else { 1 | 2 } | if per_point { 4 | 16 } else { 0 };
+    let mut out = Vec::with_capacity(128 + point_count * if per_point { 28 } else { 12 });
     out.extend_from_slice(b"HAIR");
     out.extend_from_slice(&(strands.len() as u32).to_le_bytes());
     out.extend_from_slice(&(point_count as u32).to_le_bytes());
     out.extend_from_slice(&arrays.to_le_bytes());
     out.extend_from_slice(&default_segments.to_le_bytes());
-    out.extend_from_slice(&thickness_m.to_le_bytes());
+    out.extend_from_slice(&look.root_width_m.to_le_bytes());
     out.extend_from_slice(&0.0f32.to_le_bytes()); // default transparency
-    for c in color {
+    for c in look.colors.first().copied().unwrap_or([0.35, 0.22, 0.12]) {
         out.extend_from_slice(&c.to_le_bytes());
     }
     let mut info = [0u8; 88];
@@ -120,6 +157,14 @@ pub fn hair_file(strands: &[Strand], thickness_m: f32, color: [f32; 3]) -> Vec<u
             for c in p.as_vec3().to_array() {
                 out.extend_from_slice(&c.to_le_bytes());
             }
+        }
+    }
+    if per_point {
+        for w in &look.widths_m {
+            out.extend_from_slice(&w.to_le_bytes());
+        }
+        for c in look.colors.iter().flatten() {
+            out.extend_from_slice(&c.to_le_bytes());
         }
     }
     out
@@ -172,15 +217,19 @@ impl ScalpMesh {
 }
 
 /// A USD stage with the strands as one `BasisCurves` prim (`/Hair`, linear curves, metres,
-/// y up, with its `extent`), constant width, and the root uv as a uniform primvar, under two
-/// names: `st` (USD's convention) and `surface_uv_coordinate` (the attribute Blender's hair
-/// tools use to attach curves to a surface); and the scalp as a `Mesh` (`/Scalp`) whose
-/// face-varying `st` is the space of those root uvs.
-pub fn usda_file(strands: &[Strand], scalp: &ScalpMesh, width_m: f32) -> String {
+/// y up, with its `extent`), each point's width (tapering) and colour (`displayColor`,
+/// linear) from `look`, and the root uv as a uniform primvar under two names: `st` (USD's
+/// convention) and `surface_uv_coordinate` (the attribute Blender's hair tools use to
+/// attach curves to a surface); and the scalp as a `Mesh` (`/Scalp`) whose face-varying
+/// `st` is the space of those root uvs.
+pub fn usda_file(strands: &[Strand], scalp: &ScalpMesh, look: &StrandLook) -> String {
     let mut out = usda_header("", "Exported by Hairloom");
     let points = format!("    point3f[] points = {}\n", usda_points(strands));
-    let extent = format!("    float3[] extent = {}\n", usda_extent(strands, width_m));
-    usda_curves(&mut out, strands, &points, &extent, width_m);
+    let extent = format!(
+        "    float3[] extent = {}\n",
+        usda_extent(strands, look.root_width_m)
+    );
+    usda_curves(&mut out, strands, &points, &extent, look);
     let scalp_points = format!("    point3f[] points = {}\n", usda_vec3s(&scalp.positions));
     let scalp_extent = format!("    float3[] extent = {}\n", usda_scalp_extent(scalp));
     usda_scalp(&mut out, scalp, &scalp_points, &scalp_extent);
@@ -245,8 +294,15 @@ fn usda_header(metadata: &str, doc: &str) -> String {
 }
 
 /// The `/Hair` prim: `points` and `extent` are its attributes (a value or time samples);
-/// counts and uv come from `strands`.
-fn usda_curves(out: &mut String, strands: &[Strand], points: &str, extent: &str, width_m: f32) {
+/// counts and uv come from `strands`, widths and colours from `look` (per point when it
+/// covers every point, else the root width alone).
+fn usda_curves(
+    out: &mut String,
+    strands: &[Strand],
+    points: &str,
+    extent: &str,
+    look: &StrandLook,
+) {
     use std::fmt::Write;
     let _ = writeln!(
         out,
@@ -256,10 +312,26 @@ fn usda_curves(out: &mut String, strands: &[Strand], points: &str, extent: &str,
     let _ = writeln!(out, "    int[] curveVertexCounts = [{}]", counts.join(", "));
     out.push_str(points);
     out.push_str(extent);
-    let _ = writeln!(
-        out,
-        "    float[] widths = [{width_m}] (\n        interpolation = \"constant\"\n    )"
-    );
+    let point_count: usize = strands.iter().map(|s| s.points.len()).sum();
+    if look.widths_m.len() == point_count && look.colors.len() == point_count {
+        let widths: Vec<String> = look.widths_m.iter().map(f32::to_string).collect();
+        let _ = writeln!(
+            out,
+            "    float[] widths = [{}] (\n        interpolation = \"vertex\"\n    )",
+            widths.join(", ")
+        );
+        let _ = writeln!(
+            out,
+            "    color3f[] primvars:displayColor = {} (\n        interpolation = \"vertex\"\n    )",
+            usda_vec3s(&look.colors)
+        );
+    } else {
+        let _ = writeln!(
+            out,
+            "    float[] widths = [{}] (\n        interpolation = \"constant\"\n    )",
+            look.root_width_m
+        );
+    }
     let uvs: Vec<String> = strands
         .iter()
         .map(|s| format!("({}, {})", s.root_uv.x as f32, s.root_uv.y as f32))
@@ -336,7 +408,7 @@ pub struct UsdFrame {
 /// the first; an empty list is refused.
 pub fn usda_animation(
     frames: &[UsdFrame],
-    width_m: f32,
+    look: &StrandLook,
     frames_per_second: f64,
 ) -> Result<String, String> {
     use std::fmt::Write;
@@ -371,8 +443,10 @@ pub fn usda_animation(
     };
     let mut out = usda_header(&metadata, "Simulated by Hairloom");
     let points = sampled("point3f[] points", &|f| usda_points(&f.strands));
-    let extent = sampled("float3[] extent", &|f| usda_extent(&f.strands, width_m));
-    usda_curves(&mut out, &first.strands, &points, &extent, width_m);
+    let extent = sampled("float3[] extent", &|f| {
+        usda_extent(&f.strands, look.root_width_m)
+    });
+    usda_curves(&mut out, &first.strands, &points, &extent, look);
     let scalp_points = sampled("point3f[] points", &|f| usda_vec3s(&f.scalp.positions));
     let scalp_extent = sampled("float3[] extent", &|f| usda_scalp_extent(&f.scalp));
     usda_scalp(&mut out, &first.scalp, &scalp_points, &scalp_extent);
@@ -487,12 +561,27 @@ mod tests {
                 ..StrandOptions::default()
             },
         );
-        let hair = hair_file(&strands, 1e-4, [0.3, 0.2, 0.1]);
+        let look = StrandLook::new(&strands, 1e-4, &document.scene.material);
+        let hair = hair_file(&strands, &look);
+        let u32_at = |at: usize| u32::from_le_bytes(hair[at..at + 4].try_into().expect("4"));
+        let f32_at = |at: usize| f32::from_le_bytes(hair[at..at + 4].try_into().expect("4"));
         assert_eq!(&hair[..4], b"HAIR");
-        assert_eq!(u32::from_le_bytes([hair[4], hair[5], hair[6], hair[7]]), 20);
-        assert_eq!(hair.len(), 128 + 20 * 9 * 12);
-        let usda = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), 1e-4);
+        assert_eq!(u32_at(4), 20);
+        // Points, thickness and colour arrays (no segments: every strand has 9 points).
+        assert_eq!(u32_at(12), 2 | 4 | 16);
+        assert_eq!(hair.len(), 128 + 20 * 9 * (12 + 4 + 12));
+        // The first strand's thickness tapers from the root width to 40 % at its tip.
+        let thickness = 128 + 20 * 9 * 12;
+        assert_eq!(f32_at(thickness), 1e-4);
+        assert!((f32_at(thickness + 8 * 4) - 0.4e-4).abs() < 1e-9);
+        let colors = thickness + 20 * 9 * 4;
+        let root = [0, 1, 2].map(|c| f32_at(colors + 4 * c));
+        assert!(root.iter().all(|c| c.is_finite() && *c > 0.0 && *c < 1.0));
+        // Brown hair: more red than blue.
+        assert!(root[0] > root[2], "{root:?}");
+        let usda = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), &look);
         assert!(usda.starts_with("#usda 1.0") && usda.matches("(").count() > 180);
+        assert!(usda.contains("primvars:displayColor") && usda.contains("\"vertex\""));
         let glb = glb_lines(&strands);
         let gltf = gltf::Gltf::from_slice(&glb).expect("valid glb");
         let primitive = gltf

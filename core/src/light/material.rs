@@ -121,6 +121,29 @@ pub(crate) fn strand_shading_random(root: u32) -> f64 {
     hash_to_unit(pcg_hash(SHADING_SALT ^ root))
 }
 
+/// The colour (linear RGB: what a thick mass of such hair shows) at every point of `strands`,
+/// in order: the material's absorption at the point's fraction along its strand (root to
+/// tip) with the strand's own variation, hashed from its root index in `roots` (one per
+/// strand, as [`crate::strands::reference::root_indices`] numbers them). What strand exports
+/// write as vertex colour so that other tools start from the hair's look.
+pub fn strand_point_colors(
+    material: &HairMaterial,
+    strands: &[crate::strands::reference::Strand],
+    roots: &[u32],
+) -> Vec<[f32; 3]> {
+    let fibre = Fibre::new(material);
+    let mut colors = Vec::with_capacity(strands.iter().map(|s| s.points.len()).sum());
+    for (strand, &root) in strands.iter().zip(roots) {
+        let xi = strand_shading_random(root);
+        let last = strand.points.len().saturating_sub(1).max(1) as f64;
+        colors.extend((0..strand.points.len()).map(|k| {
+            let rgb = fibre.color(fibre.sigma_a(k as f64 / last, xi));
+            rgb.map(|c| c as f32)
+        }));
+    }
+    colors
+}
+
 /// Keeps the shading random values apart from the styling ones drawn from the same roots.
 pub const SHADING_SALT: u32 = 0x5A3D_1E77;
 

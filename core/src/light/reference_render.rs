@@ -153,11 +153,12 @@ impl<'a> World<'a> {
             let last = (points.len() - 1) as f64;
             for (k, pair) in points.windows(2).enumerate() {
                 let along = [k as f64 / last, (k + 1) as f64 / last];
-                let taper = 1.0 - 0.6 * 0.5 * (along[0] + along[1]);
+                let width_m =
+                    crate::strands::strand_width_m(fibres.width_m, 0.5 * (along[0] + along[1]));
                 primitives.push(Primitive::Segment {
                     a: pair[0],
                     b: pair[1],
-                    radius: 0.5 * fibres.width_m * taper,
+                    radius: 0.5 * width_m,
                     strand: index as u32,
                     along,
                 });

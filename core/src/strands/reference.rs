@@ -221,6 +221,40 @@ impl StrandPlan {
     }
 }
 
+/// The root index of each of `strands` (in generation order, bundle by bundle) as the
+/// renderers number roots: bundle × `strands_per_bundle` + the strand's place in its bundle,
+/// which is what per-strand values (the shading variation) are hashed from. A strand that
+/// could not grow shifts the later ones of its bundle down by one, so the values match the
+/// GPU's exactly for every bundle that grew all of its strands.
+pub fn root_indices(strands: &[Strand], strands_per_bundle: u32) -> Vec<u32> {
+    let mut in_bundle = 0u32;
+    let mut last_bundle = None;
+    strands
+        .iter()
+        .map(|strand| {
+            if last_bundle != Some(strand.bundle) {
+                (last_bundle, in_bundle) = (Some(strand.bundle), 0);
+            }
+            let root = strand
+                .bundle
+                .wrapping_mul(strands_per_bundle)
+                .wrapping_add(in_bundle);
+            in_bundle += 1;
+            root
+        })
+        .collect()
+}
+
+/// The most strands any one bundle has in `strands` (listed bundle by bundle): the
+/// strands-per-bundle count they were generated with, unless every bundle lost some.
+pub fn strands_per_bundle_of(strands: &[Strand]) -> u32 {
+    strands
+        .chunk_by(|a, b| a.bundle == b.bundle)
+        .map(|run| run.len() as u32)
+        .max()
+        .unwrap_or(1)
+}
+
 /// Every strand of the document: `strands_per_bundle` per bundle that grows hair.
 pub fn generate(document: &Document, options: &StrandOptions) -> Vec<Strand> {
     generate_parallel(document, options, 1)

@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc;
 
 use hairloom_core::Document;
+use hairloom_core::io::alembic::AlembicTarget;
 use hairloom_core::runtime::textures::Precision;
 
 use crate::files::{STRAND_EXTENSIONS, generate_strands, write_runtime_bundle, write_strand_file};
@@ -47,6 +48,7 @@ impl FileRequest {
                 ("Cem Yuksel .hair", &["hair"]),
                 ("USD (text)", &["usda"]),
                 ("glTF lines", &["glb"]),
+                ("Alembic groom", &["abc"]),
             ],
         }
     }
@@ -194,8 +196,16 @@ impl RecentFiles {
 /// What an export writes.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ExportTarget {
-    Runtime { dir: PathBuf, precision: Precision },
-    Strands { file: PathBuf, vertices_log2: u32 },
+    Runtime {
+        dir: PathBuf,
+        precision: Precision,
+    },
+    Strands {
+        file: PathBuf,
+        vertices_log2: u32,
+        /// Axes and units of an `.abc`.
+        alembic: AlembicTarget,
+    },
 }
 
 /// An export running on a worker thread on a copy of the document.
@@ -231,6 +241,7 @@ impl ExportJob {
                 ExportTarget::Strands {
                     file,
                     vertices_log2,
+                    alembic,
                 } => crate::files::check_strand_file(&file)
                     .map_err(|e| format!("{e:#}"))
                     .and_then(|()| {
@@ -246,7 +257,8 @@ impl ExportJob {
                         .ok_or_else(|| "cancelled".to_string())
                     })
                     .and_then(|strands| {
-                        write_strand_file(&strands, &document, &file).map_err(|e| format!("{e:#}"))
+                        write_strand_file(&strands, &document, &file, alembic)
+                            .map_err(|e| format!("{e:#}"))
                     }),
             };
             progress.store(1_000_000, Ordering::Relaxed);
@@ -326,6 +338,7 @@ mod tests {
             ExportTarget::Strands {
                 file: file.clone(),
                 vertices_log2: 5,
+                alembic: AlembicTarget::default(),
             },
             // Big bundles: the first one is still generating when Cancel arrives.
             4096,
@@ -338,6 +351,7 @@ mod tests {
             ExportTarget::Strands {
                 file: dir.path().join("strands.obj"),
                 vertices_log2: 5,
+                alembic: AlembicTarget::default(),
             },
             4,
         );

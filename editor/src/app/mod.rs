@@ -21,6 +21,7 @@ pub mod viewport;
 
 pub use state::EditorState;
 
+use hairloom_core::io::alembic::AlembicTarget;
 use std::path::PathBuf;
 
 use files::{
@@ -164,6 +165,8 @@ pub struct HairloomApp {
     /// The typed-path prompt, where no native dialog exists.
     pub prompt: Option<PathPrompt>,
     pub export: Option<ExportJob>,
+    /// The application the next `.abc` export is for (File ▸ Export groom for ▸).
+    pub alembic_target: AlembicTarget,
     /// "Save changes?" is being asked before this action.
     pub confirm: Option<AfterConfirm>,
     /// The action to run once the typed-path prompt's Save As succeeds.
@@ -209,6 +212,7 @@ impl HairloomApp {
             dialogs: Box::new(NativeDialogs),
             prompt: None,
             export: None,
+            alembic_target: AlembicTarget::default(),
             confirm: None,
             after_save: None,
             quitting: false,
@@ -491,6 +495,7 @@ impl HairloomApp {
             FileRequest::ExportStrands => self.start_export(ExportTarget::Strands {
                 file: path,
                 vertices_log2: crate::files::EXPORT_VERTICES_LOG2,
+                alembic: self.alembic_target,
             }),
         }
     }
@@ -657,6 +662,17 @@ impl HairloomApp {
                     ui.close();
                     self.file_request(FileRequest::ExportStrands);
                 }
+                ui.add_enabled_ui(!exporting, |ui| {
+                    ui.menu_button("Export groom (.abc) for", |ui| {
+                        for target in AlembicTarget::ALL {
+                            if ui.button(alembic_target_label(target)).clicked() {
+                                ui.close();
+                                self.alembic_target = target;
+                                self.file_request(FileRequest::ExportStrands);
+                            }
+                        }
+                    });
+                });
                 ui.separator();
                 if ui
                     .add(
@@ -1006,4 +1022,15 @@ mod shortcut {
     pub const OPEN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
     pub const NEW: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
     pub const QUIT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
+}
+
+/// The File menu's name of an Alembic target, with the axes and units it gets.
+fn alembic_target_label(target: AlembicTarget) -> &'static str {
+    match target {
+        AlembicTarget::Blender => "Blender (y up, m)",
+        AlembicTarget::Houdini => "Houdini (y up, m)",
+        AlembicTarget::Maya => "Maya (y up, cm)",
+        AlembicTarget::Unity => "Unity (y up, m)",
+        AlembicTarget::Unreal => "Unreal (z up, cm)",
+    }
 }

@@ -11,7 +11,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use hairloom_core::light::reference_render::{
     Fibres, ReferenceCamera, ReferenceSettings, render_reference,
 };
@@ -484,18 +484,9 @@ pub fn reference_fibres(
         width_m,
         ..Fibres::default()
     };
-    let mut index_in_bundle = 0u32;
-    let mut last_bundle = u32::MAX;
-    for strand in &strands {
-        if strand.bundle != last_bundle {
-            (last_bundle, index_in_bundle) = (strand.bundle, 0);
-        }
-        let points: Vec<DVec3> = strand.points.clone();
-        fibres.push(
-            &points,
-            strand.bundle * strands_per_bundle + index_in_bundle,
-        );
-        index_in_bundle += 1;
+    let roots = hairloom_core::strands::reference::root_indices(&strands, strands_per_bundle);
+    for (strand, root) in strands.iter().zip(roots) {
+        fibres.push(&strand.points, root);
     }
     fibres
 }

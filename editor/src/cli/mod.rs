@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use hairloom_core::io::alembic::AlembicTarget;
 use hairloom_core::io::project;
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_core::runtime::textures::Precision;
@@ -97,6 +98,11 @@ enum Command {
         /// --strands-per-bundle and --vertices-log2.
         #[arg(long)]
         cards: Option<PathBuf>,
+        /// The application an .abc is for: blender, houdini, unity (y up, metres), maya (y
+        /// up, centimetres) or unreal (z up, centimetres), each upright with its default
+        /// import settings (README, "Strands in other tools").
+        #[arg(long = "for", default_value = "blender", value_parser = AlembicTarget::parse)]
+        alembic_for: AlembicTarget,
     },
     /// Render a project, or an exported runtime bundle folder, headless to a PNG: strands
     /// generated on the GPU from the runtime textures, lit by the scene (its lights,
@@ -244,17 +250,17 @@ pub fn main() -> ExitCode {
             precision,
             curve,
             cards,
+            alembic_for,
         }) => (|| -> anyhow::Result<()> {
             if runtime.is_some() || !strands.is_empty() || cards.is_none() {
-                files::run(
-                    &project,
-                    runtime.as_deref(),
-                    &strands,
+                let options = files::ExportOptions {
                     strands_per_bundle,
                     vertices_log2,
-                    precision.into(),
+                    precision: precision.into(),
                     curve,
-                )?;
+                    alembic: alembic_for,
+                };
+                files::run(&project, runtime.as_deref(), &strands, &options)?;
             }
             if let Some(dir) = cards {
                 let document = hairloom_core::io::project::load(&project)?.document;

@@ -10,8 +10,10 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 use glam::Vec3;
-use hairloom_core::io::alembic::{groom::Groom, groom_animation};
-use hairloom_core::io::strand_files::{ScalpMesh, StrandExportSize, UsdFrame, usda_animation};
+use hairloom_core::io::alembic::{AlembicTarget, groom::Groom, groom_animation};
+use hairloom_core::io::strand_files::{
+    ScalpMesh, StrandExportSize, StrandLook, UsdFrame, usda_animation,
+};
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::motion::{Motion, Wind};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
@@ -96,6 +98,9 @@ pub struct SimulateSettings {
     /// time samples, one per frame.
     #[arg(long)]
     pub abc: bool,
+    /// The application hair.abc is for (axes and units), as for export's --for.
+    #[arg(long = "for", default_value = "blender", value_parser = AlembicTarget::parse)]
+    pub alembic_for: AlembicTarget,
     /// Write the strands only (with --usda / --abc), no pictures.
     #[arg(long)]
     pub no_render: bool,
@@ -247,8 +252,9 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         );
     }
     if settings.usda {
-        let text =
-            usda_animation(&strand_frames, STRAND_WIDTH_M, fps).map_err(anyhow::Error::msg)?;
+        let first = strand_frames.first().map_or(&[][..], |f| &f.strands[..]);
+        let look = StrandLook::new(first, STRAND_WIDTH_M, &document.scene.material);
+        let text = usda_animation(&strand_frames, &look, fps).map_err(anyhow::Error::msg)?;
         let path = settings.out.join("hair.usda");
         hairloom_core::io::project::write_atomic(&path, text.as_bytes(), |_| {})
             .with_context(|| format!("writing {}", path.display()))?;
@@ -261,7 +267,8 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
         );
     }
     if settings.abc {
-        let bytes = groom_animation(&grooms, fps).map_err(anyhow::Error::msg)?;
+        let bytes =
+            groom_animation(&grooms, fps, settings.alembic_for).map_err(anyhow::Error::msg)?;
         let path = settings.out.join("hair.abc");
         hairloom_core::io::project::write_atomic(&path, &bytes, |_| {})
             .with_context(|| format!("writing {}", path.display()))?;

@@ -12,6 +12,7 @@ use glam::DVec3;
 
 use crate::Document;
 use crate::geometry::curve::{SegmentForm, curve_point, curve_segments};
+use crate::io::strand_files::{StrandLook, tapered_widths_m};
 use crate::strands::reference::Strand;
 
 /// Points per layer along a guide: the column's cubic curve sampled finely enough that a
@@ -30,6 +31,11 @@ pub struct GroomCurves {
     pub group_id: Vec<i32>,
     /// Unique over strands and guides together (guides first), so a strand names its guides.
     pub id: Vec<i32>,
+    /// Width at every point, metres: the root width tapering to the tip as the renderers
+    /// draw it ([`tapered_widths_m`]).
+    pub widths_m: Vec<f32>,
+    /// Colour at every point (linear RGB; what a mass of the hair shows), or empty (guides).
+    pub colors: Vec<[f32; 3]>,
 }
 
 /// A groom: strands, their guides and which guides move each strand.
@@ -42,12 +48,13 @@ pub struct Groom {
     /// Per strand: the weights of `closest_guides`, summing to 1.
     pub guide_weights: Vec<[f32; 3]>,
     pub guides: GroomCurves,
-    /// Strand width, metres.
+    /// Strand width at the root, metres.
     pub width_m: f32,
 }
 
 impl Groom {
-    /// The groom of `strands`, generated from `document`. Guides are the columns of the
+    /// The groom of `strands`, generated from `document`, `width_m` wide at their roots and
+    /// coloured by the document's hair material. Guides are the columns of the
     /// bundles that grow the strands, one per styling group that uses the column (Unreal
     /// simulates each group on its own, so a strand's guides must be in its group), each as
     /// tall as the tallest of those bundles.
@@ -88,6 +95,7 @@ impl Groom {
                 let root = positions.first().copied().unwrap_or_default();
                 guides.points.extend([root.as_vec3().to_array(); 2]);
                 guides.vertex_counts.push(2);
+                guides.widths_m.extend(tapered_widths_m(2, width_m));
             } else {
                 let segments = curve_segments(&positions[..=layers]);
                 let count = layers * GUIDE_POINTS_PER_LAYER + 1;
@@ -97,6 +105,7 @@ impl Groom {
                     guides.points.push(p.as_vec3().to_array());
                 }
                 guides.vertex_counts.push(count as i32);
+                guides.widths_m.extend(tapered_widths_m(count, width_m));
             }
             let bundle_uv = first_uv_of_column(document, column);
             guides.root_uv.push(bundle_uv);
@@ -151,6 +160,8 @@ impl Groom {
             curves.group_id.push(group);
             curves.id.push(guide_count + i as i32);
         }
+        let look = StrandLook::new(strands, width_m, &document.scene.material);
+        (groom.strands.widths_m, groom.strands.colors) = (look.widths_m, look.colors);
         groom
     }
 }

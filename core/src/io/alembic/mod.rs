@@ -4,13 +4,15 @@
 //! objects, `hair` (the strands) and `guides` (the hair mesh's columns, `groom_guide = 1`),
 //! with the attributes of Epic's "Alembic for Grooms" specification 1.5.
 //!
-//! Axes and units: metres, Z up. A point `(x, y, z)` of the model (y up, right-handed) is
-//! written `(x, z, y)`: the mirror that takes a right-handed y-up space to Unreal's
-//! left-handed z-up one, the same mapping Unreal's import conversion applies to y-up files
-//! when users set rotation X 90° and scale Y −1. So the groom imports upright with the
-//! conversion's rotation left at zero; its scale must be 100, because Unreal works in
-//! centimetres. (Checked by reading the files back: the hair's height is along z. No
-//! Unreal or Unity ran here.)
+//! Axes and units depend on the application the file is for ([`AlembicTarget`]): Alembic's
+//! own convention (y up, right-handed) in metres for Blender, Houdini and Unity, in
+//! centimetres for Maya, and Unreal's z-up left-handed centimetres for Unreal, so that each
+//! reads the groom upright, facing its front, at its size, with the default import settings
+//! (checked in Blender through `bpy` in `make test`; the others worked out from their
+//! importers' sources and documentation, see the README).
+//!
+//! Widths taper from root to tip as the renderers draw them and every point carries the
+//! hair's colour (`groom_color`), so a groom lands looking like the one in the editor.
 
 pub mod archive;
 pub mod groom;
@@ -22,15 +24,105 @@ use groom::{Groom, GroomCurves};
 /// Groom specification version written (`groom_version_major` / `_minor`).
 pub const GROOM_VERSION: (i16, i16) = (1, 5);
 
-/// Model space (y up) to the file's (z up, mirrored): see the module comment.
-pub fn to_file_axes([x, y, z]: [f32; 3]) -> [f32; 3] {
-    [x, z, y]
+/// The application an `.abc` is written for: its axes and units.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AlembicTarget {
+    /// Blender's Alembic importer converts Alembic's y up to its z up itself; metres.
+    #[default]
+    Blender,
+    /// Houdini: y up, metres (its scene unit).
+    Houdini,
+    /// Maya: y up, centimetres (its internal unit, which its importer reads).
+    Maya,
+    /// Unity's Alembic package: y up, metres; its default Swap Handedness turns our
+    /// right-handed points into its left-handed space.
+    Unity,
+    /// Unreal's groom importer applies only its conversion settings (rotation 0, scale 1 by
+    /// default) and works in centimetres in a left-handed z-up space: a model point
+    /// `(x, y, z)` is written `(x, z, y)` · 100, so the head stands up and faces +Y as
+    /// Unreal's characters do.
+    Unreal,
 }
 
-/// The `.abc` of one groom (a static file). Refused when the groom's arrays disagree (see
-/// [`groom_animation`]).
-pub fn groom_file(groom: &Groom) -> Result<Vec<u8>, String> {
-    groom_animation(std::slice::from_ref(groom), 1.0)
+impl AlembicTarget {
+    pub const ALL: [Self; 5] = [
+        Self::Blender,
+        Self::Houdini,
+        Self::Maya,
+        Self::Unity,
+        Self::Unreal,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Blender => "blender",
+            Self::Houdini => "houdini",
+            Self::Maya => "maya",
+            Self::Unity => "unity",
+            Self::Unreal => "unreal",
+        }
+    }
+
+    /// The target called `name` (as `--for` takes it), or an error naming the choices.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|t| t.name().eq_ignore_ascii_case(name))
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|t| t.name()).collect();
+                format!(
+                    "no Alembic target {name:?}: choose one of {}",
+                    names.join(", ")
+                )
+            })
+    }
+
+    /// File units per metre.
+    pub fn units_per_m(self) -> f32 {
+        match self {
+            Self::Maya | Self::Unreal => 100.0,
+            Self::Blender | Self::Houdini | Self::Unity => 1.0,
+        }
+    }
+
+    /// Whether the file's axes are z up (Unreal) rather than Alembic's y up.
+    pub fn z_up(self) -> bool {
+        self == Self::Unreal
+    }
+
+    /// A model point (metres, y up, right-handed) in the file's axes and units.
+    pub fn to_file(self, [x, y, z]: [f32; 3]) -> [f32; 3] {
+        let scale = self.units_per_m();
+        if self.z_up() {
+            [x * scale, z * scale, y * scale]
+        } else {
+            [x * scale, y * scale, z * scale]
+        }
+    }
+
+    /// What the archive's description says of its axes and units.
+    fn describe(self) -> String {
+        let units = if self.units_per_m() == 1.0 {
+            "metres"
+        } else {
+            "centimetres"
+        };
+        let axes = if self.z_up() {
+            "z up, left-handed"
+        } else {
+            "y up"
+        };
+        format!(
+            "Hair groom for {}: strands and guides, {units}, {axes}",
+            self.name()
+        )
+    }
+}
+
+/// The `.abc` of one groom (a static file) for `target`. Refused when the groom's arrays
+/// disagree (see [`groom_animation`]).
+pub fn groom_file(groom: &Groom, target: AlembicTarget) -> Result<Vec<u8>, String> {
+    groom_animation(std::slice::from_ref(groom), 1.0, target)
 }
 
 /// Whether a groom's arrays agree: as many points as its curves' vertex counts add up to,
@@ -43,6 +135,23 @@ fn check_groom(groom: &Groom) -> Result<(), String> {
                 "{name}: {} points for vertex counts adding up to {points} (each at least 2)",
                 curves.points.len()
             ));
+        }
+        let point_count = curves.points.len();
+        if curves.widths_m.len() != point_count
+            || !(curves.colors.is_empty() || curves.colors.len() == point_count)
+        {
+            return Err(format!(
+                "{name}: {} widths and {} colours for {point_count} points",
+                curves.widths_m.len(),
+                curves.colors.len()
+            ));
+        }
+        if let Some(bad) = curves
+            .widths_m
+            .iter()
+            .find(|w| !(w.is_finite() && **w >= 0.0))
+        {
+            return Err(format!("{name}: width {bad} is not a width"));
         }
         let count = curves.vertex_counts.len();
         for (attribute, len) in [
@@ -71,7 +180,11 @@ fn check_groom(groom: &Groom) -> Result<(), String> {
 /// An animated `.abc`: the points and bounds of every frame's strands and guides as time
 /// samples at `frames_per_second`; everything else from the first frame. Every frame must
 /// have the curves of the first (counts); an empty list is refused.
-pub fn groom_animation(frames: &[Groom], frames_per_second: f64) -> Result<Vec<u8>, String> {
+pub fn groom_animation(
+    frames: &[Groom],
+    frames_per_second: f64,
+    target: AlembicTarget,
+) -> Result<Vec<u8>, String> {
     let first = crate::io::strand_files::first_frame(frames, frames_per_second)?;
     for (i, frame) in frames.iter().enumerate() {
         check_groom(frame).map_err(|e| format!("frame {i}: {e}"))?;
@@ -83,8 +196,20 @@ pub fn groom_animation(frames: &[Groom], frames_per_second: f64) -> Result<Vec<u
             return Err(format!("frame {i} has other curves than frame 0"));
         }
     }
-    let hair = curves_object("hair", frames.iter().map(|g| &g.strands), first, false);
-    let guides = curves_object("guides", frames.iter().map(|g| &g.guides), first, true);
+    let hair = curves_object(
+        "hair",
+        frames.iter().map(|g| &g.strands),
+        first,
+        false,
+        target,
+    );
+    let guides = curves_object(
+        "guides",
+        frames.iter().map(|g| &g.guides),
+        first,
+        true,
+        target,
+    );
     // A frame rate only means something for an animation.
     let fps = if frames.len() > 1 {
         format!("{frames_per_second:.6}")
@@ -98,10 +223,7 @@ pub fn groom_animation(frames: &[Groom], frames_per_second: f64) -> Result<Vec<u
                 "_ai_Application",
                 &format!("Hairloom {}", env!("CARGO_PKG_VERSION")),
             ),
-            (
-                "_ai_Description",
-                "Hair groom: strands and guides, metres, z up",
-            ),
+            ("_ai_Description", &target.describe()),
             ("_ai_DCC_FPS", &fps),
         ]),
         frames_per_second,
@@ -109,25 +231,28 @@ pub fn groom_animation(frames: &[Groom], frames_per_second: f64) -> Result<Vec<u
     Ok(archive.write())
 }
 
-/// An `ICurves` object: linear curves with their widths, `groom_*` attributes per curve
-/// and the groom-level user properties.
+/// An `ICurves` object: linear curves with their widths (per point, tapering), `groom_*`
+/// attributes per curve (and colour per point) and the groom-level user properties, in
+/// `target`'s axes and units.
 fn curves_object<'a>(
     name: &str,
     frames: impl Iterator<Item = &'a GroomCurves>,
     groom: &Groom,
     guides: bool,
+    target: AlembicTarget,
 ) -> Object {
     let frames: Vec<&GroomCurves> = frames.collect();
     let curves = frames[0];
     let points: Vec<Vec<f32>> = frames
         .iter()
-        .map(|c| c.points.iter().flat_map(|&p| to_file_axes(p)).collect())
+        .map(|c| c.points.iter().flat_map(|&p| target.to_file(p)).collect())
         .collect();
     let bounds: Vec<Vec<f64>> = points.iter().map(|p| bounds_of(p)).collect();
     let point_refs: Vec<&[f32]> = points.iter().map(Vec::as_slice).collect();
     let bound_refs: Vec<&[f64]> = bounds.iter().map(Vec::as_slice).collect();
     let curve_count = curves.vertex_counts.len();
-    let width_m = groom.width_m;
+    let scale = target.units_per_m();
+    let widths: Vec<f32> = curves.widths_m.iter().map(|w| w * scale).collect();
 
     let mut arb = vec![
         geom_param(
@@ -160,11 +285,23 @@ fn curves_object<'a>(
         ),
         geom_param(
             "groom_width",
-            "uni",
+            "vtx",
             "",
-            Samples::new(Pod::F32, 1, &[&vec![width_m; curve_count]]),
+            Samples::new(Pod::F32, 1, &[&widths]),
         ),
     ];
+    if !curves.colors.is_empty() {
+        arb.push(geom_param(
+            "groom_color",
+            "vtx",
+            "rgb",
+            Samples::new(
+                Pod::F32,
+                3,
+                &[bytemuck::cast_slice::<[f32; 3], f32>(&curves.colors)],
+            ),
+        ));
+    }
     if !guides {
         arb.push(geom_param(
             "groom_closest_guides",
@@ -227,7 +364,7 @@ fn curves_object<'a>(
             Metadata::default(),
             Samples::new(Pod::U8, 4, &[&[1u8, 0, 0, 0]]),
         ),
-        geom_param("width", "con", "", Samples::new(Pod::F32, 1, &[&[width_m]])),
+        geom_param("width", "vtx", "", Samples::new(Pod::F32, 1, &[&widths])),
         Property::compound(".arbGeomParams", Metadata::default(), arb),
         Property::compound(".userProperties", Metadata::default(), user),
     ];
