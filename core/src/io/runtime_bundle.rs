@@ -15,12 +15,13 @@ pub use crate::runtime::hair::LodEntry;
 use crate::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 
-/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 3
-/// adds far hair's hierarchy (`manifest.far_hair`); version 2 stores 3 hair-mesh slices per
+/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 4
+/// adds what a game needs to rebuild the textures from a moving hair mesh (each bundle's
+/// `columns`, `column_layers`, `bare_faces`); version 3 adds far hair's hierarchy (`manifest.far_hair`); version 2 stores 3 hair-mesh slices per
 /// segment (`p_k, q0, q1`); version 1 stored the quadratics' joint `m` too (4 slices). All
 /// are read (version 1's `m` slices are dropped on load: `m` is exactly `(q0 + q1) / 2`;
 /// bundles before version 3 have no far hair).
-pub const RUNTIME_FORMAT_VERSION: u32 = 3;
+pub const RUNTIME_FORMAT_VERSION: u32 = 4;
 /// Hair-mesh slices per segment in format version 1 bundles.
 const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
@@ -66,6 +67,10 @@ pub struct BundleEntry {
     /// means 1.
     #[serde(default = "full_density", skip_serializing_if = "is_full_density")]
     pub density: f32,
+    /// The hair-mesh column each block corner's texel holds (format version 4): what a game
+    /// that simulates the hair mesh writes there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub columns: Option<[u32; 4]>,
 }
 
 fn full_density() -> f32 {
@@ -123,6 +128,12 @@ pub struct Manifest {
     /// Far hair's thick hairs and levels (seed 001), from format version 3.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub far_hair: Option<FarHairEntry>,
+    /// Layer count of every hair-mesh column (format version 4).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub column_layers: Vec<u32>,
+    /// Scalp faces without hair whose corners weigh in on layer 0's frames (version 4).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bare_faces: Vec<crate::runtime::textures::BareFace>,
 }
 
 /// File name of the manifest, the bundle's single commit point (see [`write_bundle_folder`]).
@@ -340,6 +351,89 @@ pub fn runtime_bundle(
     bundle_files(&RuntimeHair::from_document(document, options))
 }
 
+/// The hair-mesh column held by each block corner's texel of `block` (0 where a texel holds
+/// none, which a built atlas never has).
+fn block_columns(atlas: &Atlas, block: &crate::runtime::atlas::BundleBlock) -> [u32; 4] {
+    crate::runtime::atlas::BLOCK_CORNER_OFFSETS.map(|[dx, dy]| {
+        let (x, y) = (block.origin[0] + dx as u32, block.origin[1] + dy as u32);
+        atlas
+            .texels
+            .get((y * atlas.width + x) as usize)
+            .copied()
+            .flatten()
+            .map_or(0, |t| t.column)
+    })
+}
+
+/// The mesh topology of a loaded manifest (format version 4; empty before), checked: every
+/// bundle's `columns` name a column of `column_layers` tall enough for the bundle, no column
+/// is taller than `max_layers`, and bare faces have 3 or 4 corners with finite uvs. The
+/// atlas's texels learn their column and uv (from `uv`).
+fn bundle_topology(
+    manifest: &Manifest,
+    atlas: &mut Atlas,
+    uv: &Texture3d,
+) -> Result<crate::runtime::textures::MeshTopology, String> {
+    let layers = &manifest.column_layers;
+    if let Some(c) = layers.iter().position(|&l| l > manifest.max_layers) {
+        return Err(format!(
+            "column_layers[{c}] {} is above max_layers {}",
+            layers[c], manifest.max_layers
+        ));
+    }
+    let column = |c: u32, at: &str, least: u32| -> Result<(), String> {
+        match layers.get(c as usize) {
+            None => Err(format!(
+                "{at} names column {c}, but column_layers has {} columns",
+                layers.len()
+            )),
+            Some(&l) if l < least => Err(format!(
+                "{at} names column {c} of {l} layers for a bundle of {least}"
+            )),
+            Some(_) => Ok(()),
+        }
+    };
+    for (i, entry) in manifest.bundles.iter().enumerate() {
+        let Some(columns) = entry.columns else {
+            continue;
+        };
+        for (b, (&c, [dx, dy])) in columns
+            .iter()
+            .zip(crate::runtime::atlas::BLOCK_CORNER_OFFSETS)
+            .enumerate()
+        {
+            column(c, &format!("bundles[{i}].columns[{b}]"), entry.layers)?;
+            // In range: the block placement was checked before.
+            let (x, y) = (entry.origin[0] + dx as u32, entry.origin[1] + dy as u32);
+            let root_uv = uv.get(x, y, 0);
+            atlas.texels[(y * atlas.width + x) as usize] =
+                Some(crate::runtime::atlas::TexelSource {
+                    column: c,
+                    uv: glam::DVec2::new(root_uv.x as f64, root_uv.y as f64),
+                });
+        }
+    }
+    for (f, face) in manifest.bare_faces.iter().enumerate() {
+        if !(3..=4).contains(&face.columns.len()) || face.uvs.len() != face.columns.len() {
+            return Err(format!(
+                "bare_faces[{f}] has {} columns and {} uvs (3 or 4 of each)",
+                face.columns.len(),
+                face.uvs.len()
+            ));
+        }
+        for &c in &face.columns {
+            column(c, &format!("bare_faces[{f}]"), 0)?;
+        }
+        if face.uvs.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(format!("bare_faces[{f}] has a uv that is not finite"));
+        }
+    }
+    Ok(crate::runtime::textures::MeshTopology {
+        column_layers: layers.clone(),
+        bare_faces: manifest.bare_faces.clone(),
+    })
+}
+
 /// The files of a runtime bundle holding `hair`: `(file name, bytes)`, manifest last.
 pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     let textures = &hair.textures;
@@ -429,6 +523,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
                 triangle: Atlas::is_triangle(b),
                 styling_group: hair.block_styling[i] as i32 - 1,
                 density: hair.block_density[i],
+                columns: Some(block_columns(&textures.atlas, b)),
             })
             .collect(),
         strands_per_bundle: hair.strands_per_bundle,
@@ -441,6 +536,8 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         quad_samples: hair.samples.quad.clone(),
         triangle_samples: hair.samples.triangle.clone(),
         far_hair: None,
+        column_layers: textures.topology.column_layers.clone(),
+        bare_faces: textures.topology.bare_faces.clone(),
     };
     if let (Some(name), Some(bytes)) = (&manifest.body, body_glb) {
         files.push((name.clone(), bytes));
@@ -766,12 +863,14 @@ pub fn load_runtime_asset_from(
                 format!("atlas {width}x{height} is too large"),
             )
         })?;
-    let atlas = crate::runtime::atlas::Atlas {
+    let mut atlas = crate::runtime::atlas::Atlas {
         width,
         height,
         blocks,
         texels: vec![None; atlas_texels],
     };
+    let topology = bundle_topology(&manifest, &mut atlas, &uv)
+        .map_err(|message| error(MANIFEST_FILE, message))?;
     let textures = RuntimeTextures {
         atlas,
         precision: manifest.precision,
@@ -781,6 +880,7 @@ pub fn load_runtime_asset_from(
         w,
         u,
         v,
+        topology,
     };
     let body = match &manifest.body {
         None => crate::model::document::BodyMesh::default(),
@@ -972,7 +1072,7 @@ mod tests {
         assert!(!is_bundle_data_file("notes.ktx2") && !is_bundle_data_file("w.12.ktx2"));
         let manifest: Manifest = serde_json::from_slice(&files[6].1).expect("manifest");
         assert_eq!(manifest.bundles.len(), 6);
-        assert_eq!(manifest.format_version, 3);
+        assert_eq!(manifest.format_version, RUNTIME_FORMAT_VERSION);
         assert_eq!(
             manifest.far_hair.as_ref().map(|f| f.file.as_str()),
             Some(names[5])
@@ -1366,6 +1466,35 @@ mod tests {
         load_runtime_bundle_from(&files, "memory")
     }
 
+    /// Format version 4 carries the mesh topology a game needs to rebuild the textures: each
+    /// bundle's columns (the atlas's texels after loading), column layer counts, and the
+    /// faces that grow no hair; it loads back as it was built.
+    #[test]
+    fn the_mesh_topology_round_trips_with_bare_faces() {
+        let mut document = Document::new("grid", grid(3, 2, 2, 0.5));
+        document.hair_mesh.bundles[4].layers = 0;
+        let built = RuntimeHair::from_document(&document, &RuntimeOptions::default());
+        assert_eq!(built.textures.topology.bare_faces.len(), 1);
+        assert_eq!(
+            built.textures.topology.bare_faces[0].columns,
+            document.hair_mesh.bundles[4].vertices
+        );
+        let files: std::collections::HashMap<String, Vec<u8>> =
+            bundle_files(&built).expect("export").into_iter().collect();
+        let loaded = load_runtime_bundle_from(&files, "memory").expect("loads");
+        assert_eq!(loaded.textures.topology, built.textures.topology);
+        // Every texel knows its column again (its uv comes back as the f32 the file holds).
+        let columns = |hair: &RuntimeHair| -> Vec<Option<u32>> {
+            hair.textures
+                .atlas
+                .texels
+                .iter()
+                .map(|t| t.map(|t| t.column))
+                .collect()
+        };
+        assert_eq!(columns(&loaded), columns(&built));
+    }
+
     #[test]
     fn hostile_manifests_are_named_errors() {
         load_with(|_| {}).expect("the unedited bundle loads");
@@ -1406,6 +1535,25 @@ mod tests {
             (
                 Box::new(|m| m["bundles"][0]["density"] = 1.5.into()),
                 "bundles[0].density 1.5 is outside [0, 1]",
+            ),
+            (
+                Box::new(|m| m["bundles"][0]["columns"][2] = 1_000_000.into()),
+                "bundles[0].columns[2] names column 1000000",
+            ),
+            (
+                Box::new(|m| m["column_layers"][0] = 0.into()),
+                "names column 0 of 0 layers",
+            ),
+            (
+                Box::new(|m| m["column_layers"][1] = 600.into()),
+                "column_layers[1] 600 is above max_layers",
+            ),
+            (
+                Box::new(|m| {
+                    m["bare_faces"] =
+                        serde_json::json!([{"columns": [0, 1], "uvs": [[0, 0], [1, 0]]}])
+                }),
+                "bare_faces[0] has 2 columns",
             ),
         ];
         for (edit, expected) in cases {

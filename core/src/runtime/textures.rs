@@ -36,6 +36,45 @@ pub const SLICES_PER_SEGMENT: u32 = 3;
 /// asking for more is refused by name (a 20,000-layer bundle used to take 23 s and 2.5 GB to
 /// export).
 pub const MAX_LAYERS_PER_BUNDLE: u32 = 511;
+/// What a game that animates the hair mesh needs besides the textures to rebuild them
+/// (`docs/runtime-format.md`, "Animating the hair mesh"): each column's layer count, and the
+/// scalp faces that grow no hair, whose corners still weigh in on layer 0's frames.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MeshTopology {
+    /// Layer count `c` of every column of the hair mesh (its vertices are `p_0 … p_c`).
+    pub column_layers: Vec<u32>,
+    pub bare_faces: Vec<BareFace>,
+}
+
+/// A scalp face with no layers: its columns in face order and each corner's uv.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BareFace {
+    pub columns: Vec<u32>,
+    pub uvs: Vec<[f32; 2]>,
+}
+
+impl MeshTopology {
+    pub fn of(mesh: &HairMesh) -> Self {
+        Self {
+            column_layers: mesh
+                .columns
+                .iter()
+                .map(|c| c.positions.len().saturating_sub(1) as u32)
+                .collect(),
+            bare_faces: mesh
+                .bundles
+                .iter()
+                .filter(|b| !b.removed && b.layers == 0)
+                .map(|b| BareFace {
+                    columns: b.vertices.clone(),
+                    uvs: b.uvs.iter().map(|uv| uv.as_vec2().to_array()).collect(),
+                })
+                .collect(),
+        }
+    }
+}
+
 /// Largest region side in the atlas.
 pub const MAX_REGION_SIDE: usize = 64;
 
@@ -119,6 +158,8 @@ pub struct RuntimeTextures {
     pub u: Texture3d,
     /// v̂ (xyz), `1 + max_layers` slices.
     pub v: Texture3d,
+    /// Column layer counts and bare faces (empty for bundles before format version 4).
+    pub topology: MeshTopology,
 }
 
 fn quantize(v: Vec4, precision: Precision) -> Vec4 {
@@ -224,6 +265,7 @@ impl RuntimeTextures {
             w,
             u,
             v,
+            topology: MeshTopology::of(mesh),
         }
     }
 
