@@ -444,7 +444,7 @@ fn example_tables() -> Vec<Table> {
             "k {k}: the ops add up to the mirror's vertex"
         );
         first_slices.push((segment, half));
-        push("along = k / (n − 1)", index, fixed(&[along], 7));
+        push("along = k / (V − 1)", index, fixed(&[along], 7));
         push("τ = n · λ_len · along", index, fixed(&[tau as f64], 7));
         push(
             "segment, half",
