@@ -69,24 +69,33 @@ deps: gpu-deps
 	  { python3 -m venv $(VALIDATE_VENV) && $(VALIDATE_VENV)/bin/pip install -q --disable-pip-version-check $(USD_CORE) $(ALEMBIC3D); }
 
 # Blender (PyPI bpy) for the import check of our strand exports, in its own venv: bpy 5.3
-# needs Python 3.13 (pyenv's where it exists), bpy 5.0.1 runs on Debian's 3.11. Where neither
-# exists or the install fails, the check says it skipped; where bpy installed, `make test`
-# requires it (HAIRLOOM_REQUIRE_BLENDER).
+# needs Python 3.13 (pyenv's where it exists), bpy 5.0.1 runs on Debian's 3.11; its wheels
+# need a few X and GL libraries, installed as root. Success means `import bpy` works. Where
+# it cannot install, this says why and the check is skipped (the reason is kept in
+# target/bpy-venv.failed so the next run does not download again: delete it to retry);
+# where bpy works, `make test` requires the check (HAIRLOOM_REQUIRE_BLENDER).
 BPY_VENV := target/bpy-venv
+BPY_APT := libx11-6 libxrender1 libxxf86vm1 libxfixes3 libxi6 libxkbcommon0 libsm6 libgl1 libegl1
 blender-deps:
-	@$(BPY_VENV)/bin/python -c 'import bpy' 2>/dev/null || { \
-	  rm -rf $(BPY_VENV); spec=""; \
-	  for py in python3.13 $$(ls -d $$HOME/.pyenv/versions/3.13*/bin/python3.13 2>/dev/null) python3.11 python3; do \
-	    case "$$($$py -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)" in \
-	      3.13) spec='bpy==5.3.*';; 3.11) spec='bpy==5.0.1';; *) continue;; esac; break; \
-	  done; \
-	  if [ -n "$$spec" ] && $$py -m venv $(BPY_VENV) && \
-	     $(BPY_VENV)/bin/pip install -q --disable-pip-version-check "$$spec"; then \
-	    echo "installed $$spec for the Blender import check"; \
-	  else \
-	    rm -rf $(BPY_VENV); \
-	    echo "warning: Blender (PyPI bpy) did not install (needs Python 3.11 or 3.13 and PyPI); the Blender import check will say it skipped"; \
-	  fi; }
+	@if $(BPY_VENV)/bin/python -c 'import bpy' 2>/dev/null; then exit 0; fi; \
+	if [ -f $(BPY_VENV).failed ]; then \
+	  echo "warning: the Blender import check is skipped: $$(cat $(BPY_VENV).failed) (delete $(BPY_VENV).failed to retry)"; exit 0; fi; \
+	mkdir -p $(dir $(BPY_VENV)); \
+	missing=""; for p in $(BPY_APT); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ] && command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ]; then \
+	  echo "installing:$$missing"; apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing >/dev/null; fi; \
+	reason="no Python 3.13 or 3.11 was found"; \
+	for py in python3.13 $$(ls -d $$HOME/.pyenv/versions/3.13*/bin/python3.13 2>/dev/null) python3.11 python3; do \
+	  case "$$($$py -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null)" in \
+	    3.13) spec='bpy==5.3.*';; 3.11) spec='bpy==5.0.1';; *) continue;; esac; \
+	  rm -rf $(BPY_VENV); \
+	  if ! $$py -m venv $(BPY_VENV) >/dev/null 2>&1; then reason="$$py -m venv failed"; continue; fi; \
+	  if ! $(BPY_VENV)/bin/pip install -q --disable-pip-version-check "$$spec"; then reason="pip could not install $$spec"; continue; fi; \
+	  if err=$$($(BPY_VENV)/bin/python -c 'import bpy' 2>&1); then echo "installed $$spec for the Blender import check"; exit 0; fi; \
+	  reason="$$spec installed but 'import bpy' failed: $$(echo "$$err" | tail -n 1)"; \
+	done; \
+	rm -rf $(BPY_VENV); echo "$$reason" > $(BPY_VENV).failed; \
+	echo "warning: the Blender import check is skipped: $$reason"
 
 RENDER_OUT ?= out/$(notdir $(SAMPLE:.hairloom=.png))
 

@@ -19,7 +19,8 @@ use hairloom_core::runtime::strand_gen::{Filtering, runtime_strands};
 use hairloom_core::runtime::textures::Precision;
 use hairloom_core::strands::reference::{Strand, StrandContext, StrandOptions, StrandPlan};
 
-/// Strand width written to the strand files (80 µm, a typical human hair).
+/// Root width of the strands in the strand files (80 µm, a typical human hair); each
+/// tapers to 40 % of it at the tip.
 pub const STRAND_WIDTH_M: f32 = 8e-5;
 
 /// Strands have 2^N + 1 vertices in exported strand files and at a runtime bundle's full

@@ -11,7 +11,9 @@
 //!   scaled by [`HairCards::depth_range_m`];
 //! - **flow**: the strands' direction in the card's (u, v), as `0.5 + 0.5·dir` in red and green;
 //! - **root to tip**: fraction along the strand, for gradients and alpha ramps;
-//! - **id**: one random value per strand, for per-strand variation in the game's shader.
+//! - **id**: one random value per strand, for per-strand variation in the game's shader;
+//! - **root uv**: the scalp uv of the nearest strand's root (red, green), for textures a
+//!   game looks up by root (Unreal's card attribute texture carries it).
 //!
 //! A card is widened wherever its strands reach beyond the bundle's own width (styling can
 //! carry them there), so every strand lands inside its card. Level of detail lowers the
@@ -89,6 +91,8 @@ pub struct CardAtlas {
     pub flow: Vec<u8>,
     pub root_to_tip: Vec<u8>,
     pub id: Vec<u8>,
+    /// Root uv of the nearest strand, two channels per texel (0 where no strand is).
+    pub root_uv: Vec<u8>,
 }
 
 /// Cards of a hairstyle: the levels of detail and the atlas they share.
@@ -385,6 +389,7 @@ fn bake(
     let mut along_sum = vec![0f64; texels];
     let mut depth = vec![f64::NEG_INFINITY; texels];
     let mut id = vec![0u8; texels];
+    let mut root_uv = vec![0u8; texels * 2];
     let fibre = Fibre::new(&document.scene.material);
     for (c, index, points) in placed {
         let card = &cards[*c];
@@ -423,11 +428,14 @@ fn bake(
                 if d > depth[at] {
                     depth[at] = d;
                     id[at] = (strand_id * 255.0).round() as u8;
+                    let uv = strands[*index].root_uv;
+                    root_uv[2 * at] = unit_to_u8(uv.x);
+                    root_uv[2 * at + 1] = unit_to_u8(uv.y);
                 }
             }
         }
     }
-    let to_u8 = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let to_u8 = unit_to_u8;
     let mut atlas = CardAtlas {
         width,
         height,
@@ -437,6 +445,7 @@ fn bake(
         flow: Vec::with_capacity(texels * 3),
         root_to_tip: Vec::with_capacity(texels),
         id,
+        root_uv,
     };
     for i in 0..texels {
         let n = count[i];
@@ -466,6 +475,11 @@ fn bake(
         atlas.coverage.push(to_u8(coverage));
     }
     atlas
+}
+
+/// `x` in [0, 1] as an 8-bit channel (clamped; NaN is 0).
+fn unit_to_u8(x: f64) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
 }
 
 #[cfg(test)]

@@ -351,30 +351,42 @@ pub fn runtime_bundle(
     bundle_files(&RuntimeHair::from_document(document, options))
 }
 
-/// The hair-mesh column held by each block corner's texel of `block` (0 where a texel holds
-/// none, which a built atlas never has).
-fn block_columns(atlas: &Atlas, block: &crate::runtime::atlas::BundleBlock) -> [u32; 4] {
-    crate::runtime::atlas::BLOCK_CORNER_OFFSETS.map(|[dx, dy]| {
+/// The hair-mesh column held by each block corner's texel of `block`; `None` when a texel
+/// does not know its column (an atlas loaded from a bundle before format version 4).
+fn block_columns(atlas: &Atlas, block: &crate::runtime::atlas::BundleBlock) -> Option<[u32; 4]> {
+    let mut columns = [0; 4];
+    for (column, [dx, dy]) in columns
+        .iter_mut()
+        .zip(crate::runtime::atlas::BLOCK_CORNER_OFFSETS)
+    {
         let (x, y) = (block.origin[0] + dx as u32, block.origin[1] + dy as u32);
-        atlas
+        *column = atlas
             .texels
             .get((y * atlas.width + x) as usize)
             .copied()
-            .flatten()
-            .map_or(0, |t| t.column)
-    })
+            .flatten()?
+            .column;
+    }
+    Some(columns)
 }
 
-/// The mesh topology of a loaded manifest (format version 4; empty before), checked: every
-/// bundle's `columns` name a column of `column_layers` tall enough for the bundle, no column
-/// is taller than `max_layers`, and bare faces have 3 or 4 corners with finite uvs. The
-/// atlas's texels learn their column and uv (from `uv`).
+/// The mesh topology of a loaded manifest (format version 4; empty before), checked: from
+/// version 4 every bundle has `columns`, each naming a column of `column_layers` tall enough
+/// for the bundle, a triangle's block corners 2 and 3 the same one, and no texel two
+/// columns; no column is taller than `max_layers`; bare faces have 3 or 4 corners with
+/// finite uvs and positions. The atlas's texels learn their column and uv (from `uv`).
 fn bundle_topology(
     manifest: &Manifest,
+    version: u64,
     atlas: &mut Atlas,
     uv: &Texture3d,
 ) -> Result<crate::runtime::textures::MeshTopology, String> {
     let layers = &manifest.column_layers;
+    if version >= 4 && layers.is_empty() {
+        return Err(format!(
+            "format_version {version} needs column_layers (the hair mesh's columns)"
+        ));
+    }
     if let Some(c) = layers.iter().position(|&l| l > manifest.max_layers) {
         return Err(format!(
             "column_layers[{c}] {} is above max_layers {}",
@@ -395,8 +407,19 @@ fn bundle_topology(
     };
     for (i, entry) in manifest.bundles.iter().enumerate() {
         let Some(columns) = entry.columns else {
+            if version >= 4 {
+                return Err(format!(
+                    "bundles[{i}] has no columns (format_version {version} needs them)"
+                ));
+            }
             continue;
         };
+        if entry.corner_of_block[2] == entry.corner_of_block[3] && columns[2] != columns[3] {
+            return Err(format!(
+                "bundles[{i}].columns: a triangle's block corners 2 and 3 hold one column, not {} and {}",
+                columns[2], columns[3]
+            ));
+        }
         for (b, (&c, [dx, dy])) in columns
             .iter()
             .zip(crate::runtime::atlas::BLOCK_CORNER_OFFSETS)
@@ -406,20 +429,30 @@ fn bundle_topology(
             // In range: the block placement was checked before.
             let (x, y) = (entry.origin[0] + dx as u32, entry.origin[1] + dy as u32);
             let root_uv = uv.get(x, y, 0);
-            atlas.texels[(y * atlas.width + x) as usize] =
-                Some(crate::runtime::atlas::TexelSource {
-                    column: c,
-                    uv: glam::DVec2::new(root_uv.x as f64, root_uv.y as f64),
-                });
+            let texel = &mut atlas.texels[(y * atlas.width + x) as usize];
+            if let Some(held) = texel.filter(|t| t.column != c) {
+                return Err(format!(
+                    "texel ({x}, {y}) holds column {} for one bundle and column {c} for bundles[{i}]",
+                    held.column
+                ));
+            }
+            *texel = Some(crate::runtime::atlas::TexelSource {
+                column: c,
+                uv: glam::DVec2::new(root_uv.x as f64, root_uv.y as f64),
+            });
         }
     }
     for (f, face) in manifest.bare_faces.iter().enumerate() {
-        if !(3..=4).contains(&face.columns.len()) || face.uvs.len() != face.columns.len() {
+        let n = face.columns.len();
+        if !(3..=4).contains(&n) || face.uvs.len() != n || face.positions.len() != n {
             return Err(format!(
-                "bare_faces[{f}] has {} columns and {} uvs (3 or 4 of each)",
-                face.columns.len(),
-                face.uvs.len()
+                "bare_faces[{f}] has {n} columns, {} uvs and {} positions (3 or 4 of each)",
+                face.uvs.len(),
+                face.positions.len()
             ));
+        }
+        if face.positions.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(format!("bare_faces[{f}] has a position that is not finite"));
         }
         for &c in &face.columns {
             column(c, &format!("bare_faces[{f}]"), 0)?;
@@ -523,7 +556,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
                 triangle: Atlas::is_triangle(b),
                 styling_group: hair.block_styling[i] as i32 - 1,
                 density: hair.block_density[i],
-                columns: Some(block_columns(&textures.atlas, b)),
+                columns: block_columns(&textures.atlas, b),
             })
             .collect(),
         strands_per_bundle: hair.strands_per_bundle,
@@ -584,6 +617,8 @@ pub mod limits {
     pub const SAMPLES: usize = 1 << 16;
     /// `lod.max_vertices_log2`: 1025 vertices per strand.
     pub const MAX_VERTICES_LOG2: u32 = 10;
+    /// Entries of `column_layers` and of `bare_faces` (format version 4), each.
+    pub const COLUMNS: usize = 1 << 22;
 }
 
 /// Where a runtime bundle's files come from: a folder on disk ([`load_runtime_bundle`]) or
@@ -869,7 +904,7 @@ pub fn load_runtime_asset_from(
         blocks,
         texels: vec![None; atlas_texels],
     };
-    let topology = bundle_topology(&manifest, &mut atlas, &uv)
+    let topology = bundle_topology(&manifest, found, &mut atlas, &uv)
         .map_err(|message| error(MANIFEST_FILE, message))?;
     let textures = RuntimeTextures {
         atlas,
@@ -1014,6 +1049,17 @@ fn check_manifest_caps(manifest: &Manifest) -> Result<(), String> {
                 "{name} has {} entries, above the cap of {}",
                 samples.len(),
                 limits::SAMPLES
+            ));
+        }
+    }
+    for (name, count) in [
+        ("column_layers", manifest.column_layers.len()),
+        ("bare_faces", manifest.bare_faces.len()),
+    ] {
+        if count > limits::COLUMNS {
+            return Err(format!(
+                "{name} has {count} entries, above the cap of {}",
+                limits::COLUMNS
             ));
         }
     }
@@ -1550,10 +1596,28 @@ mod tests {
             ),
             (
                 Box::new(|m| {
-                    m["bare_faces"] =
-                        serde_json::json!([{"columns": [0, 1], "uvs": [[0, 0], [1, 0]]}])
+                    m["bare_faces"] = serde_json::json!([
+                        {"columns": [0, 1], "uvs": [[0, 0], [1, 0]], "positions": [[0, 0, 0], [1, 0, 0]]}
+                    ])
                 }),
                 "bare_faces[0] has 2 columns",
+            ),
+            (
+                Box::new(|m| {
+                    m["bundles"][0]
+                        .as_object_mut()
+                        .expect("a bundle")
+                        .remove("columns");
+                }),
+                "bundles[0] has no columns (format_version 4 needs them)",
+            ),
+            (
+                Box::new(|m| {
+                    let other = m["bundles"][0]["columns"][0].as_u64().expect("a column") + 1;
+                    m["bundles"][1]["columns"][0] = other.into();
+                    m["bundles"][1]["origin"] = m["bundles"][0]["origin"].clone();
+                }),
+                "holds column",
             ),
         ];
         for (edit, expected) in cases {

@@ -41,11 +41,11 @@ pub fn tapered_widths_m(count: usize, root_width_m: f32) -> impl Iterator<Item =
 }
 
 /// Points one strand export may hold (every strand × its vertices). Strands are generated
-/// in memory before they are written (24 B per point as f64, plus the file's own bytes: 12
-/// to about 40 per point), so this bounds an export to about 4 GB of memory; it also keeps
-/// every format inside its own 32-bit counts (`.hair`'s point count, a GLB's length).
-/// See `docs/resource-policy.md`.
-pub const MAX_EXPORT_POINTS: u64 = 64 << 20;
+/// in memory before they are written (24 B per point as f64, 16 B of width and colour,
+/// plus the file's own bytes: 28 to about 90 per point), so this bounds an export to about
+/// 4.4 GB of memory; it also keeps every format inside its own 32-bit counts (`.hair`'s
+/// point count, a GLB's length). See `docs/resource-policy.md`.
+pub const MAX_EXPORT_POINTS: u64 = 32 << 20;
 
 /// How big a strand export of a document would be, counted before anything is generated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,10 +79,11 @@ impl StrandExportSize {
         }
     }
 
-    /// Bytes of memory the export needs while it is written, roughly: the f64 points and
-    /// the largest file's bytes (text USD, about 40 per point).
+    /// Bytes of memory the export needs while it is written, roughly: the f64 points, each
+    /// point's width and colour, and the largest file's bytes (text USD with per-point
+    /// widths and colours, about 90 per point).
     pub fn memory_bytes(&self) -> u64 {
-        self.points.saturating_mul(24 + 40)
+        self.points.saturating_mul(24 + 16 + 90)
     }
 
     /// Refuses an export above [`MAX_EXPORT_POINTS`], saying how big it would be (the
@@ -314,12 +315,11 @@ fn usda_curves(
     out.push_str(extent);
     let point_count: usize = strands.iter().map(|s| s.points.len()).sum();
     if look.widths_m.len() == point_count && look.colors.len() == point_count {
-        let widths: Vec<String> = look.widths_m.iter().map(f32::to_string).collect();
-        let _ = writeln!(
-            out,
-            "    float[] widths = [{}] (\n        interpolation = \"vertex\"\n    )",
-            widths.join(", ")
-        );
+        out.push_str("    float[] widths = [");
+        for (i, width) in look.widths_m.iter().enumerate() {
+            let _ = write!(out, "{}{width}", if i == 0 { "" } else { ", " });
+        }
+        out.push_str("] (\n        interpolation = \"vertex\"\n    )\n");
         let _ = writeln!(
             out,
             "    color3f[] primvars:displayColor = {} (\n        interpolation = \"vertex\"\n    )",

@@ -46,12 +46,14 @@ pub struct MeshTopology {
     pub bare_faces: Vec<BareFace>,
 }
 
-/// A scalp face with no layers: its columns in face order and each corner's uv.
+/// A scalp face with no layers: its columns in face order, each corner's uv and rest
+/// position (model units; a corner no hairy face shares has no texel to read it from).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BareFace {
     pub columns: Vec<u32>,
     pub uvs: Vec<[f32; 2]>,
+    pub positions: Vec<[f32; 3]>,
 }
 
 impl MeshTopology {
@@ -69,6 +71,15 @@ impl MeshTopology {
                 .map(|b| BareFace {
                     columns: b.vertices.clone(),
                     uvs: b.uvs.iter().map(|uv| uv.as_vec2().to_array()).collect(),
+                    positions: b
+                        .vertices
+                        .iter()
+                        .map(|&c| {
+                            let column = mesh.columns.get(c as usize);
+                            let root = column.and_then(|c| c.positions.first()).copied();
+                            root.unwrap_or_default().as_vec3().to_array()
+                        })
+                        .collect(),
                 })
                 .collect(),
         }

@@ -660,6 +660,8 @@ impl HairloomApp {
                     .clicked()
                 {
                     ui.close();
+                    // A plain strand export writes an .abc for the default client.
+                    self.alembic_target = AlembicTarget::default();
                     self.file_request(FileRequest::ExportStrands);
                 }
                 ui.add_enabled_ui(!exporting, |ui| {
@@ -1030,7 +1032,7 @@ fn alembic_target_label(target: AlembicTarget) -> &'static str {
         AlembicTarget::Blender => "Blender (y up, m)",
         AlembicTarget::Houdini => "Houdini (y up, m)",
         AlembicTarget::Maya => "Maya (y up, cm)",
-        AlembicTarget::Unity => "Unity (y up, m)",
+        AlembicTarget::Unity => "Unity (y up, cm)",
         AlembicTarget::Unreal => "Unreal (z up, cm)",
     }
 }

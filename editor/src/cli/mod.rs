@@ -98,9 +98,9 @@ enum Command {
         /// --strands-per-bundle and --vertices-log2.
         #[arg(long)]
         cards: Option<PathBuf>,
-        /// The application an .abc is for: blender, houdini, unity (y up, metres), maya (y
-        /// up, centimetres) or unreal (z up, centimetres), each upright with its default
-        /// import settings (README, "Strands in other tools").
+        /// The application an .abc is for: blender, houdini (y up, metres), maya, unity (y
+        /// up, centimetres) or unreal (z up, centimetres), each upright and at its size with
+        /// its default import settings (README, "Strands in other tools").
         #[arg(long = "for", default_value = "blender", value_parser = AlembicTarget::parse)]
         alembic_for: AlembicTarget,
     },

@@ -5,8 +5,8 @@
 //! with the attributes of Epic's "Alembic for Grooms" specification 1.5.
 //!
 //! Axes and units depend on the application the file is for ([`AlembicTarget`]): Alembic's
-//! own convention (y up, right-handed) in metres for Blender, Houdini and Unity, in
-//! centimetres for Maya, and Unreal's z-up left-handed centimetres for Unreal, so that each
+//! own convention (y up, right-handed) in metres for Blender and Houdini, in centimetres for
+//! Maya and Unity, and Unreal's z-up left-handed centimetres for Unreal, so that each
 //! reads the groom upright, facing its front, at its size, with the default import settings
 //! (checked in Blender through `bpy` in `make test`; the others worked out from their
 //! importers' sources and documentation, see the README).
@@ -34,8 +34,9 @@ pub enum AlembicTarget {
     Houdini,
     /// Maya: y up, centimetres (its internal unit, which its importer reads).
     Maya,
-    /// Unity's Alembic package: y up, metres; its default Swap Handedness turns our
-    /// right-handed points into its left-handed space.
+    /// Unity's Alembic package: y up, centimetres: its default Scale Factor is 0.01 (it
+    /// expects Maya's centimetres) and its default Swap Handedness turns our right-handed
+    /// points into its left-handed space.
     Unity,
     /// Unreal's groom importer applies only its conversion settings (rotation 0, scale 1 by
     /// default) and works in centimetres in a left-handed z-up space: a model point
@@ -80,8 +81,8 @@ impl AlembicTarget {
     /// File units per metre.
     pub fn units_per_m(self) -> f32 {
         match self {
-            Self::Maya | Self::Unreal => 100.0,
-            Self::Blender | Self::Houdini | Self::Unity => 1.0,
+            Self::Maya | Self::Unity | Self::Unreal => 100.0,
+            Self::Blender | Self::Houdini => 1.0,
         }
     }
 
@@ -417,4 +418,30 @@ fn bounds_of(points: &[f32]) -> Vec<f64> {
         return vec![0.0; 6];
     }
     lo.into_iter().chain(hi).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::AlembicTarget;
+
+    /// Literal expectations, independent of `to_file`'s own arithmetic: a model point
+    /// (x right, y up, z toward the face), metres.
+    #[test]
+    fn each_target_gets_its_axes_and_units() {
+        let p = [1.0, 2.0, 3.0];
+        assert_eq!(AlembicTarget::Blender.to_file(p), [1.0, 2.0, 3.0]);
+        assert_eq!(AlembicTarget::Houdini.to_file(p), [1.0, 2.0, 3.0]);
+        assert_eq!(AlembicTarget::Maya.to_file(p), [100.0, 200.0, 300.0]);
+        assert_eq!(AlembicTarget::Unity.to_file(p), [100.0, 200.0, 300.0]);
+        // Unreal: z up, the face toward +y, centimetres.
+        assert_eq!(AlembicTarget::Unreal.to_file(p), [100.0, 300.0, 200.0]);
+        for target in AlembicTarget::ALL {
+            assert_eq!(AlembicTarget::parse(target.name()), Ok(target));
+        }
+        let error = AlembicTarget::parse("3dsmax").expect_err("unknown");
+        assert!(
+            error.contains("blender, houdini, maya, unity, unreal"),
+            "{error}"
+        );
+    }
 }
