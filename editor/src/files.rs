@@ -349,7 +349,7 @@ pub fn write_cards(
     vertices_log2: u32,
 ) -> anyhow::Result<String> {
     use hairloom_core::cards::{CardOptions, hair_cards};
-    use hairloom_core::io::cards_gltf::{CARD_MAPS, card_glb};
+    use hairloom_core::io::cards_gltf::{CARD_MAPS, CardMap, card_glb};
     check_vertices_log2(vertices_log2)?;
     let strands = generate_strands(document, strands_per_bundle, vertices_log2, &mut |_| {
         ControlFlow::Continue(())
@@ -378,17 +378,38 @@ pub fn write_cards(
     ];
     debug_assert_eq!(maps.map(|m| m.0), CARD_MAPS);
     let mut map_files = Vec::new();
+    let mut map_pngs = Vec::new();
     for (name, pixels, channels) in maps {
         let file = format!("{name}.png");
-        write(&file, &encode_png(pixels, w, h, channels)?)?;
+        let png = encode_png(pixels, w, h, channels)?;
+        write(&file, &png)?;
         map_files.push((name, file));
+        map_pngs.push(png);
+    }
+    let embedded: Vec<CardMap> = map_files
+        .iter()
+        .zip(&map_pngs)
+        .map(|((name, file), png)| CardMap {
+            name,
+            file: file.clone(),
+            png,
+        })
+        .collect();
+    // Unreal's card texture set, beside the rest in unreal/.
+    std::fs::create_dir_all(dir.join("unreal"))
+        .with_context(|| format!("creating {}", dir.join("unreal").display()))?;
+    let mut unreal = serde_json::Map::new();
+    for (stem, channels, pixels) in atlas.unreal_textures() {
+        let file = format!("unreal/{stem}.png");
+        write(&file, &encode_png(&pixels, w, h, channels)?)?;
+        unreal.insert(stem.to_string(), file.into());
     }
     let mut levels = Vec::new();
     for (level, mesh) in cards.levels.iter().enumerate() {
         let file = format!("cards_lod{level}.glb");
         write(
             &file,
-            &card_glb(&format!("hair_cards_lod{level}"), mesh, &albedo, &map_files),
+            &card_glb(&format!("hair_cards_lod{level}"), mesh, &albedo, &embedded),
         )?;
         levels.push(serde_json::json!({
             "file": file,
@@ -405,6 +426,7 @@ pub fn write_cards(
             "albedo": "albedo.png",
             "maps": map_files.iter().map(|(k, v)| (k.to_string(), serde_json::Value::from(v.clone()))).collect::<serde_json::Map<_, _>>(),
             "depth_range_m": cards.depth_range_m,
+            "unreal": unreal,
             "tile_px": options.tile_px,
         },
         "baked_from": {"strands": strands.len(), "points": cards.baked_points},

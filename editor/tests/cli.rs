@@ -273,8 +273,34 @@ fn exports_of_every_sample_pass_third_party_validators() {
                 let png = image::open(cards.join(format!("{map}.png"))).expect("a map");
                 assert_eq!((png.width(), png.height()), (w, h), "{map}");
             }
+            // Unreal's card texture set beside them, with the channels its slots take.
+            for (stem, channels) in [
+                ("T_HairCards_Depth", 1),
+                ("T_HairCards_Coverage", 1),
+                ("T_HairCards_Tangent", 3),
+                ("T_HairCards_Attribute", 4),
+            ] {
+                let file = manifest["atlas"]["unreal"][stem].as_str().expect(stem);
+                let png = image::open(cards.join(file)).expect("an Unreal texture");
+                assert_eq!((png.width(), png.height()), (w, h), "{stem}");
+                assert_eq!(png.color().channel_count(), channels, "{stem}");
+            }
             for level in levels {
-                glbs.push(cards.join(level["file"].as_str().expect("file")));
+                let glb = cards.join(level["file"].as_str().expect("file"));
+                // Every map is embedded and named by the material's extras.
+                let bytes = std::fs::read(&glb).expect("a card GLB");
+                let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("4")) as usize;
+                let json: serde_json::Value =
+                    serde_json::from_slice(&bytes[20..20 + json_len]).expect("GLB JSON");
+                let maps = &json["materials"][0]["extras"]["hairloom_maps"];
+                for name in ["coverage", "depth", "flow", "root_to_tip", "id"] {
+                    let texture = maps[name]["texture"].as_u64().expect(name) as usize;
+                    let image = json["textures"][texture]["source"]
+                        .as_u64()
+                        .expect("source");
+                    assert_eq!(json["images"][image as usize]["name"], name);
+                }
+                glbs.push(glb);
             }
         }
         // Our own reading of the .hair header: counts match what was generated.

@@ -95,6 +95,43 @@ pub struct CardAtlas {
     pub root_uv: Vec<u8>,
 }
 
+/// The texture set Unreal's groom cards take (Groom asset ▸ Cards ▸ Textures), named as its
+/// card texture generator names them: `(file stem, channels, pixels)`.
+pub const UNREAL_CARD_TEXTURES: [&str; 4] = [
+    "T_HairCards_Depth",
+    "T_HairCards_Coverage",
+    "T_HairCards_Tangent",
+    "T_HairCards_Attribute",
+];
+
+impl CardAtlas {
+    /// Unreal's card textures from the same bake ([`UNREAL_CARD_TEXTURES`]): depth (L8),
+    /// coverage (L8), tangent (RGB8: the strands' direction in the card's (u, v) and 0 out
+    /// of the card, each as `0.5 + 0.5·x`), attribute (RGBA8: root u, root v, coordinate
+    /// along the strand from root to tip, per-strand seed).
+    pub fn unreal_textures(&self) -> [(&'static str, u8, Vec<u8>); 4] {
+        let texels = (self.width * self.height) as usize;
+        let mut tangent = Vec::with_capacity(texels * 3);
+        let mut attribute = Vec::with_capacity(texels * 4);
+        for i in 0..texels {
+            tangent.extend_from_slice(&[self.flow[3 * i], self.flow[3 * i + 1], 128]);
+            attribute.extend_from_slice(&[
+                self.root_uv[2 * i],
+                self.root_uv[2 * i + 1],
+                self.root_to_tip[i],
+                self.id[i],
+            ]);
+        }
+        let [depth, coverage, tangent_name, attribute_name] = UNREAL_CARD_TEXTURES;
+        [
+            (depth, 1, self.depth.clone()),
+            (coverage, 1, self.coverage.clone()),
+            (tangent_name, 3, tangent),
+            (attribute_name, 4, attribute),
+        ]
+    }
+}
+
 /// Cards of a hairstyle: the levels of detail and the atlas they share.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HairCards {

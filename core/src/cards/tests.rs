@@ -131,3 +131,38 @@ fn a_collapsed_bundle_and_no_strands_still_give_finite_cards() {
     let [tw, th] = [many.atlas.width, many.atlas.height];
     assert!(tw * th >= 1600 * 2 * 2, "{tw}×{th} cannot hold 1,600 tiles");
 }
+
+/// Unreal's card textures come from the same bake: where strands cover a texel, the
+/// attribute texture holds the nearest strand's root uv (one of the bundle's strands),
+/// its seed (the id map) and the coordinate along it (the root-to-tip map); the tangent
+/// texture is the flow with 0 out of the card.
+#[test]
+fn unreal_card_textures_carry_root_uv_coordinate_and_seed() {
+    let (_, strands, cards) = grid_cards(&CardOptions::default());
+    let atlas = &cards.atlas;
+    let [depth, coverage, tangent, attribute] = atlas.unreal_textures();
+    assert_eq!(depth.2, atlas.depth);
+    assert_eq!(coverage.2, atlas.coverage);
+    let texels = (atlas.width * atlas.height) as usize;
+    assert_eq!((tangent.1, tangent.2.len()), (3, 3 * texels));
+    assert_eq!((attribute.1, attribute.2.len()), (4, 4 * texels));
+    let mut covered = 0;
+    for i in (0..texels).filter(|&i| atlas.coverage[i] > 0) {
+        covered += 1;
+        let a = &attribute.2[4 * i..4 * i + 4];
+        assert_eq!((a[2], a[3]), (atlas.root_to_tip[i], atlas.id[i]));
+        let uv = [a[0] as f64 / 255.0, a[1] as f64 / 255.0];
+        assert!(
+            strands
+                .iter()
+                .any(|s| (s.root_uv.x - uv[0]).abs() <= 0.5 / 255.0 + 1e-9
+                    && (s.root_uv.y - uv[1]).abs() <= 0.5 / 255.0 + 1e-9),
+            "texel {i}: root uv {uv:?} is no strand's"
+        );
+        assert_eq!(
+            &tangent.2[3 * i..3 * i + 3],
+            &[atlas.flow[3 * i], atlas.flow[3 * i + 1], 128]
+        );
+    }
+    assert!(covered > 100, "{covered} covered texels");
+}

@@ -1,8 +1,10 @@
 //! Hair cards as binary glTF: one mesh of card strips (positions, normals, tangents, atlas
 //! uvs) with a material whose base colour is the baked albedo atlas (PNG, embedded; its alpha
 //! is the strands' coverage, so `alphaMode` is `MASK`), double-sided because a card is seen
-//! from both sides. The other baked maps go beside the file as PNGs and are named in the
-//! material's `extras`, since glTF has no slots for them.
+//! from both sides. glTF has no material slots for the other baked maps (coverage, depth,
+//! flow, root to tip, id): they are embedded too, as textures the material's
+//! `extras.hairloom_maps` names (`{"texture": index, "file": the same PNG beside the GLB}`),
+//! so a loader that reads extras finds them in the file itself.
 
 use crate::cards::CardMesh;
 use crate::io::strand_files::glb_container;
@@ -10,14 +12,17 @@ use crate::io::strand_files::glb_container;
 /// Names of the maps written beside a card file, in `extras.hairloom_maps`.
 pub const CARD_MAPS: [&str; 5] = ["coverage", "depth", "flow", "root_to_tip", "id"];
 
-/// The GLB of one level of detail, `albedo_png` embedded as its base colour; `maps` are the
-/// file names of the other maps (see [`CARD_MAPS`]) relative to the GLB.
-pub fn card_glb(
-    name: &str,
-    mesh: &CardMesh,
-    albedo_png: &[u8],
-    maps: &[(&str, String)],
-) -> Vec<u8> {
+/// One baked map embedded in a card GLB: its name (see [`CARD_MAPS`]), the file name of the
+/// same PNG beside the GLB, and the PNG.
+pub struct CardMap<'a> {
+    pub name: &'a str,
+    pub file: String,
+    pub png: &'a [u8],
+}
+
+/// The GLB of one level of detail, `albedo_png` embedded as its base colour and every map
+/// of `maps` as a texture named in the material's extras.
+pub fn card_glb(name: &str, mesh: &CardMesh, albedo_png: &[u8], maps: &[CardMap]) -> Vec<u8> {
     let mut bin: Vec<u8> = Vec::new();
     let mut views = Vec::new();
     let mut push_view = |bin: &mut Vec<u8>, bytes: &[u8], target: Option<u32>| {
@@ -72,11 +77,23 @@ pub fn card_glb(
         Some(ELEMENT_ARRAY_BUFFER),
     );
     let image = push_view(&mut bin, albedo_png, None);
-    let count = mesh.positions.len();
-    let extras: serde_json::Map<String, serde_json::Value> = maps
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.clone().into()))
+    let mut images = vec![serde_json::json!({"bufferView": image, "mimeType": "image/png"})];
+    let mut extras = serde_json::Map::new();
+    for map in maps {
+        let view = push_view(&mut bin, map.png, None);
+        images.push(
+            serde_json::json!({"bufferView": view, "mimeType": "image/png", "name": map.name}),
+        );
+        // Texture i shows image i (texture 0 is the albedo).
+        extras.insert(
+            map.name.to_string(),
+            serde_json::json!({"texture": images.len() - 1, "file": map.file}),
+        );
+    }
+    let textures: Vec<serde_json::Value> = (0..images.len())
+        .map(|i| serde_json::json!({"source": i, "sampler": 0}))
         .collect();
+    let count = mesh.positions.len();
     let json = serde_json::json!({
         "asset": {"version": "2.0", "generator": format!("hairloom {}", env!("CARGO_PKG_VERSION"))},
         "scene": 0,
@@ -98,11 +115,11 @@ pub fn card_glb(
             "doubleSided": true,
             "extras": {"hairloom_maps": extras}
         }],
-        "textures": [{"source": 0, "sampler": 0}],
+        "textures": textures,
         // Linear without mipmaps: tiles meet edge to edge, so coarser mip levels would blend
         // neighbouring cards (an engine that builds mipmaps should stop at the tile size).
         "samplers": [{"magFilter": 9729, "minFilter": 9729, "wrapS": 33071, "wrapT": 33071}],
-        "images": [{"bufferView": image, "mimeType": "image/png"}],
+        "images": images,
         "accessors": [
             {"bufferView": positions, "componentType": 5126, "count": count, "type": "VEC3", "min": lo, "max": hi},
             {"bufferView": normals, "componentType": 5126, "count": count, "type": "VEC3"},
