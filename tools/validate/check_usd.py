@@ -1,9 +1,12 @@
-"""Opens Hairloom .usda exports with Pixar's USD (PyPI usd-core) and checks their curves.
+"""Opens Hairloom .usda exports with Pixar's USD (PyPI usd-core) and checks their curves,
+then runs every validator usd-core registers (UsdValidation) on the stage.
 
 Usage: python check_usd.py FILE.usda...   Exits 1 on any problem."""
 import sys
 
-from pxr import Usd, UsdGeom
+from pxr import Usd, UsdGeom, UsdValidation
+
+VALIDATORS = UsdValidation.ValidationRegistry().GetOrLoadAllValidators()
 
 failed = False
 for path in sys.argv[1:]:
@@ -87,6 +90,13 @@ for path in sys.argv[1:]:
         and animated_ok
         and look_ok
     )
-    print(f"{path}: usd-core {Usd.GetVersion()}: {len(counts)} curves, {len(points)} points, {len(samples)} time sample(s){'' if ok else ' INCONSISTENT'}")
+    issues = [
+        e for e in UsdValidation.ValidationContext(VALIDATORS).Validate(stage)
+        if e.GetType() == UsdValidation.ValidationErrorType.Error
+    ]
+    ok = ok and not issues
+    print(f"{path}: usd-core {Usd.GetVersion()}: {len(counts)} curves, {len(points)} points, {len(samples)} time sample(s), {len(VALIDATORS)} validators: {len(issues)} errors{'' if ok else ' INCONSISTENT'}")
+    for e in issues[:10]:
+        print(f"  {e.GetName()}: {e.GetMessage()}")
     failed |= not ok
 sys.exit(1 if failed else 0)
