@@ -341,7 +341,7 @@ mod tests {
                 alembic: AlembicTarget::default(),
             },
             // Big bundles: the first one is still generating when Cancel arrives.
-            4096,
+            2048,
         );
         job.cancel();
         assert_eq!(job.wait(), Err("cancelled".into()));
