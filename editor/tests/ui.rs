@@ -280,8 +280,18 @@ fn menu_item<'a>(
 
 /// Clicks File ▸ `item`.
 fn file_menu(harness: &mut Harness<'static, HairloomApp>, item: &str) {
+    file_menu_path(harness, &[item]);
+}
+
+/// File ▸ `items[0]` ▸ … ▸ the last item: every item before the last opens a submenu.
+fn file_menu_path(harness: &mut Harness<'static, HairloomApp>, items: &[&str]) {
     harness.get_by_label("File").click();
     harness.run();
+    let (item, submenus) = items.split_last().expect("a menu item");
+    for submenu in submenus {
+        menu_item(harness, submenu).click();
+        harness.run();
+    }
     menu_item(harness, item).click();
     // Steps, not `run`: an export keeps repainting its progress bar.
     for _ in 0..4 {
@@ -455,14 +465,10 @@ fn a_groom_exports_for_the_client_picked_in_the_file_menu() {
         &fresh_recovery_dir(),
         ScriptedDialogs::new([DialogAnswer::Chosen(groom.clone())]),
     );
-    harness.get_by_label("File").click();
-    harness.run();
-    menu_item(&harness, "Export groom (.abc) for").click();
-    harness.run();
-    menu_item(&harness, "Unreal (z up, cm)").click();
-    for _ in 0..4 {
-        harness.step();
-    }
+    file_menu_path(
+        &mut harness,
+        &["Export groom (.abc) for", "Unreal (z up, cm)"],
+    );
     wait_for_export(&mut harness);
     assert_eq!(
         harness.state().alembic_target,

@@ -192,10 +192,17 @@ fn a_game_rebuilds_the_textures_of_a_moving_hair_mesh_from_the_bundle_and_the_do
     let bundles = manifest["bundles"].as_array().expect("bundles");
     let mut positions: Vec<Vec<DVec3>> = vec![Vec::new(); column_layers.len()];
     let mut faces = Vec::new();
+    // Each bundle's block corners: their texel and the column it holds.
+    let mut blocks: Vec<Vec<((u32, u32), usize)>> = Vec::new();
     for bundle in bundles {
         let origin: Vec<u32> = serde_json::from_value(bundle["origin"].clone()).expect("origin");
         let columns: Vec<usize> =
             serde_json::from_value(bundle["columns"].clone()).expect("columns");
+        let corners: Vec<((u32, u32), usize)> = offsets
+            .iter()
+            .zip(&columns)
+            .map(|(o, &c)| ((origin[0] + o[0], origin[1] + o[1]), c))
+            .collect();
         let corner_of_block: Vec<usize> =
             serde_json::from_value(bundle["corner_of_block"].clone()).expect("corners");
         let triangle = bundle["triangle"].as_bool().expect("triangle");
@@ -210,8 +217,7 @@ fn a_game_rebuilds_the_textures_of_a_moving_hair_mesh_from_the_bundle_and_the_do
                 .iter()
                 .position(|&c| c == f)
                 .expect("every face corner");
-            let (x, y) = (origin[0] + offsets[b][0], origin[1] + offsets[b][1]);
-            let c = columns[b];
+            let ((x, y), c) = corners[b];
             let uv = rest.uv.get(x, y, 0);
             face.columns.push(c);
             face.uvs.push(DVec2::new(uv.x as f64, uv.y as f64));
@@ -225,6 +231,7 @@ fn a_game_rebuilds_the_textures_of_a_moving_hair_mesh_from_the_bundle_and_the_do
             }
         }
         faces.push(face);
+        blocks.push(corners);
     }
     let bare_faces = manifest["bare_faces"].as_array().expect("the bald face");
     assert_eq!(bare_faces.len(), 1);
@@ -268,41 +275,32 @@ fn a_game_rebuilds_the_textures_of_a_moving_hair_mesh_from_the_bundle_and_the_do
         (hi - lo).length()
     };
     let (mut worst_position, mut worst_frame, mut texels) = (0.0f64, 0.0f64, 0);
-    for bundle in bundles {
-        let origin: Vec<u32> = serde_json::from_value(bundle["origin"].clone()).expect("origin");
-        let columns: Vec<usize> =
-            serde_json::from_value(bundle["columns"].clone()).expect("columns");
-        for (b, offset) in offsets.iter().enumerate() {
-            let (x, y) = (origin[0] + offset[0], origin[1] + offset[1]);
-            let c = columns[b];
-            let p = &positions[c];
-            let top = column_layers[c];
-            for k in 0..=max_layers {
-                let layer = k.min(top);
-                let check =
-                    |got: DVec3, want: glam::Vec4| (got - want.truncate().as_dvec3()).length();
-                let z = 3 * k as u32;
-                worst_position =
-                    worst_position.max(check(p[layer], expected.hair_mesh.get(x, y, z)));
-                if k < max_layers {
-                    let (q0, q1) = if k < top {
-                        control_points(p, k)
-                    } else {
-                        (p[top], p[top])
-                    };
-                    worst_position = worst_position
-                        .max(check(q0, expected.hair_mesh.get(x, y, z + 1)))
-                        .max(check(q1, expected.hair_mesh.get(x, y, z + 2)));
-                }
-                let (u, v) = frames[layer][&c];
-                worst_frame = worst_frame
-                    .max(check(u, expected.u.get(x, y, k as u32)))
-                    .max(check(v, expected.v.get(x, y, k as u32)));
-                // w is the styling coordinate: the rest values stay.
-                assert_eq!(rest.w.get(x, y, k as u32), expected.w.get(x, y, k as u32));
+    for &((x, y), c) in blocks.iter().flatten() {
+        let p = &positions[c];
+        let top = column_layers[c];
+        for k in 0..=max_layers {
+            let layer = k.min(top);
+            let check = |got: DVec3, want: glam::Vec4| (got - want.truncate().as_dvec3()).length();
+            let z = 3 * k as u32;
+            worst_position = worst_position.max(check(p[layer], expected.hair_mesh.get(x, y, z)));
+            if k < max_layers {
+                let (q0, q1) = if k < top {
+                    control_points(p, k)
+                } else {
+                    (p[top], p[top])
+                };
+                worst_position = worst_position
+                    .max(check(q0, expected.hair_mesh.get(x, y, z + 1)))
+                    .max(check(q1, expected.hair_mesh.get(x, y, z + 2)));
             }
-            texels += 1;
+            let (u, v) = frames[layer][&c];
+            worst_frame = worst_frame
+                .max(check(u, expected.u.get(x, y, k as u32)))
+                .max(check(v, expected.v.get(x, y, k as u32)));
+            // w is the styling coordinate: the rest values stay.
+            assert_eq!(rest.w.get(x, y, k as u32), expected.w.get(x, y, k as u32));
         }
+        texels += 1;
     }
     assert!(texels > 1000);
     assert!(

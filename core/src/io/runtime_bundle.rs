@@ -355,11 +355,7 @@ pub fn runtime_bundle(
 /// does not know its column (an atlas loaded from a bundle before format version 4).
 fn block_columns(atlas: &Atlas, block: &crate::runtime::atlas::BundleBlock) -> Option<[u32; 4]> {
     let mut columns = [0; 4];
-    for (column, [dx, dy]) in columns
-        .iter_mut()
-        .zip(crate::runtime::atlas::BLOCK_CORNER_OFFSETS)
-    {
-        let (x, y) = (block.origin[0] + dx as u32, block.origin[1] + dy as u32);
+    for (column, (x, y)) in columns.iter_mut().zip(block.corner_texels()) {
         *column = atlas
             .texels
             .get((y * atlas.width + x) as usize)
@@ -420,14 +416,10 @@ fn bundle_topology(
                 columns[2], columns[3]
             ));
         }
-        for (b, (&c, [dx, dy])) in columns
-            .iter()
-            .zip(crate::runtime::atlas::BLOCK_CORNER_OFFSETS)
-            .enumerate()
-        {
+        // The atlas's block i is bundles[i], its placement checked before.
+        let corners = atlas.blocks[i].corner_texels();
+        for (b, (&c, (x, y))) in columns.iter().zip(corners).enumerate() {
             column(c, &format!("bundles[{i}].columns[{b}]"), entry.layers)?;
-            // In range: the block placement was checked before.
-            let (x, y) = (entry.origin[0] + dx as u32, entry.origin[1] + dy as u32);
             let root_uv = uv.get(x, y, 0);
             let texel = &mut atlas.texels[(y * atlas.width + x) as usize];
             if let Some(held) = texel.filter(|t| t.column != c) {

@@ -118,6 +118,14 @@ struct Chart {
 
 /// Texel offsets of block corners 0-3.
 pub const BLOCK_CORNER_OFFSETS: [[i32; 2]; 4] = [[0, 0], [1, 0], [1, 1], [0, 1]];
+
+impl BundleBlock {
+    /// The texel `(x, y)` of each block corner (origin + [`BLOCK_CORNER_OFFSETS`]).
+    pub fn corner_texels(&self) -> [(u32, u32); 4] {
+        BLOCK_CORNER_OFFSETS
+            .map(|[dx, dy]| (self.origin[0] + dx as u32, self.origin[1] + dy as u32))
+    }
+}
 /// Cell step across block edge `e` (from block corner `e` to `e + 1`).
 const ACROSS_BLOCK_EDGE: [[i32; 2]; 4] = [[0, -1], [1, 0], [0, 1], [-1, 0]];
 
