@@ -13,7 +13,8 @@
 //! | [`runtime`] | the runtime asset ([`runtime::hair::RuntimeHair`]: textures, samples, placements, styling) and the CPU mirror of every shader |
 //! | [`cards`] | hair cards from bundles: card strips with the strands baked into an atlas |
 //! | [`fur`] | fur as shells and fins (seed 002): the strand volume, its shell and fin textures, lapped patches over any mesh |
-//! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) strand exports, Alembic grooms and card glTF |
+//! | [`fit`] | grooms made elsewhere turned into a hair mesh and styling, and the fit's measured error |
+//! | [`io`] | project files, glTF import, the runtime bundle (KTX2 + manifest) strand exports, Alembic grooms and card glTF, grooms read in |
 //! | [`samples`] | the bundled sample projects, built by code |
 //!
 //! This crate has no GPU or UI dependency; the f64 code here is the reference every faster
@@ -21,11 +22,13 @@
 
 pub mod cards;
 pub mod edit;
+pub mod fit;
 pub mod fur;
 pub mod geometry;
 pub mod io;
 pub mod light;
 pub mod model;
+pub mod parallel;
 pub mod runtime;
 pub mod samples;
 pub mod simulate;

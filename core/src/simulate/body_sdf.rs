@@ -31,6 +31,11 @@ enum Feature {
     Vertex(u8),
 }
 
+/// The closest point to `p` on triangle `abc` (groom fitting puts roots on a scalp with it).
+pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    closest_on_triangle(p, a, b, c).0
+}
+
 /// The closest point to `p` on triangle `abc` and the feature it lies on (Ericson 2004,
 /// "Real-Time Collision Detection" §5.1.5, by Voronoi regions).
 fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, Feature) {

@@ -270,34 +270,15 @@ pub fn generate_parallel(
     let context = StrandContext::new(document);
     let plan = StrandPlan::new(options);
     let bundle_count = document.hair_mesh.bundles.len();
-    let threads = threads.clamp(1, bundle_count.max(1));
-    if threads == 1 {
-        return (0..bundle_count)
+    let chunk = bundle_count.div_ceil(threads.max(1));
+    crate::parallel::in_chunks(bundle_count, chunk, threads, |range| {
+        range
             .flat_map(|i| plan.bundle_strands(&context, i))
-            .collect();
-    }
-    let chunk = bundle_count.div_ceil(threads);
-    let (context, plan) = (&context, &plan);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..bundle_count)
-            .step_by(chunk)
-            .map(|start| {
-                scope.spawn(move || {
-                    (start..(start + chunk).min(bundle_count))
-                        .flat_map(|i| plan.bundle_strands(context, i))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        // A worker panic is a bug: re-raise it here instead of returning fewer strands.
-        handles
-            .into_iter()
-            .flat_map(|h| {
-                h.join()
-                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-            })
-            .collect()
+            .collect::<Vec<_>>()
     })
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 #[cfg(test)]

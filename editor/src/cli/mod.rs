@@ -19,6 +19,7 @@ mod bench_crowd;
 mod bench_effects;
 mod bench_shading;
 mod bench_sim;
+mod fit;
 mod render;
 mod simulate;
 
@@ -69,6 +70,10 @@ enum Command {
         #[arg(long)]
         max_vertices: Option<usize>,
     },
+    /// Fit an editable hair mesh and styling to a groom made elsewhere (.abc, .usda, .usdc,
+    /// .usdz or .hair) and print its error against the input (closest-point distances both
+    /// ways, root placement, strand length, time).
+    Fit(fit::FitArgs),
     /// Export the runtime bundle (manifest + KTX2 textures), strands for other tools and/or
     /// hair cards.
     Export {
@@ -241,6 +246,7 @@ pub fn main() -> ExitCode {
             generate_uv,
             max_vertices,
         }) => import(&scalp, &out, mesh, scale, generate_uv, max_vertices),
+        Some(Command::Fit(args)) => fit::run(args),
         Some(Command::Export {
             project,
             runtime,

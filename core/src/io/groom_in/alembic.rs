@@ -1,0 +1,301 @@
+//! Alembic grooms through `ogawa-rs`: every `ICurves` object (plain curves as Blender,
+//! Houdini and Maya write them, and Unreal's groom schema). Unreal's guide curves
+//! (`groom_guide` = 1) are skipped: they drive simulation, they are not hair. Widths come
+//! from `width` (or `groom_width`), root uv from `groom_root_uv` (or the curves' `uv`),
+//! groups from `groom_group_id`; the first time sample is read.
+//!
+//! `ogawa-rs` trusts the sizes a file states (it allocates what a blob header claims) and has
+//! `todo!()`s for some types, so before it sees a file, [`check_ogawa_tree`] walks the whole
+//! Ogawa tree and refuses any blob or group that does not fit inside the file; a panic left
+//! in the crate becomes a named error ([`without_panics`]).
+//!
+//! Not read: transforms (`ogawa-rs` 0.4 reads no `IXform` samples). A non-identity
+//! transform above a curves object is reported in the groom's notes.
+
+use std::io::{Cursor, Read, Seek, SeekFrom};
+use std::ops::ControlFlow;
+use std::path::Path;
+
+use ogawa_rs::{Archive, ArchiveReader, ObjectReader, PodArray, PropertyReader, Schema};
+
+use super::{GroomBuilder, GroomLimits, GroomReadError, InputGroom, without_panics};
+
+/// Deepest object hierarchy and most Ogawa nodes walked.
+const MAX_DEPTH: usize = 64;
+const MAX_NODES: usize = 1 << 22;
+const DATA_BIT: u64 = 1 << 63;
+
+/// A file held in memory, as `ogawa-rs` reads one.
+struct BytesReader(Cursor<Vec<u8>>);
+
+impl Read for BytesReader {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        self.0.read(buf)
+    }
+}
+
+impl Seek for BytesReader {
+    fn seek(&mut self, pos: SeekFrom) -> std::io::Result<u64> {
+        self.0.seek(pos)
+    }
+}
+
+impl ArchiveReader for BytesReader {
+    fn size(&self) -> u64 {
+        self.0.get_ref().len() as u64
+    }
+}
+
+/// Parses Alembic bytes (`path` only names the file in errors).
+pub fn parse(
+    path: &Path,
+    bytes: Vec<u8>,
+    limits: GroomLimits,
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<InputGroom, GroomReadError> {
+    check_ogawa_tree(&bytes).map_err(|message| GroomReadError::Format {
+        file: path.display().to_string(),
+        message,
+    })?;
+    without_panics(path, "the Alembic reader", move || {
+        let mut builder = GroomBuilder::new(path, limits, progress);
+        let mut reader = BytesReader(Cursor::new(bytes));
+        let archive = Archive::new(&mut reader)
+            .map_err(|e| builder.format_error(format!("not an Alembic archive: {e:?}")))?;
+        let root = archive
+            .load_root_object(&mut reader)
+            .map_err(|e| builder.format_error(format!("no root object: {e:?}")))?;
+        let mut walk = Walk {
+            reader: &mut reader,
+            archive: &archive,
+            builder: &mut builder,
+            guides_skipped: 0,
+            transforms_ignored: 0,
+        };
+        walk.object(&root, 0, false)?;
+        let (guides, transforms) = (walk.guides_skipped, walk.transforms_ignored);
+        if guides > 0 {
+            builder.note(format!("{guides} guide curves skipped"));
+        }
+        if transforms > 0 {
+            builder.note(format!(
+                "{transforms} non-identity transforms above curves were not applied (ogawa-rs reads no transform samples): apply transforms before exporting"
+            ));
+        }
+        builder.note("Alembic (Ogawa)");
+        builder.finish()
+    })
+}
+
+/// Walks every group and data blob reachable from the root, refusing sizes and offsets that
+/// do not fit in the file, so no later read can allocate more than the file holds.
+pub fn check_ogawa_tree(bytes: &[u8]) -> Result<(), String> {
+    if bytes.len() < 16 || &bytes[..5] != b"Ogawa" {
+        return Err("not an Alembic (Ogawa) file".into());
+    }
+    let len = bytes.len() as u64;
+    let u64_at = |at: u64| -> Option<u64> {
+        let at = usize::try_from(at).ok()?;
+        let slice = bytes.get(at..at.checked_add(8)?)?;
+        Some(u64::from_le_bytes(slice.try_into().ok()?))
+    };
+    let root = u64_at(8).ok_or("truncated header")?;
+    let mut stack = vec![root];
+    let mut seen = std::collections::HashSet::new();
+    while let Some(offset) = stack.pop() {
+        if seen.len() > MAX_NODES {
+            return Err(format!("more than {MAX_NODES} Ogawa nodes"));
+        }
+        if !seen.insert(offset) {
+            continue;
+        }
+        if offset & DATA_BIT != 0 {
+            let at = offset & !DATA_BIT;
+            if at == 0 {
+                continue; // empty data
+            }
+            let size = u64_at(at).ok_or_else(|| format!("data at {at} lies outside the file"))?;
+            if size > len || at + 8 > len - size {
+                return Err(format!(
+                    "data at {at} claims {size} bytes, past the file's end"
+                ));
+            }
+        } else {
+            if offset == 0 {
+                continue; // empty group
+            }
+            let count =
+                u64_at(offset).ok_or_else(|| format!("group at {offset} lies outside the file"))?;
+            if count > len / 8 || offset + 8 > len - 8 * count {
+                return Err(format!(
+                    "group at {offset} claims {count} children, past the file's end"
+                ));
+            }
+            for k in 0..count {
+                stack.push(u64_at(offset + 8 + 8 * k).ok_or("group child outside the file")?);
+            }
+        }
+    }
+    Ok(())
+}
+
+struct Walk<'a, 'b> {
+    reader: &'a mut BytesReader,
+    archive: &'a Archive,
+    builder: &'a mut GroomBuilder<'b>,
+    guides_skipped: usize,
+    transforms_ignored: usize,
+}
+
+impl Walk<'_, '_> {
+    fn error(&self, object: &ObjectReader, what: &str, e: impl std::fmt::Debug) -> GroomReadError {
+        self.builder
+            .format_error(format!("{}: {what}: {e:?}", object.header.full_name))
+    }
+
+    fn object(
+        &mut self,
+        object: &ObjectReader,
+        depth: usize,
+        transformed: bool,
+    ) -> Result<(), GroomReadError> {
+        if depth > MAX_DEPTH {
+            return Err(self
+                .builder
+                .format_error(format!("objects nest deeper than {MAX_DEPTH}")));
+        }
+        let schema = object.header.meta_data.tokens.get("schema").cloned();
+        let mut transformed = transformed;
+        match schema.as_deref() {
+            Some("AbcGeom_Curve_v2") => {
+                if transformed {
+                    self.transforms_ignored += 1;
+                }
+                self.curves(object)?;
+            }
+            Some("AbcGeom_Xform_v3") => {
+                if let Ok(Schema::Xform(xform)) = Schema::parse(object, self.reader, self.archive)
+                    && !xform.is_constant_identity()
+                {
+                    transformed = true;
+                }
+            }
+            _ => {}
+        }
+        for i in 0..object.child_count() {
+            let child = object
+                .load_child(
+                    i,
+                    self.reader,
+                    &self.archive.indexed_meta_data,
+                    &self.archive.time_samplings,
+                )
+                .map_err(|e| self.error(object, "child", e))?;
+            self.object(&child, depth + 1, transformed)?;
+        }
+        Ok(())
+    }
+
+    /// The array `name` of the curves' `.arbGeomParams`, first sample.
+    fn arb_param(&mut self, object: &ObjectReader, name: &str) -> Option<PodArray> {
+        let props = object.properties()?;
+        let geom = match props
+            .load_sub_property_by_name(".geom", self.reader, self.archive)
+            .ok()??
+        {
+            PropertyReader::Compound(c) => c,
+            _ => return None,
+        };
+        let params = match geom
+            .load_sub_property_by_name(".arbGeomParams", self.reader, self.archive)
+            .ok()??
+        {
+            PropertyReader::Compound(c) => c,
+            _ => return None,
+        };
+        match params
+            .load_sub_property_by_name(name, self.reader, self.archive)
+            .ok()??
+        {
+            PropertyReader::Array(a) => a.load_sample(0, self.reader).ok(),
+            _ => None,
+        }
+    }
+
+    fn curves(&mut self, object: &ObjectReader) -> Result<(), GroomReadError> {
+        let Schema::Curves(curves) = Schema::parse(object, self.reader, self.archive)
+            .map_err(|e| self.error(object, "curves", e))?
+        else {
+            return Ok(());
+        };
+        let counts = curves
+            .load_n_vertices_sample(0, self.reader)
+            .map_err(|e| self.error(object, "nVertices", e))?;
+        let points = curves
+            .load_positions_sample(0, self.reader)
+            .map_err(|e| self.error(object, "P", e))?;
+        let total: i64 = counts.iter().map(|&c| i64::from(c.max(0))).sum();
+        if counts.iter().any(|&c| c < 0) || total != points.len() as i64 {
+            return Err(self.builder.format_error(format!(
+                "{}: nVertices add up to {total} (or hold a negative count) but P has {} points",
+                object.header.full_name,
+                points.len()
+            )));
+        }
+        let curve_count = counts.len();
+        let per_curve_i32 = |array: Option<PodArray>| match array {
+            Some(PodArray::I32(v)) if v.len() == curve_count => Some(v),
+            _ => None,
+        };
+        let guide = per_curve_i32(self.arb_param(object, "groom_guide"));
+        let groups = per_curve_i32(self.arb_param(object, "groom_group_id"));
+        let widths = match curves.load_widths_sample(0, self.reader).ok().flatten() {
+            Some(w) => Some(w),
+            None => match self.arb_param(object, "groom_width") {
+                Some(PodArray::F32(w)) => Some(w),
+                _ => None,
+            },
+        };
+        let root_uvs: Option<Vec<[f32; 2]>> = match self.arb_param(object, "groom_root_uv") {
+            Some(PodArray::F32(v)) if v.len() == 2 * curve_count => {
+                Some(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+            }
+            _ => None,
+        };
+        self.builder
+            .expect(curve_count as u64, points.len() as u64)?;
+        let mut first = 0usize;
+        let mut curve_widths = Vec::new();
+        for (i, &count) in counts.iter().enumerate() {
+            let span = first..first + count as usize;
+            first = span.end;
+            if guide.as_ref().is_some_and(|g| g[i] != 0) {
+                self.guides_skipped += 1;
+                continue;
+            }
+            curve_widths.clear();
+            let have_widths = match &widths {
+                Some(w) if w.len() == points.len() => {
+                    curve_widths.extend_from_slice(&w[span.clone()]);
+                    true
+                }
+                Some(w) if w.len() == curve_count => {
+                    curve_widths.resize(span.len(), w[i]);
+                    true
+                }
+                Some(w) if w.len() == 1 => {
+                    curve_widths.resize(span.len(), w[0]);
+                    true
+                }
+                _ => false,
+            };
+            self.builder.push(
+                points[span].iter().copied(),
+                have_widths.then_some(curve_widths.as_slice()),
+                root_uvs.as_ref().map(|uv| uv[i]),
+                groups.as_ref().map(|g| g[i]),
+            )?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,260 @@
+//! The readers on our own exports (every format holds the same strands) and on hostile
+//! bytes (named errors, never a panic).
+
+use std::ops::ControlFlow;
+use std::path::Path;
+
+use super::*;
+
+fn no_progress() -> impl FnMut(f64) -> ControlFlow<()> {
+    |_| ControlFlow::Continue(())
+}
+
+use crate::io::alembic::groom::Groom;
+use crate::io::alembic::{AlembicTarget, groom_file};
+use crate::io::strand_files::{ScalpMesh, StrandLook, hair_file, usda_file};
+use crate::model::document::Document;
+use crate::samples::{grid_scalp, straight_layers};
+use crate::strands::reference::{Strand, StrandOptions, generate};
+
+fn strands() -> (Document, Vec<Strand>) {
+    let scalp = grid_scalp(3, 2, |s, t| glam::DVec3::new(0.1 * s, 0.0, 0.08 * t));
+    let mesh = straight_layers(scalp, 4, glam::DVec3::new(0.01, 0.03, 0.0));
+    let document = Document::new("grid", mesh);
+    let options = StrandOptions {
+        strands_per_bundle: 8,
+        vertices_log2: 3,
+        ..StrandOptions::default()
+    };
+    let strands = generate(&document, &options);
+    (document, strands)
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> std::path::PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).expect("write");
+    path
+}
+
+/// Every format holds the same strands, points within f32 rounding, widths where written.
+#[test]
+fn our_exports_read_back_in_every_format() {
+    let (document, strands) = strands();
+    let look = StrandLook::new(&strands, 8e-5, &document.scene.material);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let groom = Groom::new(&document, &strands, 8e-5);
+    let files = [
+        write(dir.path(), "g.hair", &hair_file(&strands, &look)),
+        write(
+            dir.path(),
+            "g.usda",
+            usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), &look).as_bytes(),
+        ),
+        write(
+            dir.path(),
+            "g.abc",
+            &groom_file(&groom, AlembicTarget::Blender).expect("abc"),
+        ),
+    ];
+    for file in &files {
+        let read = read_groom(file, GroomLimits::default(), &mut no_progress())
+            .unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        assert_eq!(read.curve_count(), strands.len(), "{}", file.display());
+        for (i, strand) in strands.iter().enumerate() {
+            let curve = read.curve(i);
+            assert_eq!(curve.len(), strand.points.len());
+            for (p, q) in curve.iter().zip(&strand.points) {
+                let d = glam::Vec3::from_array(*p).as_dvec3() - *q;
+                assert!(
+                    d.length() < 1e-6,
+                    "{}: curve {i} off by {}",
+                    file.display(),
+                    d.length()
+                );
+            }
+        }
+        let widths = read.widths_m.as_ref().expect("widths");
+        assert_eq!(widths.len(), read.points.len());
+        assert!((widths[0] - 8e-5).abs() < 1e-9, "root width {}", widths[0]);
+    }
+}
+
+fn parse_hair(bytes: &[u8]) -> Result<InputGroom, GroomReadError> {
+    hair::parse(
+        Path::new("x.hair"),
+        bytes,
+        GroomLimits::default(),
+        &mut no_progress(),
+    )
+}
+
+fn hair_bytes(counts: &[u16], points: &[[f32; 3]], declared_points: u32) -> Vec<u8> {
+    let mut out = b"HAIR".to_vec();
+    out.extend_from_slice(&(counts.len() as u32).to_le_bytes());
+    out.extend_from_slice(&declared_points.to_le_bytes());
+    out.extend_from_slice(&3u32.to_le_bytes()); // segments + points
+    out.extend_from_slice(&0u32.to_le_bytes());
+    out.extend_from_slice(&[0u8; 20]);
+    out.extend_from_slice(&[0u8; 88]);
+    for c in counts {
+        out.extend_from_slice(&c.to_le_bytes());
+    }
+    for p in points {
+        for c in p {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    out
+}
+
+#[test]
+fn hostile_hair_files_get_named_errors() {
+    let good = [[0.0f32, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    assert!(parse_hair(&hair_bytes(&[1], &good, 2)).is_ok());
+    // NaN point: named with its curve and point.
+    let nan = [[0.0f32, 0.0, 0.0], [f32::NAN, 1.0, 0.0]];
+    match parse_hair(&hair_bytes(&[1], &nan, 2)) {
+        Err(GroomReadError::NonFinite {
+            curve: 0, point: 1, ..
+        }) => {}
+        other => panic!("{other:?}"),
+    }
+    // A one-point curve (0 segments).
+    match parse_hair(&hair_bytes(&[0, 1], &[[0.0; 3], [0.0; 3], [1.0; 3]], 3)) {
+        Err(GroomReadError::SinglePointCurve { curve: 0, .. }) => {}
+        other => panic!("{other:?}"),
+    }
+    // The header promises more points than the file holds: refused before reading them.
+    match parse_hair(&hair_bytes(&[1], &good, 4_000_000)) {
+        Err(GroomReadError::Format { message, .. }) => assert!(message.contains("promises")),
+        other => panic!("{other:?}"),
+    }
+    // Absurd counts: over the caps, refused from the header alone.
+    match parse_hair(&hair_bytes(&[1], &good, u32::MAX)) {
+        Err(GroomReadError::TooMany { what: "points", .. }) => {}
+        other => panic!("{other:?}"),
+    }
+    // Not a .hair file, and an empty one.
+    assert!(matches!(
+        parse_hair(b"nonsense"),
+        Err(GroomReadError::Format { .. })
+    ));
+    match parse_hair(&hair_bytes(&[], &[], 0)) {
+        Err(GroomReadError::NoCurves { .. }) => {}
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn hostile_alembic_files_get_named_errors_not_panics() {
+    let (document, strands) = strands();
+    let groom = Groom::new(&document, &strands, 8e-5);
+    let bytes = groom_file(&groom, AlembicTarget::Blender).expect("abc");
+    let parse = |bytes: Vec<u8>| {
+        alembic::parse(
+            Path::new("x.abc"),
+            bytes,
+            GroomLimits::default(),
+            &mut no_progress(),
+        )
+    };
+    assert!(parse(bytes.clone()).is_ok());
+    // Every truncation and a sweep of corrupted bytes: an error or a groom, never a panic
+    // (a panic would fail this test) and never an allocation past the file's size.
+    for cut in (0..bytes.len()).step_by(bytes.len() / 97 + 1) {
+        let _ = parse(bytes[..cut].to_vec());
+    }
+    for at in (16..bytes.len()).step_by(bytes.len() / 211 + 1) {
+        let mut bad = bytes.clone();
+        bad[at] ^= 0xff;
+        let _ = parse(bad);
+    }
+    // A blob that claims more bytes than the file has is refused by the tree check.
+    let mut huge = bytes.clone();
+    let root = u64::from_le_bytes(huge[8..16].try_into().expect("8 bytes")) as usize;
+    huge[root..root + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+    match parse(huge) {
+        Err(GroomReadError::Format { message, .. }) => {
+            assert!(message.contains("past the file's end"), "{message}")
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        parse(b"not alembic".to_vec()),
+        Err(GroomReadError::Format { .. })
+    ));
+}
+
+#[test]
+fn a_usd_stage_reads_nothing_outside_its_folder() {
+    let outside = tempfile::tempdir().expect("temp dir");
+    let secret = write(
+        outside.path(),
+        "secret.usda",
+        b"#usda 1.0\n(\n    defaultPrim = \"Hair\"\n)\ndef BasisCurves \"Hair\" {\n int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0), (0,1,0)]\n}\n",
+    );
+    let dir = tempfile::tempdir().expect("temp dir");
+    let stage = format!(
+        "#usda 1.0\ndef \"Root\" (\n    references = @{}@\n)\n{{\n}}\n",
+        secret.display()
+    );
+    let file = write(dir.path(), "groom.usda", stage.as_bytes());
+    match read_groom(&file, GroomLimits::default(), &mut no_progress()) {
+        Err(GroomReadError::NoCurves { .. }) | Err(GroomReadError::Format { .. }) => {}
+        Ok(groom) => panic!(
+            "read {} curves through a reference outside the folder",
+            groom.curve_count()
+        ),
+        Err(other) => panic!("{other}"),
+    }
+    // The same reference inside the folder is followed.
+    let inside = write(
+        dir.path(),
+        "hair.usda",
+        &std::fs::read(&secret).expect("read"),
+    );
+    let stage = "#usda 1.0\ndef \"Root\" (\n    references = @./hair.usda@\n)\n{\n}\n";
+    let _ = inside;
+    let file = write(dir.path(), "groom2.usda", stage.as_bytes());
+    let groom = read_groom(&file, GroomLimits::default(), &mut no_progress()).expect("reads");
+    assert_eq!(groom.curve_count(), 1);
+}
+
+#[test]
+fn usd_curve_counts_that_do_not_add_up_are_named() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = write(
+        dir.path(),
+        "bad.usda",
+        b"#usda 1.0\ndef BasisCurves \"Hair\" {\n int[] curveVertexCounts = [3]\n point3f[] points = [(0,0,0), (0,1,0)]\n}\n",
+    );
+    match read_groom(&file, GroomLimits::default(), &mut no_progress()) {
+        Err(GroomReadError::Format { message, .. }) => {
+            assert!(message.contains("add up"), "{message}")
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn reading_can_be_cancelled_and_unknown_extensions_are_named() {
+    let points: Vec<[f32; 3]> = (0..20_000)
+        .flat_map(|i| [[i as f32, 0.0, 0.0], [i as f32, 1.0, 0.0]])
+        .collect();
+    let bytes = hair_bytes(&vec![1; 10_000], &points, 20_000);
+    let cancelled = hair::parse(
+        Path::new("x.hair"),
+        &bytes,
+        GroomLimits::default(),
+        &mut |_| ControlFlow::Break(()),
+    );
+    assert!(matches!(cancelled, Err(GroomReadError::Cancelled { .. })));
+    assert!(matches!(
+        read_groom(
+            Path::new("groom.obj"),
+            GroomLimits::default(),
+            &mut no_progress()
+        ),
+        Err(GroomReadError::UnknownFormat { .. })
+    ));
+}

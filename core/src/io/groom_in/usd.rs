@@ -1,0 +1,318 @@
+//! USD grooms: every `BasisCurves` prim of the composed stage (`.usda`, `.usdc`, `.usdz`),
+//! read through `openusd`, a pure-Rust USD library with composition (no C++ USD to build,
+//! and it reads all three encodings). Points go through the prim's world transform; widths
+//! (constant, per curve or per point) and the root uv primvar `surface_uv_coordinate`
+//! (Blender's and ours) are kept; each prim is a group.
+//!
+//! A stage may name other layers (references, payloads, sublayers). They are read only from
+//! inside the groom's own folder, as every input file's references are
+//! (`docs/resource-policy.md`): the resolver refuses any other path.
+
+use std::io;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+use openusd::ar::{self, Asset, ResolvedPath, Resolver};
+use openusd::gf;
+use openusd::schemas::geom::{BasisCurves, Xform, Xformable};
+use openusd::sdf;
+use openusd::usd::{Prim, Stage, TimeCode};
+
+use super::{GroomBuilder, GroomLimits, GroomReadError, InputGroom, without_panics};
+use crate::io::input_files::{InputFolder, read_regular_file};
+
+/// Most prims walked, so a stage of millions of empty prims cannot run unbounded.
+const MAX_PRIMS: usize = 1 << 20;
+
+/// The default resolver, limited to regular files inside one folder and under a size cap.
+struct FolderResolver {
+    inner: ar::DefaultResolver,
+    folder: PathBuf,
+    cap_bytes: u64,
+}
+
+impl FolderResolver {
+    fn inside(&self, resolved: &Path) -> bool {
+        // A package-relative path (`pkg.usdz[inner]`) is checked by its package.
+        let text = resolved.to_string_lossy();
+        let outer = text.split('[').next().unwrap_or("");
+        std::fs::canonicalize(outer)
+            .map(|p| p.starts_with(&self.folder))
+            .unwrap_or(false)
+    }
+}
+
+impl Resolver for FolderResolver {
+    fn create_identifier(&self, asset_path: &str, anchor: Option<&ResolvedPath>) -> String {
+        self.inner.create_identifier(asset_path, anchor)
+    }
+
+    fn resolve(&self, asset_path: &str) -> Option<ResolvedPath> {
+        let resolved = self.inner.resolve(asset_path)?;
+        self.inside(&resolved).then_some(resolved)
+    }
+
+    fn resolve_for_new_asset(&self, _asset_path: &str) -> Option<ResolvedPath> {
+        None
+    }
+
+    fn open_asset(&self, resolved_path: &ResolvedPath) -> io::Result<Box<dyn Asset>> {
+        let refused = || {
+            io::Error::new(
+                io::ErrorKind::PermissionDenied,
+                "only regular files inside the groom's folder are read",
+            )
+        };
+        if !self.inside(resolved_path) {
+            return Err(refused());
+        }
+        let text = resolved_path.to_string_lossy();
+        let outer = text.split('[').next().unwrap_or("");
+        let metadata = std::fs::metadata(outer)?;
+        if !metadata.is_file() {
+            return Err(refused());
+        }
+        if metadata.len() > self.cap_bytes {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("larger than the cap of {} bytes", self.cap_bytes),
+            ));
+        }
+        self.inner.open_asset(resolved_path)
+    }
+
+    fn identity(&self) -> String {
+        format!("hairloom-folder:{}", self.folder.display())
+    }
+}
+
+pub fn read(
+    path: &Path,
+    limits: GroomLimits,
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<InputGroom, GroomReadError> {
+    // The named file itself: a regular file under the cap (this also refuses FIFOs and
+    // devices before the USD library opens it).
+    let probe = read_regular_file(path, limits.max_file_bytes, "a groom").map(|_| ());
+    probe?;
+    let folder = InputFolder::of_file(path)?;
+    let canonical_folder = std::fs::canonicalize(folder.path()).map_err(|source| {
+        crate::io::input_files::InputFileError::Io {
+            path: folder.path().display().to_string(),
+            source,
+        }
+    })?;
+    let root = std::fs::canonicalize(path).map_err(|source| {
+        crate::io::input_files::InputFileError::Io {
+            path: path.display().to_string(),
+            source,
+        }
+    })?;
+    without_panics(path, "the USD reader", || {
+        read_stage(path, &root, canonical_folder, limits, progress)
+    })
+}
+
+fn read_stage(
+    path: &Path,
+    root: &Path,
+    folder: PathBuf,
+    limits: GroomLimits,
+    progress: &mut dyn FnMut(f64) -> ControlFlow<()>,
+) -> Result<InputGroom, GroomReadError> {
+    let mut builder = GroomBuilder::new(path, limits, progress);
+    let resolver = FolderResolver {
+        inner: ar::DefaultResolver::with_search_paths([folder.clone()]),
+        folder,
+        cap_bytes: limits.max_file_bytes,
+    };
+    let stage = Stage::builder()
+        .resolver(resolver)
+        .open(&root.to_string_lossy())
+        .map_err(|e| builder.format_error(format!("not a USD stage: {e:#}")))?;
+    let usd_error =
+        |builder: &GroomBuilder, e: anyhow::Error| builder.format_error(format!("{e:#}"));
+    let mut stack = vec![stage.prim(sdf::Path::abs_root())];
+    let mut walked = 0usize;
+    let mut curve_prims = 0i32;
+    let mut skipped_types = std::collections::BTreeSet::new();
+    while let Some(prim) = stack.pop() {
+        walked += 1;
+        if walked > MAX_PRIMS {
+            return Err(GroomReadError::TooMany {
+                file: builder.file().to_string(),
+                what: "prims",
+                count: walked as u64,
+                cap: MAX_PRIMS as u64,
+            });
+        }
+        let type_name = prim
+            .type_name()
+            .map_err(|e| usd_error(&builder, e))?
+            .map(|t| t.as_str().to_string())
+            .unwrap_or_default();
+        match type_name.as_str() {
+            "BasisCurves" => {
+                read_curves(&stage, &prim, curve_prims, &mut builder)?;
+                curve_prims += 1;
+            }
+            "NurbsCurves" | "HermiteCurves" => {
+                skipped_types.insert(type_name);
+            }
+            _ => {}
+        }
+        let mut children = prim.children().map_err(|e| usd_error(&builder, e))?;
+        children.reverse();
+        stack.extend(children);
+    }
+    for skipped in skipped_types {
+        builder.note(format!("{skipped} prims are not read (only BasisCurves)"));
+    }
+    builder.note(format!("USD: {curve_prims} BasisCurves prims"));
+    builder.finish()
+}
+
+/// The value of `attribute` at its default time, or at its first time sample.
+fn value_of<T>(prim: &Prim, attribute: &str) -> anyhow::Result<Option<T>>
+where
+    T: TryFrom<sdf::Value>,
+    T::Error: std::error::Error + Send + Sync + 'static,
+{
+    let attribute = prim.attribute(attribute);
+    if let Some(value) = attribute.get::<T>()? {
+        return Ok(Some(value));
+    }
+    match attribute.time_sample_times()?.first() {
+        Some(&t) => attribute.get_at::<T>(TimeCode::new(t)),
+        None => Ok(None),
+    }
+}
+
+/// The world transform of `prim`: its own and every ancestor Xform's local transforms.
+fn world_transform(stage: &Stage, prim: &Prim) -> anyhow::Result<gf::Matrix4d> {
+    let mut matrix = gf::Matrix4d::IDENTITY;
+    let mut path = Some(prim.path().clone());
+    while let Some(p) = path {
+        let local = if let Some(curves) = BasisCurves::get(stage, p.clone())? {
+            Some((
+                curves.local_to_parent_transform(TimeCode::EARLIEST)?,
+                curves.resets_xform_stack()?,
+            ))
+        } else if let Some(xform) = Xform::get(stage, p.clone())? {
+            Some((
+                xform.local_to_parent_transform(TimeCode::EARLIEST)?,
+                xform.resets_xform_stack()?,
+            ))
+        } else {
+            None
+        };
+        if let Some((local, resets)) = local {
+            // Row vectors: a point is p · M_local · M_parent …
+            matrix = matrix * local;
+            if resets {
+                break;
+            }
+        }
+        path = p.parent();
+    }
+    Ok(matrix)
+}
+
+fn read_curves(
+    stage: &Stage,
+    prim: &Prim,
+    group: i32,
+    builder: &mut GroomBuilder,
+) -> Result<(), GroomReadError> {
+    let name = prim.path().as_str().to_string();
+    let error = |builder: &GroomBuilder, message: String| {
+        builder.format_error(format!("{name}: {message}"))
+    };
+    let points: Vec<[f32; 3]> = value_of(prim, "points")
+        .map_err(|e| error(builder, format!("points: {e:#}")))?
+        .unwrap_or_default();
+    let counts: Vec<i64> = match prim
+        .attribute("curveVertexCounts")
+        .get::<sdf::Value>()
+        .map_err(|e| error(builder, format!("curveVertexCounts: {e:#}")))?
+    {
+        Some(sdf::Value::IntVec(v)) => v.into_iter().map(i64::from).collect(),
+        Some(sdf::Value::Int64Vec(v)) => v,
+        Some(other) => {
+            return Err(error(
+                builder,
+                format!("curveVertexCounts is not an int array ({other:?})"),
+            ));
+        }
+        None => return Err(error(builder, "has no curveVertexCounts".into())),
+    };
+    let total: i64 = counts.iter().map(|&c| c.max(0)).sum();
+    if counts.iter().any(|&c| c < 0) || total != points.len() as i64 {
+        return Err(error(
+            builder,
+            format!(
+                "curveVertexCounts add up to {total} (or hold a negative count) but there are {} points",
+                points.len()
+            ),
+        ));
+    }
+    builder.expect(counts.len() as u64, points.len() as u64)?;
+    let transform =
+        world_transform(stage, prim).map_err(|e| error(builder, format!("transform: {e:#}")))?;
+    let identity = transform == gf::Matrix4d::IDENTITY;
+    let widths: Vec<f32> = value_of(prim, "widths")
+        .map_err(|e| error(builder, format!("widths: {e:#}")))?
+        .unwrap_or_default();
+    // Widths scale with the transform's mean scale (the cube root of its determinant).
+    let scale = if identity {
+        1.0
+    } else {
+        let m = &transform.0;
+        let det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8])
+            + m[2] * (m[4] * m[9] - m[5] * m[8]);
+        det.abs().cbrt() as f32
+    };
+    let uvs: Vec<[f32; 2]> = value_of(prim, "primvars:surface_uv_coordinate")
+        .ok()
+        .flatten()
+        .unwrap_or_default();
+    let mut first = 0usize;
+    let mut curve_widths = Vec::new();
+    for (i, &count) in counts.iter().enumerate() {
+        let count = count as usize;
+        let span = first..first + count;
+        curve_widths.clear();
+        let have_widths = if widths.len() == points.len() {
+            curve_widths.extend(widths[span.clone()].iter().map(|w| w * scale));
+            true
+        } else if widths.len() == counts.len() {
+            curve_widths.resize(count, widths[i] * scale);
+            true
+        } else if widths.len() == 1 {
+            curve_widths.resize(count, widths[0] * scale);
+            true
+        } else {
+            false
+        };
+        let curve = points[span].iter().map(|&p| {
+            if identity {
+                p
+            } else {
+                let q = transform.transform_point(gf::Vec3f {
+                    x: p[0],
+                    y: p[1],
+                    z: p[2],
+                });
+                [q.x, q.y, q.z]
+            }
+        });
+        builder.push(
+            curve,
+            have_widths.then_some(curve_widths.as_slice()),
+            (uvs.len() == counts.len()).then(|| uvs[i]),
+            Some(group),
+        )?;
+        first += count;
+    }
+    Ok(())
+}
