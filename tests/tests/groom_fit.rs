@@ -39,11 +39,22 @@ fn fit_and_measure(groom: &InputGroom, scalp: ScalpSource, name: &str) -> FitRep
     measure(groom, &fitted, &MeasureOptions::default())
 }
 
+/// Strand length per bundle, within this share of the input's on the head samples (2.8 %
+/// on the curly one, whose helices are 2 × their axis; the teapot's fur misses by 23 %,
+/// noted on the issue).
+const HEAD_LENGTH_TARGET: f64 = 0.10;
+
 fn check(report: &FitReport, what: &str) {
     println!("{what}\n{}", report.summary());
     assert!(
         report.pooled.mean <= MEAN_TARGET && report.pooled.p95 <= P95_TARGET,
         "{what} misses the targets:\n{}",
+        report.summary()
+    );
+    assert!(
+        !what.starts_with("head") || report.length_error <= HEAD_LENGTH_TARGET,
+        "{what}: strand length off by more than {} %:\n{}",
+        100.0 * HEAD_LENGTH_TARGET,
         report.summary()
     );
 }

@@ -193,15 +193,148 @@ pub fn fit(
     if progress("roots", 1.0).is_break() {
         return Err(FitError::Cancelled);
     }
-    let mut mesh = scalp_mesh.clone();
-    let layers = options.layers as usize;
-    let lengths: Vec<f64> = groom.curves().map(columns::arc_length).collect();
-    let mut strands_in = vec![0usize; mesh.bundles.len()];
+    let mut strands_in = vec![0usize; scalp_mesh.bundles.len()];
     for hit in &hits {
         strands_in[hit.face as usize] += 1;
     }
+    let mut mesh_of = |strands: &InputGroom| {
+        fit_mesh(
+            strands,
+            &hits,
+            &roots,
+            &scalp_mesh,
+            options.layers,
+            threads,
+            size,
+            progress,
+        )
+    };
+    let first = mesh_of(groom)?;
+    // Curly strands: the columns just fitted follow points on the helices, which leaves them
+    // zigzagging (longer than the hair's axis) and soaking up part of the curl. Once the curl
+    // is known, the columns are fitted again to each strand's axis (its curl averaged away)
+    // and the curl is measured against those.
+    let min_curl_radius = 1e-3 * size;
+    let mut probe = Document::new(name.to_string(), first.mesh.clone());
+    let first_curl = styling::fit_curl_styling(
+        &mut probe,
+        groom,
+        &hits,
+        &first.reference_lengths,
+        min_curl_radius,
+        None,
+    );
+    drop(probe);
+    let fitted_mesh = match first_curl {
+        Some((turns_per_m, radius_m)) => {
+            mesh_of(&styling::strand_axes(groom, turns_per_m, radius_m))?
+        }
+        None => first,
+    };
+    lap(&mut timings, "columns");
+    let MeshFit {
+        mut mesh,
+        lengths,
+        reference_lengths,
+        locked,
+    } = fitted_mesh;
+    // Density: root count per area, relative to the densest tenth of the bundles.
+    let areas: Vec<f64> = mesh
+        .bundles
+        .iter()
+        .map(|b| face_area(&mesh, &b.vertices))
+        .collect();
+    let mut densities: Vec<f64> = strands_in
+        .iter()
+        .zip(&areas)
+        .filter(|(n, _)| **n > 0)
+        .map(|(n, a)| *n as f64 / a.max(1e-300))
+        .collect();
+    densities.sort_by(f64::total_cmp);
+    let reference_density = densities
+        .get(((densities.len() as f64) * 0.9) as usize)
+        .or(densities.last())
+        .copied()
+        .unwrap_or(1.0);
+    let mut area_sum = 0.0;
+    let mut growing = 0usize;
+    for ((bundle, &n), &area) in mesh.bundles.iter_mut().zip(&strands_in).zip(&areas) {
+        if n > 0 {
+            bundle.density = (n as f64 / area.max(1e-300) / reference_density).clamp(0.01, 1.0);
+            area_sum += area;
+            growing += 1;
+        }
+    }
+    // Strands per bundle that give the input's count over the hair at full density.
+    let mean_area = area_sum / growing.max(1) as f64;
+    let strands_per_bundle = (reference_density * mean_area).round().clamp(1.0, 4096.0) as u32;
+    let source = if built {
+        format!("Fitted to {name} (scalp built from its {curves} roots)")
+    } else {
+        format!("Fitted to {name}")
+    };
+    let mut document = Document::new(name.to_string(), mesh);
+    document.source = source;
+    document.body = body;
+    styling::fit_styling(&mut document, &lengths, &reference_lengths);
+    if let Some((turns_per_m, _)) = first_curl {
+        styling::fit_curl_styling(
+            &mut document,
+            groom,
+            &hits,
+            &reference_lengths,
+            min_curl_radius,
+            Some(turns_per_m),
+        );
+    }
+    lap(&mut timings, "styling");
+    document
+        .validate()
+        .map_err(|e| FitError::Invalid(e.to_string()))?;
+    let _ = progress("styling", 1.0);
+    Ok(Fitted {
+        document,
+        hits,
+        strands_per_bundle,
+        locked_interior: locked,
+        timings_s: timings,
+    })
+}
+
+/// The hair mesh fitted to a groom's strands, with what styling needs from the fit.
+struct MeshFit {
+    mesh: HairMesh,
+    /// Arc length per strand.
+    lengths: Vec<f64>,
+    /// Per strand, the length its columns were fitted for (see [`fit_mesh`]).
+    reference_lengths: Vec<f64>,
+    /// Interior vertices locked where the strands put them.
+    locked: usize,
+}
+
+/// Steps 2 and 3 of the module comment: bundles from the root hits, then columns layer by
+/// layer from the strands sampled at equal shares of their reference length.
+#[allow(clippy::too_many_arguments)]
+fn fit_mesh(
+    groom: &InputGroom,
+    hits: &[RootHit],
+    roots: &[DVec3],
+    scalp_mesh: &HairMesh,
+    layers: u32,
+    threads: usize,
+    size: f64,
+    progress: &mut FitProgress,
+) -> Result<MeshFit, FitError> {
+    let curves = groom.curve_count();
+    let mut mesh = scalp_mesh.clone();
+    let layers = layers as usize;
+    let lengths: Vec<f64> = groom.curves().map(columns::arc_length).collect();
+    let mut strands_in = vec![0usize; mesh.bundles.len()];
+    for hit in hits {
+        strands_in[hit.face as usize] += 1;
+    }
     for (bundle, &count) in mesh.bundles.iter_mut().zip(&strands_in) {
-        bundle.layers = if count > 0 { options.layers } else { 0 };
+        bundle.layers = if count > 0 { layers as u32 } else { 0 };
     }
     let weights_of = |hit: &RootHit| {
         let corners = mesh.bundles[hit.face as usize].vertices.len();
@@ -286,7 +419,6 @@ pub fn fit(
         }
     }
     drop(systems_and_starts);
-    lap(&mut timings, "sample");
     let topology = Topology::build(&mesh);
     let grows: Vec<bool> = (0..column_count)
         .map(|c| {
@@ -370,58 +502,11 @@ pub fn fit(
     }
     let locked = keep_interior_fit(&mut mesh, INTERIOR_TOLERANCE_RELATIVE * size);
     mesh.update_w();
-    lap(&mut timings, "columns");
-    // Density: root count per area, relative to the densest tenth of the bundles.
-    let areas: Vec<f64> = mesh
-        .bundles
-        .iter()
-        .map(|b| face_area(&mesh, &b.vertices))
-        .collect();
-    let mut densities: Vec<f64> = strands_in
-        .iter()
-        .zip(&areas)
-        .filter(|(n, _)| **n > 0)
-        .map(|(n, a)| *n as f64 / a.max(1e-300))
-        .collect();
-    densities.sort_by(f64::total_cmp);
-    let reference_density = densities
-        .get(((densities.len() as f64) * 0.9) as usize)
-        .or(densities.last())
-        .copied()
-        .unwrap_or(1.0);
-    let mut area_sum = 0.0;
-    let mut growing = 0usize;
-    for ((bundle, &n), &area) in mesh.bundles.iter_mut().zip(&strands_in).zip(&areas) {
-        if n > 0 {
-            bundle.density = (n as f64 / area.max(1e-300) / reference_density).clamp(0.01, 1.0);
-            area_sum += area;
-            growing += 1;
-        }
-    }
-    // Strands per bundle that give the input's count over the hair at full density.
-    let mean_area = area_sum / growing.max(1) as f64;
-    let strands_per_bundle = (reference_density * mean_area).round().clamp(1.0, 4096.0) as u32;
-    let source = if built {
-        format!("Fitted to {name} (scalp built from its {curves} roots)")
-    } else {
-        format!("Fitted to {name}")
-    };
-    let mut document = Document::new(name.to_string(), mesh);
-    document.source = source;
-    document.body = body;
-    styling::fit_styling(&mut document, &lengths, &reference_lengths);
-    styling::fit_curl_styling(&mut document, groom, &hits, &reference_lengths, 1e-3 * size);
-    lap(&mut timings, "styling");
-    document
-        .validate()
-        .map_err(|e| FitError::Invalid(e.to_string()))?;
-    let _ = progress("styling", 1.0);
-    Ok(Fitted {
-        document,
-        hits,
-        strands_per_bundle,
-        locked_interior: locked,
-        timings_s: timings,
+    Ok(MeshFit {
+        mesh,
+        lengths,
+        reference_lengths,
+        locked,
     })
 }
 

@@ -166,7 +166,7 @@ fn residual(
 /// component is strongest over the strands (its radius is [`curl_radius`]'s). The residual's mean is
 /// removed per strand first (a bundle-scale offset is not a curl). `None` when no rotating
 /// component stands out of the rest of the spectrum.
-fn fit_curl(residuals: &[Residual]) -> Option<f64> {
+fn fit_curl(residuals: &[Residual], near: Option<f64>) -> Option<f64> {
     let ratio =
         (CURL_MAX_TURNS_PER_M / CURL_MIN_TURNS_PER_M).powf(1.0 / (CURL_FREQUENCIES - 1) as f64);
     let frequencies: Vec<f64> = (0..CURL_FREQUENCIES)
@@ -174,6 +174,8 @@ fn fit_curl(residuals: &[Residual]) -> Option<f64> {
             let f = CURL_MIN_TURNS_PER_M * ratio.powi(k as i32);
             [f, -f]
         })
+        // A known rate (from a first pass) is refined within −30 % … +40 % of itself.
+        .filter(|&f| near.is_none_or(|n| f * n > 0.0 && (0.7..=1.4).contains(&(f / n))))
         .collect();
     let mut power = vec![0.0f64; frequencies.len()];
     for r in residuals {
@@ -201,6 +203,10 @@ fn fit_curl(residuals: &[Residual]) -> Option<f64> {
         }
     }
     let (best, &peak) = power.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))?;
+    if near.is_some() {
+        // The first pass already found the peak over the whole spectrum.
+        return (peak > 0.0).then_some(frequencies[best]);
+    }
     let mut sorted = power.clone();
     sorted.sort_by(f64::total_cmp);
     let median = sorted[sorted.len() / 2];
@@ -214,13 +220,14 @@ fn fit_curl(residuals: &[Residual]) -> Option<f64> {
     Some(frequencies[best])
 }
 
-/// The curl's radius once its rate is known: the median distance of the residual from its
-/// own mean over one turn. The spectral peak's magnitude would do for a perfect match of w,
-/// but each sample's w comes from a nearest-point search and the phase error it leaves
-/// cancels part of the coherent sum (the peak said 3.8 mm for a 6 mm curl); the distance
-/// from the one-turn mean does not depend on the phase, and the one-turn mean removes what
-/// the hair mesh's shape leaves at lower frequencies.
-fn curl_radius(residuals: &[Residual], turns_per_m: f64) -> Option<f64> {
+/// The curl's radius once its rate is known: the median distance of the residual from the
+/// strand's axis. With `about_axis`, the hair mesh was fitted to the strands' axes
+/// ([`strand_axes`]) and the residual itself is that distance. Otherwise the mesh follows
+/// points on the helices and the residual is taken about its own one-turn mean, a rough
+/// estimate (low by about a quarter on the curly sample) that is only good enough to size
+/// the axes' smoothing. The spectral peak's magnitude would do neither: each sample's w comes
+/// from a nearest-point search and the phase error it leaves cancels part of the coherent sum.
+fn curl_radius(residuals: &[Residual], turns_per_m: f64, about_axis: bool) -> Option<f64> {
     let half_turn = 0.5 / turns_per_m.abs().max(1e-9);
     let mut distances = Vec::new();
     for r in residuals {
@@ -241,7 +248,12 @@ fn curl_radius(residuals: &[Residual], turns_per_m: f64) -> Option<f64> {
             if r.w[j] - half_turn < first || r.w[j] + half_turn > last || hi - lo < 4 {
                 continue; // the window is not a whole turn
             }
-            distances.push((r.z[j] - sum / (hi - lo) as f64).length());
+            let centre = if about_axis {
+                DVec2::ZERO
+            } else {
+                sum / (hi - lo) as f64
+            };
+            distances.push((r.z[j] - centre).length());
         }
     }
     if distances.is_empty() {
@@ -253,13 +265,15 @@ fn curl_radius(residuals: &[Residual], turns_per_m: f64) -> Option<f64> {
 }
 
 /// Curl fitted from the strands' residuals (see [`fit_curl`]); sets the global curl when
-/// one stands out and is larger than `min_radius`.
+/// one stands out and is larger than `min_radius`. With `near`, a rate found before is
+/// refined near itself and the mesh is taken to follow the strands' axes.
 pub fn fit_curl_styling(
     document: &mut Document,
     groom: &InputGroom,
     hits: &[RootHit],
     reference_lengths: &[f64],
     min_radius: f64,
+    near: Option<f64>,
 ) -> Option<(f64, f64)> {
     let mesh = &document.hair_mesh;
     let frames: Vec<Vec<Option<Frame>>> = (0..=mesh.max_layers())
@@ -279,8 +293,8 @@ pub fn fit_curl_styling(
             )
         })
         .collect();
-    let turns_per_m = fit_curl(&residuals)?;
-    let radius = curl_radius(&residuals, turns_per_m)?;
+    let turns_per_m = fit_curl(&residuals, near)?;
+    let radius = curl_radius(&residuals, turns_per_m, near.is_some())?;
     if radius < min_radius {
         return None;
     }
@@ -288,4 +302,78 @@ pub fn fit_curl_styling(
     curl.turns_per_m = turns_per_m;
     curl.radius_m = radius;
     Some((turns_per_m, radius))
+}
+
+/// Each strand with its curl averaged away: its axis. Three passes of a moving mean one turn
+/// of the helix long (in arc length): one pass cancels a helix of exactly that turn length,
+/// and three make the cancellation forgiving (a sinc³ response: a turn length off by 20 %
+/// leaves about 1 % of the radius). Near the ends the axis is extrapolated (see
+/// [`moving_mean`]); the root stays where it was.
+pub fn strand_axes(groom: &InputGroom, turns_per_m: f64, radius_m: f64) -> InputGroom {
+    let turn_arc_m =
+        ((std::f64::consts::TAU * radius_m).powi(2) + (1.0 / turns_per_m).powi(2)).sqrt();
+    let mut axes = InputGroom {
+        starts: Vec::with_capacity(groom.starts.len()),
+        points: Vec::with_capacity(groom.points.len()),
+        ..InputGroom::default()
+    };
+    axes.starts.push(0);
+    for i in 0..groom.curve_count() {
+        let points = groom.curve(i);
+        let length = super::columns::arc_length(points);
+        // 16 samples a turn, bounded by the input's own size (a few times its points).
+        let count = ((length / (turn_arc_m / 16.0)).ceil() as usize + 1)
+            .min((4 * points.len()).clamp(64, 4096))
+            .max(2);
+        let mut samples: Vec<DVec3> = super::columns::sample_at_arc_length(points, length, count)
+            .into_iter()
+            .map_while(|p| p)
+            .collect();
+        let spacing = length / (count - 1) as f64;
+        let half = (0.5 * turn_arc_m / spacing.max(1e-300)).round() as usize;
+        let root = samples.first().copied();
+        for _ in 0..3 {
+            samples = moving_mean(&samples, half);
+        }
+        // The root stays where the file put it (its scalp hit is already known).
+        if let (Some(first), Some(root)) = (samples.first_mut(), root) {
+            *first = root;
+        }
+        axes.points
+            .extend(samples.iter().map(|p| p.as_vec3().to_array()));
+        axes.starts.push(axes.points.len() as u32);
+    }
+    axes
+}
+
+/// Mean of each point's neighbourhood of `half` points either side. Within `half` of an
+/// end, where a whole window does not fit, the curve is continued by point reflection
+/// through the last whole-window mean (`2 m(h) − m(2h − j)`): a shrinking window would keep
+/// the helix there, and a clamped one would pile the points up. Strands shorter than two
+/// windows get the shrinking window.
+fn moving_mean(points: &[DVec3], half: usize) -> Vec<DVec3> {
+    let mut prefix = Vec::with_capacity(points.len() + 1);
+    prefix.push(DVec3::ZERO);
+    for p in points {
+        prefix.push(prefix[prefix.len() - 1] + *p);
+    }
+    let n = points.len();
+    let mean = |j: usize, m: usize| (prefix[j + m + 1] - prefix[j - m]) / (2 * m + 1) as f64;
+    if n < 4 * half + 1 {
+        return (0..n)
+            .map(|j| mean(j, half.min(j).min(n - 1 - j)))
+            .collect();
+    }
+    let (first, last) = (half, n - 1 - half);
+    (0..n)
+        .map(|j| {
+            if j < first {
+                2.0 * mean(first, half) - mean(2 * first - j, half)
+            } else if j > last {
+                2.0 * mean(last, half) - mean(2 * last - j, half)
+            } else {
+                mean(j, half)
+            }
+        })
+        .collect()
 }
