@@ -410,14 +410,24 @@ fn quitting_with_unsaved_changes_asks_first() {
 
 /// Runs frames until the export worker is done (bounded, so a hang fails instead).
 fn wait_for_export(harness: &mut Harness<'static, HairloomApp>) {
-    for _ in 0..2000 {
-        if harness.state().export.is_none() {
+    wait_for(harness, |app| app.export.is_none(), 2000, "the export");
+}
+
+/// Steps the app until `done` (a worker job finished), at most `steps` × 10 ms.
+fn wait_for(
+    harness: &mut Harness<'static, HairloomApp>,
+    done: impl Fn(&HairloomApp) -> bool,
+    steps: usize,
+    what: &str,
+) {
+    for _ in 0..steps {
+        if done(harness.state()) {
             return;
         }
         std::thread::sleep(std::time::Duration::from_millis(10));
         harness.step();
     }
-    panic!("the export did not finish");
+    panic!("{what} did not finish");
 }
 
 #[test]
@@ -1937,4 +1947,83 @@ fn ctrl_tab_cycles_tabs_except_during_a_modal_tool() {
         before,
         "Ctrl+Tab cycles the hovered group"
     );
+}
+
+/// File ▸ Import groom… on the scripted dialog's file, Fit on the scalp offered, and the
+/// status message once the fit is done.
+fn import_groom(harness: &mut Harness<'static, HairloomApp>) -> String {
+    file_menu(harness, "Import groom…");
+    harness.get_by_label("Fit").click();
+    harness.step();
+    wait_for(
+        harness,
+        |app| app.groom_import.is_none(),
+        6000,
+        "the groom import",
+    );
+    harness.state().state.message.clone()
+}
+
+#[test]
+fn a_groom_from_another_tool_comes_in_as_one_undo_step_on_the_chosen_scalp() {
+    use hairloom_core::io::strand_files::{StrandLook, hair_file};
+    use hairloom_core::strands::reference::{StrandOptions, generate};
+    // A groom "made elsewhere": the sample's own strands written as a .hair file.
+    let sample = EditorState::sample().document().clone();
+    let strands = generate(
+        &sample,
+        &StrandOptions {
+            strands_per_bundle: 6,
+            vertices_log2: 4,
+            ..StrandOptions::default()
+        },
+    );
+    let dir = tempfile::tempdir().expect("temp dir");
+    let groom = dir.path().join("other_tool.hair");
+    let look = StrandLook::new(&strands, 8e-5, &sample.scene.material);
+    std::fs::write(&groom, hair_file(&strands, &look)).expect("write groom");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Chosen(groom.clone())]),
+    );
+    // The scalp question: the project's scalp is offered and chosen by default.
+    let message = import_groom(&mut harness);
+    assert!(
+        message.starts_with("imported groom other_tool"),
+        "{message}"
+    );
+    assert!(
+        message.contains("% mean"),
+        "the error is reported: {message}"
+    );
+    let imported = harness.state().state.document().clone();
+    assert_eq!(imported.name, "other_tool");
+    // Fitted on the project's scalp: the same root faces, now grown with the fit's layers.
+    assert_eq!(
+        imported.hair_mesh.bundles.len(),
+        sample.hair_mesh.bundles.len()
+    );
+    assert!(imported.hair_mesh.bundles.iter().any(|b| b.layers == 12));
+    assert_eq!(imported.scene, sample.scene, "the project's scene is kept");
+    assert_eq!(harness.state().state.project.history.undo.len(), 1);
+    harness.state_mut().state.undo();
+    assert_eq!(harness.state().state.document(), &sample);
+
+    // Cancel on the question leaves the project as it was; a broken file is named.
+    std::fs::write(&groom, b"HAIR broken").expect("write");
+    harness.state_mut().dialogs = Box::new(ScriptedDialogs::new([
+        DialogAnswer::Chosen(groom.clone()),
+        DialogAnswer::Chosen(groom.clone()),
+    ]));
+    file_menu(&mut harness, "Import groom…");
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert!(harness.state().groom_import.is_none());
+    assert_eq!(harness.state().state.document(), &sample);
+    let message = import_groom(&mut harness);
+    assert!(
+        message.starts_with("groom import failed") && message.contains("other_tool.hair"),
+        "{message}"
+    );
+    assert_eq!(harness.state().state.document(), &sample);
 }

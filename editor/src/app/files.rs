@@ -21,6 +21,8 @@ pub enum FileRequest {
     OpenProject,
     SaveProjectAs,
     ImportScalp,
+    /// A groom made elsewhere (`.abc`, `.usd*`, `.hair`), fitted to a hair mesh.
+    ImportGroom,
     /// A folder for the runtime bundle.
     ExportRuntime,
     /// A `.hair`, `.usda` or `.glb` file.
@@ -33,6 +35,7 @@ impl FileRequest {
             Self::OpenProject => "Open project",
             Self::SaveProjectAs => "Save project as",
             Self::ImportScalp => "Import scalp (glTF / GLB)",
+            Self::ImportGroom => "Import groom (Alembic, USD, .hair)",
             Self::ExportRuntime => "Export runtime bundle to folder",
             Self::ExportStrands => "Export strands (.hair, .usda, .glb, .abc)",
         }
@@ -43,6 +46,10 @@ impl FileRequest {
         match self {
             Self::OpenProject | Self::SaveProjectAs => &[("Hairloom project", &["hairloom"])],
             Self::ImportScalp => &[("glTF scalp", &["glb", "gltf"])],
+            Self::ImportGroom => &[(
+                "Groom (Alembic, USD, Cem Yuksel .hair)",
+                &["abc", "usda", "usdc", "usdz", "usd", "hair"],
+            )],
             Self::ExportRuntime => &[],
             Self::ExportStrands => &[
                 ("Cem Yuksel .hair", &["hair"]),
@@ -208,63 +215,60 @@ pub enum ExportTarget {
     },
 }
 
-/// An export running on a worker thread on a copy of the document.
-pub struct ExportJob {
-    pub target: ExportTarget,
+/// Work on a worker thread with a progress fraction and a Cancel flag, so the editor stays
+/// responsive (exports, groom imports).
+pub struct WorkerJob<T> {
     /// Fraction done × 10⁶.
     progress: Arc<AtomicU32>,
     cancel: Arc<AtomicBool>,
-    result: mpsc::Receiver<Result<String, String>>,
+    result: mpsc::Receiver<Result<T, String>>,
+    /// What the job is, for "… stopped unexpectedly".
+    what: &'static str,
 }
 
-impl ExportJob {
-    pub fn start(document: Document, target: ExportTarget, strands_per_bundle: u32) -> Self {
+/// The worker's side of a [`WorkerJob`]: report progress, see Cancel.
+#[derive(Clone)]
+pub struct JobProgress {
+    progress: Arc<AtomicU32>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl JobProgress {
+    /// Reports `fraction` (0 to 1) done; breaks once Cancel was pressed.
+    pub fn report(&self, fraction: f64) -> ControlFlow<()> {
+        self.progress
+            .store((fraction.clamp(0.0, 1.0) * 1e6) as u32, Ordering::Relaxed);
+        if self.cancel.load(Ordering::Relaxed) {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    }
+}
+
+impl<T: Send + 'static> WorkerJob<T> {
+    pub fn start(
+        what: &'static str,
+        work: impl FnOnce(&JobProgress) -> Result<T, String> + Send + 'static,
+    ) -> Self {
         let progress = Arc::new(AtomicU32::new(0));
         let cancel = Arc::new(AtomicBool::new(false));
         let (sender, result) = mpsc::channel();
-        let job = Self {
-            target: target.clone(),
+        let worker = JobProgress {
             progress: progress.clone(),
             cancel: cancel.clone(),
-            result,
         };
         std::thread::spawn(move || {
-            let outcome = match target {
-                ExportTarget::Runtime { dir, precision } => write_runtime_bundle(
-                    &document,
-                    &dir,
-                    precision,
-                    strands_per_bundle,
-                    crate::files::EXPORT_VERTICES_LOG2,
-                )
-                .map_err(|e| format!("{e:#}")),
-                ExportTarget::Strands {
-                    file,
-                    vertices_log2,
-                    alembic,
-                } => crate::files::check_strand_file(&file)
-                    .map_err(|e| format!("{e:#}"))
-                    .and_then(|()| {
-                        generate_strands(&document, strands_per_bundle, vertices_log2, &mut |f| {
-                            progress.store((f * 1e6) as u32, Ordering::Relaxed);
-                            if cancel.load(Ordering::Relaxed) {
-                                ControlFlow::Break(())
-                            } else {
-                                ControlFlow::Continue(())
-                            }
-                        })
-                        .map_err(|e| format!("{e:#}"))?
-                        .ok_or_else(|| "cancelled".to_string())
-                    })
-                    .and_then(|strands| {
-                        write_strand_file(&strands, &document, &file, alembic)
-                            .map_err(|e| format!("{e:#}"))
-                    }),
-            };
-            progress.store(1_000_000, Ordering::Relaxed);
+            let outcome = work(&worker);
+            worker.progress.store(1_000_000, Ordering::Relaxed);
             let _ = sender.send(outcome);
         });
-        job
+        Self {
+            progress,
+            cancel,
+            result,
+            what,
+        }
     }
 
     pub fn fraction(&self) -> f32 {
@@ -275,22 +279,98 @@ impl ExportJob {
         self.cancel.store(true, Ordering::Relaxed);
     }
 
-    /// The outcome once the worker is done (a summary or the error's message).
-    pub fn finished(&self) -> Option<Result<String, String>> {
+    /// The outcome once the worker is done (its result or the error's message).
+    pub fn finished(&self) -> Option<Result<T, String>> {
         match self.result.try_recv() {
             Ok(outcome) => Some(outcome),
             Err(mpsc::TryRecvError::Empty) => None,
             Err(mpsc::TryRecvError::Disconnected) => {
-                Some(Err("the export stopped unexpectedly".into()))
+                Some(Err(format!("the {} stopped unexpectedly", self.what)))
             }
         }
     }
 
-    /// Blocks until the worker is done (tests, and quitting during an export).
-    pub fn wait(&self) -> Result<String, String> {
+    /// Blocks until the worker is done (tests, and quitting during a job).
+    pub fn wait(&self) -> Result<T, String> {
         self.result
             .recv()
-            .unwrap_or_else(|_| Err("the export stopped unexpectedly".into()))
+            .unwrap_or_else(|_| Err(format!("the {} stopped unexpectedly", self.what)))
+    }
+}
+
+/// A modal with a heading, what is being worked on, a progress bar and Cancel (it keeps
+/// repainting while shown). Returns whether Cancel was clicked.
+pub fn progress_modal(ui: &mut egui::Ui, heading: &str, label: &str, fraction: f32) -> bool {
+    let mut cancelled = false;
+    egui::Modal::new(egui::Id::unique(heading)).show(ui.ctx(), |ui| {
+        ui.heading(heading);
+        ui.label(label);
+        ui.add(
+            egui::ProgressBar::new(fraction)
+                .show_percentage()
+                .desired_width(360.0),
+        );
+        cancelled = ui.button("Cancel").clicked();
+    });
+    ui.ctx().request_repaint();
+    cancelled
+}
+
+/// An export running on a worker thread on a copy of the document.
+pub struct ExportJob {
+    pub target: ExportTarget,
+    job: WorkerJob<String>,
+}
+
+impl ExportJob {
+    pub fn start(document: Document, target: ExportTarget, strands_per_bundle: u32) -> Self {
+        let work_target = target.clone();
+        let job = WorkerJob::start("export", move |progress| match work_target {
+            ExportTarget::Runtime { dir, precision } => write_runtime_bundle(
+                &document,
+                &dir,
+                precision,
+                strands_per_bundle,
+                crate::files::EXPORT_VERTICES_LOG2,
+            )
+            .map_err(|e| format!("{e:#}")),
+            ExportTarget::Strands {
+                file,
+                vertices_log2,
+                alembic,
+            } => crate::files::check_strand_file(&file)
+                .map_err(|e| format!("{e:#}"))
+                .and_then(|()| {
+                    generate_strands(&document, strands_per_bundle, vertices_log2, &mut |f| {
+                        progress.report(f64::from(f))
+                    })
+                    .map_err(|e| format!("{e:#}"))?
+                    .ok_or_else(|| "cancelled".to_string())
+                })
+                .and_then(|strands| {
+                    write_strand_file(&strands, &document, &file, alembic)
+                        .map_err(|e| format!("{e:#}"))
+                }),
+        });
+        Self { target, job }
+    }
+
+    pub fn fraction(&self) -> f32 {
+        self.job.fraction()
+    }
+
+    pub fn cancel(&self) {
+        self.job.cancel();
+    }
+
+    /// The outcome once the worker is done (a summary or the error's message).
+    pub fn finished(&self) -> Option<Result<String, String>> {
+        self.job.finished()
+    }
+
+    /// Blocks until the worker is done (tests, and quitting during an export).
+    pub fn wait(&self) -> Result<String, String> {
+        self.job.wait()
     }
 }
 

@@ -21,6 +21,8 @@ pub mod viewport;
 
 pub use state::EditorState;
 
+pub mod groom_import;
+
 use hairloom_core::io::alembic::AlembicTarget;
 use std::path::PathBuf;
 
@@ -165,6 +167,8 @@ pub struct HairloomApp {
     /// The typed-path prompt, where no native dialog exists.
     pub prompt: Option<PathPrompt>,
     pub export: Option<ExportJob>,
+    /// File ▸ Import groom…: the scalp question, then the fit on a worker.
+    pub groom_import: Option<groom_import::GroomImport>,
     /// The application the next `.abc` export is for (File ▸ Export groom for ▸).
     pub alembic_target: AlembicTarget,
     /// "Save changes?" is being asked before this action.
@@ -212,6 +216,7 @@ impl HairloomApp {
             dialogs: Box::new(NativeDialogs),
             prompt: None,
             export: None,
+            groom_import: None,
             alembic_target: AlembicTarget::default(),
             confirm: None,
             after_save: None,
@@ -312,6 +317,7 @@ impl HairloomApp {
             || self.confirm.is_some()
             || self.prompt.is_some()
             || self.export.is_some()
+            || self.groom_import.is_some()
     }
 
     fn shortcuts(&mut self, ui: &mut egui::Ui) {
@@ -488,6 +494,10 @@ impl HairloomApp {
                 Err(_) => self.after_save = None,
             },
             FileRequest::ImportScalp => self.import_scalp(&path),
+            FileRequest::ImportGroom => {
+                let has_scalp = !self.state.document().hair_mesh.bundles.is_empty();
+                self.groom_import = Some(groom_import::GroomImport::choose(path, has_scalp));
+            }
             FileRequest::ExportRuntime => self.start_export(ExportTarget::Runtime {
                 dir: path,
                 precision: self.viewport.settings.precision,
@@ -647,6 +657,10 @@ impl HairloomApp {
                     ui.close();
                     self.file_request(FileRequest::ImportScalp);
                 }
+                if ui.button("Import groom…").clicked() {
+                    ui.close();
+                    self.file_request(FileRequest::ImportGroom);
+                }
                 let exporting = self.export.is_some();
                 if ui
                     .add_enabled(!exporting, egui::Button::new("Export runtime bundle…"))
@@ -741,9 +755,11 @@ impl HairloomApp {
         });
     }
 
-    /// The modal windows: recovery offer, "save changes?", typed path, export progress.
+    /// The modal windows: recovery offer, groom import, "save changes?", typed path, export
+    /// progress.
     fn modals(&mut self, ui: &mut egui::Ui) {
         self.recovery_offer(ui);
+        self.groom_import_modal(ui);
         if let Some(action) = self.confirm.clone() {
             let mut choice = None;
             let modal =
@@ -827,22 +843,34 @@ impl HairloomApp {
                     self.export = None;
                 }
                 None => {
-                    egui::Modal::new(egui::Id::unique("hairloom export")).show(ui.ctx(), |ui| {
-                        ui.heading("Exporting");
-                        ui.label(match &job.target {
-                            ExportTarget::Runtime { dir, .. } => dir.display().to_string(),
-                            ExportTarget::Strands { file, .. } => file.display().to_string(),
-                        });
-                        ui.add(
-                            egui::ProgressBar::new(job.fraction())
-                                .show_percentage()
-                                .desired_width(360.0),
-                        );
-                        if ui.button("Cancel").clicked() {
-                            job.cancel();
-                        }
-                    });
-                    ui.ctx().request_repaint();
+                    let label = match &job.target {
+                        ExportTarget::Runtime { dir, .. } => dir.display().to_string(),
+                        ExportTarget::Strands { file, .. } => file.display().to_string(),
+                    };
+                    if files::progress_modal(ui, "Exporting", &label, job.fraction()) {
+                        job.cancel();
+                    }
+                }
+            }
+        }
+    }
+
+    /// The groom import's modal, and its result once the fit is done.
+    fn groom_import_modal(&mut self, ui: &mut egui::Ui) {
+        let Some(import) = &mut self.groom_import else {
+            return;
+        };
+        match import.ui(ui, self.state.document()) {
+            groom_import::GroomImportAction::Waiting => {}
+            groom_import::GroomImportAction::Closed => self.groom_import = None,
+            groom_import::GroomImportAction::Done(outcome) => {
+                self.groom_import = None;
+                match outcome {
+                    Ok(fitted) => {
+                        self.state.import_groom(*fitted.document, &fitted.summary);
+                        self.viewport.reframe();
+                    }
+                    Err(error) => self.state.message = format!("groom import failed: {error}"),
                 }
             }
         }
@@ -955,6 +983,9 @@ impl eframe::App for HairloomApp {
         if let Some(job) = &self.export {
             // Let the export finish writing (each file is atomic either way).
             let _ = job.wait();
+        }
+        if let Some(import) = &self.groom_import {
+            import.wait();
         }
         // Unsaved work survives a quit; nothing unsaved leaves no recovery file behind.
         if self.state.is_dirty() && !self.quitting {

@@ -137,15 +137,30 @@ impl EditorState {
     /// Replaces the scalp, body and name with an imported document's, keeping the styling:
     /// one undo step.
     pub fn import_scalp(&mut self, imported: Document, summary: &str) {
+        self.replace_from(imported, "Import scalp", false, summary);
+    }
+
+    /// The name, source, hair mesh and body (and with `styling`, the styling) of `imported`
+    /// replace the document's, as one undo step named `label`.
+    fn replace_from(&mut self, imported: Document, label: &str, styling: bool, summary: &str) {
         self.commit_edit();
-        let document = self.edit(ChangeKind::Rebuild, "Import scalp");
+        let document = self.edit(ChangeKind::Rebuild, label);
         document.name = imported.name;
         document.source = imported.source;
         document.hair_mesh = imported.hair_mesh;
         document.body = imported.body;
+        if styling {
+            document.styling = imported.styling;
+        }
         self.commit_edit();
         self.selection.clear();
         self.message = format!("imported {summary}");
+    }
+
+    /// Replaces the hair mesh, scalp, body, name and styling with a fitted groom's, keeping
+    /// the scene (lights, material, effects): one undo step.
+    pub fn import_groom(&mut self, fitted: Document, summary: &str) {
+        self.replace_from(fitted, "Import groom", true, summary);
     }
 
     /// Opens a project file; the error names the file and the problem.

@@ -258,3 +258,57 @@ fn reading_can_be_cancelled_and_unknown_extensions_are_named() {
         Err(GroomReadError::UnknownFormat { .. })
     ));
 }
+
+#[test]
+fn usd_axes_and_units_become_metres_y_up() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let curve = "def BasisCurves \"Hair\" {\n int[] curveVertexCounts = [2]\n point3f[] points = [(1,2,3), (1,2,13)]\n float[] widths = [0.5, 0.5]\n}\n";
+    // Blender's default USD export: Z up, metres. Its front (−Y) turns to glTF's +Z.
+    let z_up = write(
+        dir.path(),
+        "z_up.usda",
+        format!("#usda 1.0\n(\n    metersPerUnit = 1\n    upAxis = \"Z\"\n)\n{curve}").as_bytes(),
+    );
+    let groom = read_groom(&z_up, GroomLimits::default(), &mut no_progress()).expect("reads");
+    assert_eq!(groom.points, vec![[1.0, 3.0, -2.0], [1.0, 13.0, -2.0]]);
+    assert!(
+        groom.notes.iter().any(|n| n.contains("Z up")),
+        "{:?}",
+        groom.notes
+    );
+    // Centimetres, Y up; and no metadata at all means USD's fallback, centimetres.
+    for (name, header) in [
+        (
+            "cm.usda",
+            "(\n    metersPerUnit = 0.01\n    upAxis = \"Y\"\n)\n",
+        ),
+        ("bare.usda", ""),
+    ] {
+        let file = write(
+            dir.path(),
+            name,
+            format!("#usda 1.0\n{header}{curve}").as_bytes(),
+        );
+        let groom = read_groom(&file, GroomLimits::default(), &mut no_progress()).expect("reads");
+        let expected = [[0.01f32, 0.02, 0.03], [0.01, 0.02, 0.13]];
+        for (p, e) in groom.points.iter().zip(&expected) {
+            for (a, b) in p.iter().zip(e) {
+                assert!((a - b).abs() < 1e-7, "{name}: {p:?} vs {e:?}");
+            }
+        }
+        let widths = groom.widths_m.as_ref().expect("widths");
+        assert!((widths[0] - 0.005).abs() < 1e-9, "{name}: {widths:?}");
+    }
+    // A frame that is neither is named.
+    let odd = write(
+        dir.path(),
+        "odd.usda",
+        format!("#usda 1.0\n(\n    upAxis = \"X\"\n)\n{curve}").as_bytes(),
+    );
+    match read_groom(&odd, GroomLimits::default(), &mut no_progress()) {
+        Err(GroomReadError::Format { message, .. }) => {
+            assert!(message.contains("upAxis"), "{message}")
+        }
+        other => panic!("{other:?}"),
+    }
+}

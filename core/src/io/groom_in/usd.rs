@@ -169,7 +169,90 @@ fn read_stage(
         builder.note(format!("{skipped} prims are not read (only BasisCurves)"));
     }
     builder.note(format!("USD: {curve_prims} BasisCurves prims"));
-    builder.finish()
+    let frame = StageFrame::of(&stage).map_err(|message| builder.format_error(message))?;
+    if let Some(note) = frame.note() {
+        builder.note(note);
+    }
+    let mut groom = builder.finish()?;
+    frame.apply(&mut groom);
+    Ok(groom)
+}
+
+/// The stage's axes and units (`upAxis`, `metersPerUnit`), which Hairloom's metres, +Y up
+/// differ from in files made in Z-up tools (Blender's default USD export) or in
+/// centimetres.
+struct StageFrame {
+    z_up: bool,
+    meters_per_unit: f64,
+}
+
+impl StageFrame {
+    /// USD's fallbacks where the root layer says nothing: Y up, and 0.01 metres per unit
+    /// (`UsdGeomGetStageMetersPerUnit`'s centimetres).
+    fn of(stage: &Stage) -> Result<Self, String> {
+        let layer = stage.root_layer();
+        let root = layer.pseudo_root();
+        let up = root
+            .as_ref()
+            .and_then(|r| r.get::<sdf::Value>("upAxis"))
+            .and_then(|v| v.try_as_token_ref().map(|t| t.as_str().to_string()));
+        let z_up = match up.as_deref() {
+            None | Some("Y") => false,
+            Some("Z") => true,
+            Some(other) => return Err(format!("upAxis \"{other}\" is neither Y nor Z")),
+        };
+        let meters_per_unit = match root
+            .as_ref()
+            .and_then(|r| r.get::<sdf::Value>("metersPerUnit"))
+        {
+            None => 0.01,
+            Some(value) => {
+                let m = value
+                    .try_as_double_ref()
+                    .copied()
+                    .or_else(|| value.try_as_float_ref().map(|f| f64::from(*f)))
+                    .or_else(|| value.try_as_int_ref().map(|i| f64::from(*i)))
+                    .ok_or_else(|| "metersPerUnit is not a number".to_string())?;
+                if !(m.is_finite() && m > 0.0) {
+                    return Err(format!("metersPerUnit {m} is not a positive length"));
+                }
+                m
+            }
+        };
+        Ok(Self {
+            z_up,
+            meters_per_unit,
+        })
+    }
+
+    fn note(&self) -> Option<String> {
+        (self.z_up || self.meters_per_unit != 1.0).then(|| {
+            format!(
+                "stage {} up, {} m per unit: converted to metres, Y up",
+                if self.z_up { "Z" } else { "Y" },
+                self.meters_per_unit
+            )
+        })
+    }
+
+    /// Points to metres, Y up (Z up turns by −90° about x: its front, −Y, becomes +Z as in
+    /// glTF), widths to metres.
+    fn apply(&self, groom: &mut InputGroom) {
+        let m = self.meters_per_unit as f32;
+        for p in &mut groom.points {
+            let [x, y, z] = *p;
+            *p = if self.z_up {
+                [x * m, z * m, -y * m]
+            } else {
+                [x * m, y * m, z * m]
+            };
+        }
+        if let Some(widths) = &mut groom.widths_m {
+            for w in widths {
+                *w *= m;
+            }
+        }
+    }
 }
 
 /// The value of `attribute` at its default time, or at its first time sample.
