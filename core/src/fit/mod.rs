@@ -210,6 +210,7 @@ pub fn fit(
         )
     };
     let first = mesh_of(groom)?;
+    lap(&mut timings, "columns");
     // Curly strands: the columns just fitted follow points on the helices, which leaves them
     // zigzagging (longer than the hair's axis) and soaking up part of the curl. Once the curl
     // is known, the columns are fitted again to each strand's axis (its curl averaged away)
@@ -231,7 +232,8 @@ pub fn fit(
         }
         None => first,
     };
-    lap(&mut timings, "columns");
+    // The curl scan, and where it found a curl, the columns again on the strands' axes.
+    lap(&mut timings, "curl");
     let MeshFit {
         mut mesh,
         lengths,

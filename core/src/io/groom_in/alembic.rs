@@ -1,7 +1,7 @@
 //! Alembic grooms through `ogawa-rs`: every `ICurves` object (plain curves as Blender,
 //! Houdini and Maya write them, and Unreal's groom schema). Unreal's guide curves
 //! (`groom_guide` = 1) are skipped: they drive simulation, they are not hair. Widths come
-//! from `width` (or `groom_width`), root uv from `groom_root_uv` (or the curves' `uv`),
+//! from `width` (or `groom_width`), root uv from `groom_root_uv` (or Blender's `surface_uv_coordinate`),
 //! groups from `groom_group_id`; the first time sample is read.
 //!
 //! `ogawa-rs` trusts the sizes a file states (it allocates what a blob header claims) and has
@@ -256,12 +256,15 @@ impl Walk<'_, '_> {
                 _ => None,
             },
         };
-        let root_uvs: Option<Vec<[f32; 2]>> = match self.arb_param(object, "groom_root_uv") {
-            Some(PodArray::F32(v)) if v.len() == 2 * curve_count => {
-                Some(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
-            }
-            _ => None,
-        };
+        // Unreal's groom attribute, else Blender's (it writes the hair's surface uv).
+        let root_uvs: Option<Vec<[f32; 2]>> = ["groom_root_uv", "surface_uv_coordinate"]
+            .into_iter()
+            .find_map(|name| match self.arb_param(object, name) {
+                Some(PodArray::F32(v)) if v.len() == 2 * curve_count => {
+                    Some(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
+                }
+                _ => None,
+            });
         self.builder
             .expect(curve_count as u64, points.len() as u64)?;
         let mut first = 0usize;
