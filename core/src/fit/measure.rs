@@ -130,8 +130,17 @@ impl Default for MeasureOptions {
     }
 }
 
+/// Most samples a strand adds beyond its own points: a strand that zigzags across the whole
+/// groom would otherwise add hundreds per segment.
+const MAX_SAMPLES_PER_STRAND: f64 = 1024.0;
+
 fn resample(points: &[DVec3], spacing: f64, out: &mut Vec<[f64; 3]>) {
-    out.push(points[0].to_array());
+    let Some(first) = points.first() else {
+        return;
+    };
+    let length: f64 = points.windows(2).map(|w| (w[1] - w[0]).length()).sum();
+    let spacing = spacing.max(length / MAX_SAMPLES_PER_STRAND);
+    out.push(first.to_array());
     for w in points.windows(2) {
         let len = (w[1] - w[0]).length();
         let steps = (len / spacing).ceil().max(1.0) as usize;

@@ -376,7 +376,11 @@ fn fit_mesh(
     // One pass over the strands: every layer's normal equations, and each column's start
     // direction (the first sample's offset from the root).
     let bundle_count = mesh.bundles.len();
-    let systems_and_starts = in_chunks(curves, threads, |range| {
+    // Each chunk holds every layer's normal equations for every bundle, so the chunks are
+    // at most 16 (fixed, for determinism): memory stays 16 × layers × bundles × 224 bytes
+    // however many curves come in.
+    let chunk = curves.div_ceil(16).max(CHUNK);
+    let systems_and_starts = crate::parallel::in_chunks(curves, chunk, threads, |range| {
         let mut systems: Vec<columns::LayerSystem> = (0..=layers)
             .map(|_| columns::LayerSystem::new(bundle_count))
             .collect();

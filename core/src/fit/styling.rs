@@ -66,9 +66,10 @@ fn residual(
         return None;
     }
     let length = super::columns::arc_length(points);
+    // Bounded: a coil whose axis is far shorter than its arc would ask for any number.
     let count = ((length / reference_length.max(1e-12)) * samples as f64)
         .ceil()
-        .max(8.0) as usize;
+        .clamp(8.0, 16.0 * samples as f64) as usize;
     let along = super::columns::sample_at_arc_length(points, length, count);
     let root = along[0]?;
     // The unstyled strand finely sampled, with its length so far (w). Each input sample is
@@ -295,7 +296,13 @@ pub fn fit_curl_styling(
         .collect();
     let turns_per_m = fit_curl(&residuals, near)?;
     let radius = curl_radius(&residuals, turns_per_m, near.is_some())?;
-    if radius < min_radius {
+    // A "curl" wider than a styling parameter may be (a groom in centimetres or
+    // millimetres: the fit works in file units) is left out rather than failing the fit.
+    let max_radius = crate::model::styling::HARD_RANGES
+        .iter()
+        .find(|(name, ..)| *name == "curl.radius_m")
+        .map_or(f64::INFINITY, |&(_, _, hi)| hi);
+    if radius < min_radius || radius > max_radius {
         return None;
     }
     let curl = &mut document.styling.global.curl;
@@ -330,7 +337,8 @@ pub fn strand_axes(groom: &InputGroom, turns_per_m: f64, radius_m: f64) -> Input
             .map_while(|p| p)
             .collect();
         let spacing = length / (count - 1) as f64;
-        let half = (0.5 * turn_arc_m / spacing.max(1e-300)).round() as usize;
+        // At most the strand's own samples (a zero-length strand would ask for usize::MAX).
+        let half = ((0.5 * turn_arc_m / spacing.max(1e-300)).round() as usize).min(samples.len());
         let root = samples.first().copied();
         for _ in 0..3 {
             samples = moving_mean(&samples, half);

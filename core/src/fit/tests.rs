@@ -265,3 +265,44 @@ fn bad_layer_counts_are_refused() {
         ));
     }
 }
+
+#[test]
+fn strand_axes_keep_degenerate_strands_whole() {
+    // A zero-length strand, a two-point one and a normal helix: every axis keeps its root
+    // and stays finite.
+    let mut groom = InputGroom {
+        starts: vec![0],
+        ..InputGroom::default()
+    };
+    let mut add = |points: Vec<[f32; 3]>| {
+        groom.points.extend(points);
+        groom.starts.push(groom.points.len() as u32);
+    };
+    add(vec![[0.1, 0.2, 0.3]; 5]);
+    add(vec![[0.0, 0.0, 0.0], [0.0, 0.01, 0.0]]);
+    add((0..200)
+        .map(|k| {
+            let t = k as f32 * 0.001;
+            let phase = std::f32::consts::TAU * 40.0 * t;
+            [0.005 * phase.cos(), t, 0.005 * phase.sin()]
+        })
+        .collect());
+    let axes = super::styling::strand_axes(&groom, 40.0, 0.005);
+    assert_eq!(axes.curve_count(), 3);
+    for i in 0..3 {
+        let axis = axes.curve(i);
+        assert_eq!(axis[0], groom.curve(i)[0], "curve {i} keeps its root");
+        assert!(axis.iter().flatten().all(|c| c.is_finite()), "curve {i}");
+    }
+    // The helix's axis lies on the y axis, away from the ends' half turn.
+    let helix = axes.curve(2);
+    let middle = &helix[helix.len() / 4..3 * helix.len() / 4];
+    let off = middle
+        .iter()
+        .map(|p| (p[0] * p[0] + p[2] * p[2]).sqrt())
+        .fold(0.0f32, f32::max);
+    assert!(
+        off < 0.0005,
+        "the axis strays {off} m from the helix's axis"
+    );
+}

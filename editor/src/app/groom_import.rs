@@ -21,7 +21,21 @@ const FIT_SHARE: f64 = 0.6;
 pub struct FittedGroom {
     /// Boxed: a document is large, and this travels through enums.
     pub document: Box<Document>,
+    /// Strands per bundle that give the input's strand count (the viewport shows that many).
+    pub strands_per_bundle: u32,
     pub summary: String,
+}
+
+/// The fit's own steps as one rising fraction (the columns take most of the time; a curly
+/// groom fits its columns twice, so the bar goes back once).
+fn fit_fraction(step: &str, fraction: f64) -> f64 {
+    let (start, end) = match step {
+        "scalp" => (0.0, 0.05),
+        "roots" => (0.05, 0.1),
+        "columns" => (0.1, 0.9),
+        _ => (0.9, 1.0),
+    };
+    start + (end - start) * fraction.clamp(0.0, 1.0)
 }
 
 /// The scalp question, then the running fit.
@@ -66,9 +80,13 @@ impl GroomImport {
             let name = groom
                 .file_stem()
                 .map_or_else(|| "groom".into(), |s| s.to_string_lossy().into_owned());
-            let fitted = fit(&input, scalp, &name, &FitOptions::default(), &mut |_, f| {
-                progress.report(READ_SHARE + FIT_SHARE * f)
-            })
+            let fitted = fit(
+                &input,
+                scalp,
+                &name,
+                &FitOptions::default(),
+                &mut |step, f| progress.report(READ_SHARE + FIT_SHARE * fit_fraction(step, f)),
+            )
             .map_err(|e| e.to_string())?;
             if progress.report(READ_SHARE + FIT_SHARE).is_break() {
                 return Err("cancelled".into());
@@ -86,6 +104,7 @@ impl GroomImport {
                 started.elapsed().as_secs_f64()
             );
             Ok(FittedGroom {
+                strands_per_bundle: fitted.strands_per_bundle,
                 document: Box::new(fitted.document),
                 summary,
             })
@@ -158,9 +177,11 @@ impl GroomImport {
         action
     }
 
-    /// Blocks until a running fit is done (quitting during an import).
-    pub fn wait(&self) {
+    /// Cancels a running fit and waits for its worker to stop (quitting during an import:
+    /// the import changes nothing until it lands, so nothing is lost).
+    pub fn cancel_and_wait(&self) {
         if let Self::Fitting { job, .. } = self {
+            job.cancel();
             let _ = job.wait();
         }
     }

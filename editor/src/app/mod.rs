@@ -867,6 +867,9 @@ impl HairloomApp {
                 self.groom_import = None;
                 match outcome {
                     Ok(fitted) => {
+                        self.viewport.settings.strands_per_bundle = fitted
+                            .strands_per_bundle
+                            .clamp(1, viewport::MAX_STRANDS_PER_BUNDLE);
                         self.state.import_groom(*fitted.document, &fitted.summary);
                         self.viewport.reframe();
                     }
@@ -985,7 +988,7 @@ impl eframe::App for HairloomApp {
             let _ = job.wait();
         }
         if let Some(import) = &self.groom_import {
-            import.wait();
+            import.cancel_and_wait();
         }
         // Unsaved work survives a quit; nothing unsaved leaves no recovery file behind.
         if self.state.is_dirty() && !self.quitting {

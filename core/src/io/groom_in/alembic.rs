@@ -102,6 +102,9 @@ pub fn check_ogawa_tree(bytes: &[u8]) -> Result<(), String> {
     let root = u64_at(8).ok_or("truncated header")?;
     let mut stack = vec![root];
     let mut seen = std::collections::HashSet::new();
+    // In a well-formed file each child slot is its own 8-byte word: groups that share their
+    // slots (a hostile file) could otherwise push far more children than the file holds.
+    let mut children_pushed = 0u64;
     while let Some(offset) = stack.pop() {
         if seen.len() > MAX_NODES {
             return Err(format!("more than {MAX_NODES} Ogawa nodes"));
@@ -129,6 +132,12 @@ pub fn check_ogawa_tree(bytes: &[u8]) -> Result<(), String> {
             if count > len / 8 || offset + 8 > len - 8 * count {
                 return Err(format!(
                     "group at {offset} claims {count} children, past the file's end"
+                ));
+            }
+            children_pushed += count;
+            if children_pushed > len / 8 {
+                return Err(format!(
+                    "groups list more children ({children_pushed}) than the file has words"
                 ));
             }
             for k in 0..count {

@@ -312,3 +312,38 @@ fn usd_axes_and_units_become_metres_y_up() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn usd_counts_that_overflow_and_absurd_units_are_named() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // 16 × 2⁶⁰ wraps an unchecked i64 sum back to 2, the point count.
+    let counts: Vec<String> = std::iter::repeat_n("1152921504606846976".to_string(), 16)
+        .chain(["2".to_string()])
+        .collect();
+    let wrapping = write(
+        dir.path(),
+        "wrap.usda",
+        format!(
+            "#usda 1.0\n(\n    metersPerUnit = 1\n)\ndef BasisCurves \"Hair\" {{\n int64[] curveVertexCounts = [{}]\n point3f[] points = [(0,0,0), (0,1,0)]\n float[] widths = [0.5]\n}}\n",
+            counts.join(", ")
+        )
+        .as_bytes(),
+    );
+    match read_groom(&wrapping, GroomLimits::default(), &mut no_progress()) {
+        Err(GroomReadError::Format { message, .. }) => {
+            assert!(message.contains("curveVertexCounts"), "{message}")
+        }
+        other => panic!("{other:?}"),
+    }
+    let absurd = write(
+        dir.path(),
+        "absurd.usda",
+        b"#usda 1.0\n(\n    metersPerUnit = 1e39\n)\ndef BasisCurves \"Hair\" {\n int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0), (0,1,0)]\n}\n",
+    );
+    match read_groom(&absurd, GroomLimits::default(), &mut no_progress()) {
+        Err(GroomReadError::Format { message, .. }) => {
+            assert!(message.contains("metersPerUnit"), "{message}")
+        }
+        other => panic!("{other:?}"),
+    }
+}

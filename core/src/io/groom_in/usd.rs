@@ -173,8 +173,11 @@ fn read_stage(
     if let Some(note) = frame.note() {
         builder.note(note);
     }
+    let file = builder.file().to_string();
     let mut groom = builder.finish()?;
-    frame.apply(&mut groom);
+    frame
+        .apply(&mut groom)
+        .map_err(|message| GroomReadError::Format { file, message })?;
     Ok(groom)
 }
 
@@ -213,8 +216,12 @@ impl StageFrame {
                     .or_else(|| value.try_as_float_ref().map(|f| f64::from(*f)))
                     .or_else(|| value.try_as_int_ref().map(|i| f64::from(*i)))
                     .ok_or_else(|| "metersPerUnit is not a number".to_string())?;
-                if !(m.is_finite() && m > 0.0) {
-                    return Err(format!("metersPerUnit {m} is not a positive length"));
+                // A micrometre to a thousand kilometres per unit; beyond, f32 points would
+                // overflow or vanish.
+                if !(1e-6..=1e6).contains(&m) {
+                    return Err(format!(
+                        "metersPerUnit {m} is outside 1e-6 … 1e6 (not a length a groom is in)"
+                    ));
                 }
                 m
             }
@@ -237,7 +244,7 @@ impl StageFrame {
 
     /// Points to metres, Y up (Z up turns by −90° about x: its front, −Y, becomes +Z as in
     /// glTF), widths to metres.
-    fn apply(&self, groom: &mut InputGroom) {
+    fn apply(&self, groom: &mut InputGroom) -> Result<(), String> {
         let m = self.meters_per_unit as f32;
         for p in &mut groom.points {
             let [x, y, z] = *p;
@@ -251,6 +258,17 @@ impl StageFrame {
             for w in widths {
                 *w *= m;
             }
+        }
+        match groom
+            .points
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            Some(i) => Err(format!(
+                "point {i} is not finite in metres ({} m per unit)",
+                self.meters_per_unit
+            )),
+            None => Ok(()),
         }
     }
 }
@@ -329,8 +347,16 @@ fn read_curves(
         }
         None => return Err(error(builder, "has no curveVertexCounts".into())),
     };
-    let total: i64 = counts.iter().map(|&c| c.max(0)).sum();
-    if counts.iter().any(|&c| c < 0) || total != points.len() as i64 {
+    // Checked: int64 counts from the file could wrap a plain sum back to the point count.
+    let total = counts.iter().try_fold(
+        0i64,
+        |sum, &c| if c < 0 { None } else { sum.checked_add(c) },
+    );
+    if total != Some(points.len() as i64) {
+        let total = total.map_or_else(
+            || "a negative or overflowing total".to_string(),
+            |t| t.to_string(),
+        );
         return Err(error(
             builder,
             format!(
