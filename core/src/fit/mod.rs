@@ -75,11 +75,17 @@ pub enum FitError {
     },
     #[error("{0} layers: choose 1 to 64")]
     Layers(u32),
+    #[error("{0} scalp faces: choose at most {MAX_SCALP_FACES}")]
+    ScalpFaces(usize),
     #[error("fitting was cancelled")]
     Cancelled,
     #[error("the fitted hair mesh is invalid: {0}")]
     Invalid(String),
 }
+
+/// Most faces of a scalp built from the roots (a lattice of this many is built and
+/// triangulated; far more than the 4096 the automatic choice goes up to).
+pub const MAX_SCALP_FACES: usize = 1 << 18;
 
 /// Where the scalp comes from.
 pub enum ScalpSource {
@@ -138,6 +144,9 @@ pub fn fit(
 ) -> Result<Fitted, FitError> {
     if options.layers == 0 || options.layers > 64 {
         return Err(FitError::Layers(options.layers));
+    }
+    if options.scalp_faces > MAX_SCALP_FACES {
+        return Err(FitError::ScalpFaces(options.scalp_faces));
     }
     let threads = thread_count(options);
     let mut timings = Vec::new();

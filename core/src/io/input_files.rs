@@ -144,20 +144,30 @@ pub fn read_regular_file(
     read_regular_file_as(path, path, cap_bytes, what)
 }
 
-fn read_regular_file_as(
+/// Checks that `path` is a regular file of at most `cap_bytes` without reading it (for a
+/// file a library then reads itself, such as a USD stage).
+pub fn check_regular_file(
+    path: &Path,
+    cap_bytes: u64,
+    what: &'static str,
+) -> Result<(), InputFileError> {
+    open_regular(path, path, cap_bytes, what).map(|_| ())
+}
+
+/// Opens `path` and checks, on the open file, that it is a regular file under the cap (so a
+/// swap between a check and the open cannot slip a FIFO or device in).
+fn open_regular(
     path: &Path,
     shown: &Path,
     cap_bytes: u64,
     what: &'static str,
-) -> Result<Vec<u8>, InputFileError> {
+) -> Result<(std::fs::File, u64), InputFileError> {
     let shown_text = || shown.display().to_string();
     let io = |source| InputFileError::Io {
         path: shown_text(),
         source,
     };
     let file = open_without_blocking(path).map_err(io)?;
-    // The type is checked on the open file, so a swap between a check and the open
-    // cannot slip a FIFO or device in.
     let metadata = file.metadata().map_err(io)?;
     let file_type = metadata.file_type();
     if !file_type.is_file() {
@@ -173,13 +183,26 @@ fn read_regular_file_as(
             what,
         });
     }
-    let mut bytes = Vec::with_capacity(metadata.len() as usize);
+    Ok((file, metadata.len()))
+}
+
+fn read_regular_file_as(
+    path: &Path,
+    shown: &Path,
+    cap_bytes: u64,
+    what: &'static str,
+) -> Result<Vec<u8>, InputFileError> {
+    let (file, len) = open_regular(path, shown, cap_bytes, what)?;
+    let mut bytes = Vec::with_capacity(len as usize);
     file.take(cap_bytes.saturating_add(1))
         .read_to_end(&mut bytes)
-        .map_err(io)?;
+        .map_err(|source| InputFileError::Io {
+            path: shown.display().to_string(),
+            source,
+        })?;
     if bytes.len() as u64 > cap_bytes {
         return Err(InputFileError::TooLarge {
-            path: shown_text(),
+            path: shown.display().to_string(),
             cap_bytes,
             what,
         });

@@ -19,7 +19,7 @@ use openusd::sdf;
 use openusd::usd::{Prim, Stage, TimeCode};
 
 use super::{GroomBuilder, GroomLimits, GroomReadError, InputGroom, without_panics};
-use crate::io::input_files::{InputFolder, read_regular_file};
+use crate::io::input_files::{InputFolder, check_regular_file};
 
 /// Most prims walked, so a stage of millions of empty prims cannot run unbounded.
 const MAX_PRIMS: usize = 1 << 20;
@@ -93,8 +93,7 @@ pub fn read(
 ) -> Result<InputGroom, GroomReadError> {
     // The named file itself: a regular file under the cap (this also refuses FIFOs and
     // devices before the USD library opens it).
-    let probe = read_regular_file(path, limits.max_file_bytes, "a groom").map(|_| ());
-    probe?;
+    check_regular_file(path, limits.max_file_bytes, "a groom")?;
     let folder = InputFolder::of_file(path)?;
     let canonical_folder = std::fs::canonicalize(folder.path()).map_err(|source| {
         crate::io::input_files::InputFileError::Io {
