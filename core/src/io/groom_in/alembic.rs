@@ -145,6 +145,55 @@ pub fn check_ogawa_tree(bytes: &[u8]) -> Result<(), String> {
             }
         }
     }
+    check_time_samplings(bytes, root)
+}
+
+/// The archive's time samplings (the root group's fifth child, a data blob): `ogawa-rs`
+/// allocates each entry's sample list from a count in the blob (up to 32 GiB) before it
+/// reads a sample, so every count is checked against what the blob holds first.
+fn check_time_samplings(bytes: &[u8], root: u64) -> Result<(), String> {
+    let u64_at = |at: u64| -> Option<u64> {
+        let at = usize::try_from(at).ok()?;
+        Some(u64::from_le_bytes(
+            bytes.get(at..at.checked_add(8)?)?.try_into().ok()?,
+        ))
+    };
+    let Some(count) = u64_at(root) else {
+        return Ok(());
+    };
+    if count < 5 {
+        return Ok(()); // not an archive the crate reads; it says so itself
+    }
+    let Some(child) = root.checked_add(8 + 8 * 4).and_then(u64_at) else {
+        return Ok(());
+    };
+    if child & DATA_BIT == 0 || child & !DATA_BIT == 0 {
+        return Ok(());
+    }
+    let at = child & !DATA_BIT;
+    let Some(size) = u64_at(at) else {
+        return Ok(());
+    };
+    let blob = usize::try_from(at + 8)
+        .ok()
+        .and_then(|start| bytes.get(start..start.checked_add(usize::try_from(size).ok()?)?))
+        .ok_or("the time samplings lie outside the file")?;
+    let mut pos = 0usize;
+    while pos < blob.len() {
+        // max sample (u32), time per cycle (f64), samples per cycle (u32), then the samples.
+        let header = blob
+            .get(pos..pos + 16)
+            .ok_or("a time sampling is cut short")?;
+        let samples = u32::from_le_bytes(header[12..16].try_into().map_err(|_| "cut short")?);
+        let needed = 8 * samples as usize;
+        if needed > blob.len() - pos - 16 {
+            return Err(format!(
+                "a time sampling claims {samples} samples, more than its {} bytes hold",
+                blob.len() - pos - 16
+            ));
+        }
+        pos += 16 + needed;
+    }
     Ok(())
 }
 

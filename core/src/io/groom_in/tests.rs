@@ -183,6 +183,19 @@ fn hostile_alembic_files_get_named_errors_not_panics() {
         parse(b"not alembic".to_vec()),
         Err(GroomReadError::Format { .. })
     ));
+    // A time sampling that claims 4 Gi samples (32 GiB) is refused before the crate
+    // allocates them.
+    let mut greedy = bytes.clone();
+    let word = |b: &[u8], at: usize| u64::from_le_bytes(b[at..at + 8].try_into().expect("8"));
+    let sampling = word(&greedy, root + 8 + 8 * 4) & !(1u64 << 63);
+    let first_count = sampling as usize + 8 + 12;
+    greedy[first_count..first_count + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    match parse(greedy) {
+        Err(GroomReadError::Format { message, .. }) => {
+            assert!(message.contains("time sampling"), "{message}")
+        }
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]
