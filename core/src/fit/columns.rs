@@ -22,15 +22,12 @@ pub fn sample_at_arc_length(
     reference_length: f64,
     count: usize,
 ) -> Vec<Option<DVec3>> {
-    let to = |p: [f32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+    let to = super::to_d;
     let mut out = Vec::with_capacity(count);
     let mut segment = 0usize;
     let mut segment_start = 0.0f64;
     let last = points.len() - 1;
-    let total: f64 = points
-        .windows(2)
-        .map(|w| (to(w[1]) - to(w[0])).length())
-        .sum();
+    let total = arc_length(points);
     for k in 0..count {
         let s = reference_length * k as f64 / (count - 1).max(1) as f64;
         if s > total + 0.02 * reference_length {
@@ -72,14 +69,7 @@ pub fn sample_at_arc_length(
 pub fn arc_length(points: &[[f32; 3]]) -> f64 {
     points
         .windows(2)
-        .map(|w| {
-            let d = DVec3::new(
-                (w[1][0] - w[0][0]) as f64,
-                (w[1][1] - w[0][1]) as f64,
-                (w[1][2] - w[0][2]) as f64,
-            );
-            d.length()
-        })
+        .map(|w| (super::to_d(w[1]) - super::to_d(w[0])).length())
         .sum()
 }
 

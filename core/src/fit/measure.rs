@@ -193,9 +193,8 @@ pub fn measure(groom: &InputGroom, fitted: &Fitted, options: &MeasureOptions) ->
     let generated = fitted_strands(fitted, options, threads);
     let stride = |count: usize| count.div_ceil(options.max_strands.max(1)).max(1);
     let mut input_points = Vec::new();
-    let to_d = |p: &[f32; 3]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
     for i in (0..groom.curve_count()).step_by(stride(groom.curve_count())) {
-        let curve: Vec<DVec3> = groom.curve(i).iter().map(to_d).collect();
+        let curve: Vec<DVec3> = groom.curve(i).iter().map(|&p| super::to_d(p)).collect();
         resample(&curve, spacing, &mut input_points);
     }
     let mut fit_points = Vec::new();

@@ -109,7 +109,8 @@ pub struct Fitted {
 /// Progress of a fit: the step and its fraction; break to cancel.
 pub type FitProgress<'a> = dyn FnMut(&str, f64) -> ControlFlow<()> + 'a;
 
-fn to_d(p: [f32; 3]) -> DVec3 {
+/// A groom point (f32, as files hold them) in the fit's f64.
+pub(crate) fn to_d(p: [f32; 3]) -> DVec3 {
     DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 

@@ -94,11 +94,7 @@ pub fn check_ogawa_tree(bytes: &[u8]) -> Result<(), String> {
         return Err("not an Alembic (Ogawa) file".into());
     }
     let len = bytes.len() as u64;
-    let u64_at = |at: u64| -> Option<u64> {
-        let at = usize::try_from(at).ok()?;
-        let slice = bytes.get(at..at.checked_add(8)?)?;
-        Some(u64::from_le_bytes(slice.try_into().ok()?))
-    };
+    let u64_at = |at: u64| word_at(bytes, at);
     let root = u64_at(8).ok_or("truncated header")?;
     let mut stack = vec![root];
     let mut seen = std::collections::HashSet::new();
@@ -148,16 +144,18 @@ pub fn check_ogawa_tree(bytes: &[u8]) -> Result<(), String> {
     check_time_samplings(bytes, root)
 }
 
+/// The little-endian word at byte `at`; `None` past the end.
+fn word_at(bytes: &[u8], at: u64) -> Option<u64> {
+    let at = usize::try_from(at).ok()?;
+    let slice = bytes.get(at..at.checked_add(8)?)?;
+    Some(u64::from_le_bytes(slice.try_into().ok()?))
+}
+
 /// The archive's time samplings (the root group's fifth child, a data blob): `ogawa-rs`
 /// allocates each entry's sample list from a count in the blob (up to 32 GiB) before it
 /// reads a sample, so every count is checked against what the blob holds first.
 fn check_time_samplings(bytes: &[u8], root: u64) -> Result<(), String> {
-    let u64_at = |at: u64| -> Option<u64> {
-        let at = usize::try_from(at).ok()?;
-        Some(u64::from_le_bytes(
-            bytes.get(at..at.checked_add(8)?)?.try_into().ok()?,
-        ))
-    };
+    let u64_at = |at: u64| word_at(bytes, at);
     let Some(count) = u64_at(root) else {
         return Ok(());
     };
