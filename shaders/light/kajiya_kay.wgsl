@@ -1,13 +1,22 @@
-// Kajiya & Kay 1989: a diffuse lobe sin(T, L) and a specular lobe sin(T, H)^p, plus a shifted,
-// tinted secondary highlight, in the fibre frame of hair_bsdf.wgsl (x is the tangent). The
-// colour comes from the material's absorption (hair_color), so the two shading models show
-// the same hair.
+// Kajiya & Kay 1989: a diffuse lobe sin(T, L), a white primary highlight sin(T, H)^80 and a
+// tinted secondary one sin(T, H)^20, in the fibre frame of hair_bsdf.wgsl (x is the tangent).
+// CPU mirror (same name): core/src/light/kajiya_kay.rs, which chooses the weights
+// (`scene.kajiya_kay`) per material so that, averaged over the sphere, it scatters what the
+// Marschner fibre does: the primary highlight as R, the tinted lobes as TT + TRT + the rest.
+// Switching a scene between the two models then keeps the hair's colour.
 
 fn kajiya_kay(wo: vec3<f32>, wi: vec3<f32>, base: vec3<f32>) -> vec3<f32> {
     let diffuse = sqrt(max(1.0 - wi.x * wi.x, 0.0));
-    let half_vector = normalize(wi + wo);
-    let sin_th = sqrt(max(1.0 - half_vector.x * half_vector.x, 0.0));
-    let primary = pow(sin_th, 80.0) * 0.12;
-    let secondary = pow(sin_th, 20.0) * 0.25;
-    return base * diffuse * 0.35 + vec3<f32>(primary) + base * secondary;
+    let sum = wi + wo;
+    var primary = 0.0;
+    var secondary = 0.0;
+    // Looking straight into the light there is no half vector: no highlight.
+    if dot(sum, sum) > 1e-12 {
+        let half_vector = normalize(sum);
+        let sin_th = sqrt(max(1.0 - half_vector.x * half_vector.x, 0.0));
+        primary = pow(sin_th, 80.0);
+        secondary = pow(sin_th, 20.0);
+    }
+    return base * scene.kajiya_kay.rgb * (0.35 * diffuse + 0.25 * secondary)
+        + vec3<f32>(scene.kajiya_kay.w * primary);
 }

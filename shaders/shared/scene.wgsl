@@ -40,6 +40,9 @@ struct SceneUniforms {
     body_color: vec4<f32>,
     // x: Gauss-Legendre offsets averaged across thin fibres (1 to 3).
     quality: vec4<u32>,
+    // Kajiya-Kay's weights for the material (light/kajiya_kay.wgsl): rgb the tint of its
+    // diffuse and secondary lobes, w its primary highlight's weight.
+    kajiya_kay: vec4<f32>,
 }
 
 @group(1) @binding(0) var<uniform> scene: SceneUniforms;

@@ -129,6 +129,13 @@ impl HairBsdf {
         a
     }
 
+    /// Each lobe's attenuation `A_p` for outgoing `wo` at offset `h` and absorption `sigma_a`:
+    /// what the lobe scatters in all (`∫ M_p N_p dω_i = 1`).
+    pub fn attenuations(&self, wo: DVec3, h: f64, sigma_a: [f64; 3]) -> [[f64; 3]; P_MAX + 1] {
+        let inside = self.inside(wo, h, sigma_a);
+        self.ap(inside.cos_theta_o, inside.h, inside.transmittance)
+    }
+
     /// The scattering function `f_s(wo, wi)` at offset `h` (see the module's conventions).
     pub fn hair_bsdf(&self, wo: DVec3, wi: DVec3, h: f64, sigma_a: [f64; 3]) -> [f64; 3] {
         let inside = self.inside(wo, h, sigma_a);

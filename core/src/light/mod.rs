@@ -5,6 +5,7 @@
 //! | file | what |
 //! |---|---|
 //! | [`material`] | absorption from melanin or colour (Chiang et al. 2016), root-to-tip and per-strand variation |
+//! | [`kajiya_kay`] | Kajiya & Kay 1989's cheap fibre shading, weighted per material to show the Marschner model's mean colour |
 //! | [`hair_bsdf`] | the Marschner R / TT / TRT fibre model in Chiang's energy-conserving form |
 //! | [`dual_scattering`] | Zinke et al. 2008's multiple-scattering tables and response |
 //! | [`aggregated_bcsdf`] | far hair: seed 001's aggregated BCSDF for a thick hair standing for a cluster of fibres |
@@ -17,6 +18,7 @@ pub mod aggregated_bcsdf;
 pub mod cluster_reference;
 pub mod dual_scattering;
 pub mod hair_bsdf;
+pub mod kajiya_kay;
 pub mod material;
 pub mod opacity_maps;
 pub mod reference_render;

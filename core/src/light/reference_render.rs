@@ -120,7 +120,12 @@ enum Primitive {
         /// Fraction along the strand at `a` and `b`.
         along: [f64; 2],
     },
-    Triangle([DVec3; 3]),
+    /// A body triangle: its corners and their smooth shading normals (zero where a vertex
+    /// has none), as the GPU's body pass interpolates them.
+    Triangle {
+        corners: [DVec3; 3],
+        normals: [DVec3; 3],
+    },
 }
 
 struct Hit {
@@ -164,16 +169,19 @@ impl<'a> World<'a> {
                 });
             }
         }
+        let vertex_normals = body.vertex_normals();
         for triangle in &body.triangles {
-            let corner = |i: usize| {
-                let p = body
-                    .positions
+            let at = |values: &[[f32; 3]], i: usize| {
+                let p = values
                     .get(triangle[i] as usize)
                     .copied()
                     .unwrap_or_default();
                 DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
             };
-            primitives.push(Primitive::Triangle([corner(0), corner(1), corner(2)]));
+            primitives.push(Primitive::Triangle {
+                corners: [0, 1, 2].map(|i| at(&body.positions, i)),
+                normals: [0, 1, 2].map(|i| at(&vertex_normals, i)),
+            });
         }
         let aabbs: Vec<Aabb> = primitives
             .iter()
@@ -183,7 +191,9 @@ impl<'a> World<'a> {
                         a.min(*b) - DVec3::splat(*radius),
                         a.max(*b) + DVec3::splat(*radius),
                     ),
-                    Primitive::Triangle([a, b, c]) => (a.min(*b).min(*c), a.max(*b).max(*c)),
+                    Primitive::Triangle {
+                        corners: [a, b, c], ..
+                    } => (a.min(*b).min(*c), a.max(*b).max(*c)),
                 };
                 // Widen by a float's rounding so f32 boxes always hold the f64 shapes.
                 let pad = DVec3::splat(1e-6 * (1.0 + lo.abs().max(hi.abs()).max_element()));
@@ -239,7 +249,7 @@ impl<'a> World<'a> {
                 Primitive::Segment { a, b, radius, .. } => {
                     intersect_segment(origin, direction, *a, *b, *radius, t_min)
                 }
-                Primitive::Triangle(corners) => {
+                Primitive::Triangle { corners, .. } => {
                     intersect_triangle(origin, direction, corners, t_min).map(|t| (t, 0.0))
                 }
             };
@@ -345,11 +355,8 @@ impl<'a> World<'a> {
                             (wi, f.map(|v| v / pdf))
                         })
                 }
-                Primitive::Triangle([p0, p1, p2]) => {
-                    let mut normal = (*p1 - *p0).cross(*p2 - *p0).normalize_or_zero();
-                    if normal.dot(wo) < 0.0 {
-                        normal = -normal;
-                    }
+                Primitive::Triangle { corners, normals } => {
+                    let normal = shading_normal(corners, normals, point, wo);
                     let albedo = scene.body_color.map(f64::from);
                     for light in &scene.lights {
                         let Some((wi, irradiance, distance)) = light_at(light, point) else {
@@ -498,6 +505,32 @@ fn intersect_triangle(
     }
     let t = e2.dot(q) * inv;
     (t > t_min).then_some(t)
+}
+
+/// The body's shading normal at `point` on a triangle, as `shaders/preview_body.wgsl` takes
+/// it: the corners' normals interpolated (barycentric), turned to `wo`'s side of the face;
+/// the face's own normal where they (nearly) cancel or a corner has none.
+fn shading_normal(corners: &[DVec3; 3], normals: &[DVec3; 3], point: DVec3, wo: DVec3) -> DVec3 {
+    let [p0, p1, p2] = *corners;
+    let cross = (p1 - p0).cross(p2 - p0);
+    let mut face = cross.normalize_or_zero();
+    if face.dot(wo) < 0.0 {
+        face = -face;
+    }
+    let area2 = cross.length_squared();
+    if area2.is_nan() || area2 <= 0.0 {
+        return face;
+    }
+    // Barycentric weights from the sub-triangles' areas (signed along the face's normal).
+    let weight = |a: DVec3, b: DVec3| (b - a).cross(point - a).dot(cross) / area2;
+    let interpolated =
+        normals[0] * weight(p1, p2) + normals[1] * weight(p2, p0) + normals[2] * weight(p0, p1);
+    let length = interpolated.length();
+    if length.is_nan() || length <= 0.1 {
+        return face;
+    }
+    let n = interpolated / length;
+    if n.dot(face) < 0.0 { -n } else { n }
 }
 
 /// Path-traces `fibres` over `body` lit by `scene`, seen by `camera`.

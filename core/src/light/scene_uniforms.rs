@@ -8,10 +8,11 @@ use glam::Vec3;
 
 use crate::light::dual_scattering::DualScatteringTables;
 use crate::light::hair_bsdf::HairBsdf;
+use crate::light::kajiya_kay::KajiyaKayWeights;
 use crate::light::material::Fibre;
 use crate::light::opacity_maps::ShadowView;
 use crate::model::scene::{
-    Coverage, LightSource, MAX_LIGHTS, MAX_SHADOWED_LIGHTS, Scene, SelfShadowing,
+    Coverage, LightSource, MAX_LIGHTS, MAX_SHADOWED_LIGHTS, Scene, SelfShadowing, Shading,
 };
 
 /// One light. Keep in sync with `shaders/shared/scene.wgsl` (`SceneLight`).
@@ -67,6 +68,10 @@ pub struct SceneUniforms {
     pub body_color: [f32; 4],
     /// x: Gauss-Legendre offsets across thin fibres (1 to 3); y, z, w: 0.
     pub quality: [u32; 4],
+    /// Kajiya-Kay's weights for this material (`KajiyaKayWeights::matching`; zero when the
+    /// scene shades with Marschner): rgb the tint of the diffuse and secondary lobes, w the
+    /// primary highlight's weight.
+    pub kajiya_kay: [f32; 4],
 }
 
 /// Deep opacity maps' default depth (the layers' span behind the first hair) as a fraction of
@@ -192,6 +197,10 @@ impl SceneUniforms {
         }
         uniforms.body_color = rgb(scene.body_color, 0.0);
         uniforms.quality = [effects.fibre_offsets.clamp(1, 3), 0, 0, 0];
+        if effects.shading == Shading::KajiyaKay {
+            let weights = KajiyaKayWeights::matching(&fibre);
+            uniforms.kajiya_kay = rgb(weights.tint.map(|t| t as f32), weights.primary as f32);
+        }
         uniforms
     }
 }

@@ -149,6 +149,6 @@ impl BodyShadowRenderer {
         });
         pass.set_pipeline(&self.pipeline);
         BodyRenderer::bind(&mut pass, prepared, slot + 1);
-        body.draw(&mut pass);
+        body.draw(&mut pass, false);
     }
 }

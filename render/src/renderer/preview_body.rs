@@ -20,10 +20,17 @@ pub struct BodyUniforms {
     pub camera_position: [f32; 4],
 }
 
-/// The body mesh on the GPU: vertex and index buffers, made once per document.
+/// The body mesh on the GPU: positions, smooth shading normals
+/// ([`hairloom_core::BodyMesh::vertex_normals`]) and indices, made once per document.
 pub struct GpuBody {
-    buffers: Option<(Tracked<wgpu::Buffer>, Tracked<wgpu::Buffer>)>,
+    buffers: Option<BodyBuffers>,
     index_count: u32,
+}
+
+struct BodyBuffers {
+    positions: Tracked<wgpu::Buffer>,
+    normals: Tracked<wgpu::Buffer>,
+    indices: Tracked<wgpu::Buffer>,
 }
 
 impl GpuBody {
@@ -42,18 +49,23 @@ impl GpuBody {
             )
         };
         Self {
-            buffers: Some((
-                buffer(
+            buffers: Some(BodyBuffers {
+                positions: buffer(
                     "body_vertices",
                     bytemuck::cast_slice(&body.positions),
                     wgpu::BufferUsages::VERTEX,
                 ),
-                buffer(
+                normals: buffer(
+                    "body_normals",
+                    bytemuck::cast_slice(&body.vertex_normals()),
+                    wgpu::BufferUsages::VERTEX,
+                ),
+                indices: buffer(
                     "body_indices",
                     bytemuck::cast_slice(&body.triangles),
                     wgpu::BufferUsages::INDEX,
                 ),
-            )),
+            }),
             index_count: body.triangles.len() as u32 * 3,
         }
     }
@@ -70,23 +82,41 @@ impl GpuBody {
         self.buffers.is_none()
     }
 
-    /// Binds the mesh and draws it (pipeline and groups set by the caller).
-    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
-        if let Some((vertices, indices)) = &self.buffers {
-            pass.set_vertex_buffer(0, vertices.slice(..));
-            pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+    /// Binds the mesh and draws it (pipeline and groups set by the caller): positions in
+    /// slot 0, and the normals in slot 1 where `with_normals` (the lit pass; shadow maps
+    /// need positions only).
+    pub(crate) fn draw(&self, pass: &mut wgpu::RenderPass<'_>, with_normals: bool) {
+        if let Some(buffers) = &self.buffers {
+            pass.set_vertex_buffer(0, buffers.positions.slice(..));
+            if with_normals {
+                pass.set_vertex_buffer(1, buffers.normals.slice(..));
+            }
+            pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..self.index_count, 0, 0..1);
         }
     }
 }
 
-/// The body's vertex layout (positions only).
-pub(crate) const BODY_VERTEX_LAYOUT: [Option<wgpu::VertexBufferLayout<'static>>; 1] =
-    [Some(wgpu::VertexBufferLayout {
+/// One tightly packed `vec3<f32>` per vertex, for `attributes`' one location.
+const fn vec3_buffer(
+    attributes: &'static [wgpu::VertexAttribute; 1],
+) -> Option<wgpu::VertexBufferLayout<'static>> {
+    Some(wgpu::VertexBufferLayout {
         array_stride: 12,
         step_mode: wgpu::VertexStepMode::Vertex,
-        attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-    })];
+        attributes,
+    })
+}
+
+/// The body's positions, for the shadow maps (`vs_shadow`).
+pub(crate) const BODY_VERTEX_LAYOUT: [Option<wgpu::VertexBufferLayout<'static>>; 1] =
+    [vec3_buffer(&wgpu::vertex_attr_array![0 => Float32x3])];
+
+/// The body's positions and smooth normals, for the lit pass (`vs_main`).
+const BODY_LIT_VERTEX_LAYOUT: [Option<wgpu::VertexBufferLayout<'static>>; 2] = [
+    vec3_buffer(&wgpu::vertex_attr_array![0 => Float32x3]),
+    vec3_buffer(&wgpu::vertex_attr_array![1 => Float32x3]),
+];
 
 /// The body's bindings (group 0) and its lit pipeline for the current effects.
 pub struct BodyRenderer {
@@ -156,7 +186,7 @@ impl BodyRenderer {
                 label: "preview_body",
                 source: &source,
                 groups: &groups,
-                buffers: &BODY_VERTEX_LAYOUT,
+                buffers: &BODY_LIT_VERTEX_LAYOUT,
                 vertex_entry: "vs_main",
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 fragment_entry: Some("fs_main"),
@@ -218,7 +248,7 @@ impl BodyRenderer {
         if let (Some((_, pipeline)), false) = (&self.pipeline, body.is_empty()) {
             pass.set_pipeline(pipeline);
             Self::bind(pass, prepared, 0);
-            body.draw(pass);
+            body.draw(pass, true);
         }
     }
 }
