@@ -191,7 +191,7 @@ fn shade_fur(in: FurVertex, local_tangent: vec3<f32>, tint: f32) -> vec4<f32> {
         let crossed = hairs_in_front(in.world, slot) + through_fur;
         let visible = body_visibility(in.world, slot);
         let wi_local = vec3<f32>(dot(wi, frame[0]), dot(wi, frame[1]), dot(wi, frame[2]));
-        let single = hair_single(wo_local, wi_local, 0.0, sigma_a);
+        let single = hair_single(wo_local, wi_local, 0.0, sigma_a, i);
         radiance += hair_radiance(wo_local, wi_local, single, crossed) * light_irradiance(i, in.world) * visible;
     }
     return vec4<f32>(tonemap(radiance * tint), 1.0);

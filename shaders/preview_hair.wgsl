@@ -54,11 +54,11 @@ fn pass_vertex(ribbon: RibbonVertex) -> VertexOutput {
 // which is what a path tracer's pixel averages to. Blended between 2 and 4 pixels so nothing
 // pops as a strand's width changes. (Multiple scattering does not depend on h:
 // `hair_radiance` adds it once.)
-fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: vec3<f32>) -> vec3<f32> {
+fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: vec3<f32>, light: u32) -> vec3<f32> {
     let averaged = clamp(2.0 - 0.5 * width_px, 0.0, 1.0);
     var result = vec3<f32>(0.0);
     if averaged < 1.0 {
-        result += (1.0 - averaged) * hair_single(wo, wi, clamp(h, -1.0, 1.0), sigma_a);
+        result += (1.0 - averaged) * hair_single(wo, wi, clamp(h, -1.0, 1.0), sigma_a, light);
     }
     if averaged > 0.0 {
         // Gauss-Legendre over h ∈ [−1, 1], weights summing to 1, written out per count (a
@@ -66,14 +66,14 @@ fn fibre_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, width_px: f32, sigma_a: ve
         var average: vec3<f32>;
         let points = scene.quality.x;
         if points <= 1u {
-            average = hair_single(wo, wi, 0.0, sigma_a);
+            average = hair_single(wo, wi, 0.0, sigma_a, light);
         } else if points == 2u {
-            average = 0.5 * (hair_single(wo, wi, -0.5773503, sigma_a)
-                + hair_single(wo, wi, 0.5773503, sigma_a));
+            average = 0.5 * (hair_single(wo, wi, -0.5773503, sigma_a, light)
+                + hair_single(wo, wi, 0.5773503, sigma_a, light));
         } else {
-            average = 0.2777778 * (hair_single(wo, wi, -0.7745967, sigma_a)
-                + hair_single(wo, wi, 0.7745967, sigma_a))
-                + 0.4444444 * hair_single(wo, wi, 0.0, sigma_a);
+            average = 0.2777778 * (hair_single(wo, wi, -0.7745967, sigma_a, light)
+                + hair_single(wo, wi, 0.7745967, sigma_a, light))
+                + 0.4444444 * hair_single(wo, wi, 0.0, sigma_a, light);
         }
         result += averaged * average;
     }
@@ -96,7 +96,7 @@ fn shade_hair(in: VertexOutput) -> vec3<f32> {
         let n = hairs_in_front(in.world, slot);
         let visible = body_visibility(in.world, slot);
         let wi_local = vec3<f32>(dot(wi, x), dot(wi, y), dot(wi, z));
-        let single = fibre_single(wo_local, wi_local, in.h, in.width_px, sigma_a);
+        let single = fibre_single(wo_local, wi_local, in.h, in.width_px, sigma_a, i);
         radiance += hair_radiance(wo_local, wi_local, single, n) * light_irradiance(i, in.world) * visible;
     }
     return tonemap(radiance);

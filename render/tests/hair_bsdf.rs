@@ -7,16 +7,18 @@
 //! shapes, including the hard cases (light along the tangent, grazing angles, h = ±1, lowest
 //! roughness, one-strand and flat clusters, the ribbon's edges).
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use hairloom_core::light::aggregated_bcsdf::{
     AggregatedTables, ClusterShape, HairsOnPath, VISIBLE_DEPTHS, cluster_hairs_on_path,
 };
 use hairloom_core::light::dual_scattering::DualScatteringTables;
 use hairloom_core::light::hair_bsdf::{HairBsdf, direction};
-use hairloom_core::light::kajiya_kay::{KajiyaKayWeights, kajiya_kay};
+use hairloom_core::light::kajiya_kay::{KajiyaKayTable, kajiya_kay};
 use hairloom_core::light::material::Fibre;
 use hairloom_core::light::scene_uniforms::SceneUniforms;
-use hairloom_core::model::scene::{HairMaterial, Pigment, Scene, SelfShadowing, Shading};
+use hairloom_core::model::scene::{
+    HairMaterial, LightSource, Pigment, Scene, SelfShadowing, Shading,
+};
 use hairloom_render::device::{GpuContext, headless_for_test, read_buffer};
 use hairloom_render::preview::PreviewRenderer;
 use hairloom_render::renderer::preview_hair::default_hair_shader;
@@ -292,13 +294,13 @@ fn evaluate_kajiya_kay(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let c = cases[i];
-    results[2u * i] = vec4<f32>(kajiya_kay(c.wo.xyz, c.wi.xyz, c.sigma_a.xyz), 0.0);
+    results[2u * i] = vec4<f32>(kajiya_kay(c.wo.xyz, c.wi.xyz, c.sigma_a.xyz, scene.lights[0].kajiya_kay), 0.0);
     results[2u * i + 1u] = vec4<f32>(0.0);
 }
 "#;
 
 /// `kajiya_kay` (light/kajiya_kay.wgsl) against `hairloom_core::light::kajiya_kay` with the
-/// weights the scene uniforms carry for three materials, the mirror and highlight directions
+/// key light's weights the scene uniforms carry for three materials, the mirror and highlight directions
 /// included (and looking straight into the light, where there is no half vector).
 #[test]
 fn gpu_kajiya_kay_matches_the_cpu_mirror() {
@@ -342,12 +344,17 @@ fn gpu_kajiya_kay_matches_the_cpu_mirror() {
             ..Scene::default()
         };
         let lighting = SceneLighting::new(&context);
-        lighting.write(
-            &context,
-            &SceneUniforms::new(&scene, &[], None, [0.5; 3], 0.2, 0.0005),
-        );
+        let mut uniforms = SceneUniforms::new(&scene, &[], None, [0.5; 3], 0.2, 0.0005);
+        let (center, eye) = (Vec3::new(0.0, 1.6, 0.0), Vec3::new(0.3, 1.7, 1.0));
         let fibre = Fibre::new(&material);
-        let weights = KajiyaKayWeights::matching(&fibre);
+        let table = KajiyaKayTable::new(&fibre);
+        uniforms.match_kajiya_kay(&scene, center, eye, &table);
+        lighting.write(&context, &uniforms);
+        let LightSource::Directional { to_light } = scene.lights[0].source else {
+            panic!("the default key light is directional");
+        };
+        let weights = table.at((eye - center).as_dvec3(), Vec3::from(to_light).as_dvec3());
+        assert!(weights.primary > 0.0 && weights.tint.iter().all(|t| *t > 0.0));
         let half_pi = std::f64::consts::FRAC_PI_2;
         let angles = [-half_pi, -1.2, -0.5, 0.0, 0.02, 0.3, 0.9, half_pi];
         let azimuths = [0.0, 0.7, 1.6, 3.1, std::f64::consts::PI, -2.4];

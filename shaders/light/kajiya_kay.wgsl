@@ -1,11 +1,11 @@
 // Kajiya & Kay 1989: a diffuse lobe sin(T, L), a white primary highlight sin(T, H)^80 and a
-// tinted secondary one sin(T, H)^20, in the fibre frame of hair_bsdf.wgsl (x is the tangent).
-// CPU mirror (same name): core/src/light/kajiya_kay.rs, which chooses the weights
-// (`scene.kajiya_kay`) per material so that, averaged over the sphere, it scatters what the
-// Marschner fibre does: the primary highlight as R, the tinted lobes as TT + TRT + the rest.
-// Switching a scene between the two models then keeps the hair's colour.
+// tinted secondary one sin(T, H)^20, in the fibre frame of hair_bsdf.wgsl (x is the tangent),
+// with one light's `weights` (rgb: tint of the diffuse and secondary lobes; w: the primary's
+// weight). CPU mirror (same name): core/src/light/kajiya_kay.rs, which chooses the weights
+// per light and frame so that, over every fibre orientation, it shows the Marschner model's
+// mean colour: the primary highlight as R, the tinted lobes as TT + TRT + the rest.
 
-fn kajiya_kay(wo: vec3<f32>, wi: vec3<f32>, base: vec3<f32>) -> vec3<f32> {
+fn kajiya_kay(wo: vec3<f32>, wi: vec3<f32>, base: vec3<f32>, weights: vec4<f32>) -> vec3<f32> {
     let diffuse = sqrt(max(1.0 - wi.x * wi.x, 0.0));
     let sum = wi + wo;
     var primary = 0.0;
@@ -17,6 +17,5 @@ fn kajiya_kay(wo: vec3<f32>, wi: vec3<f32>, base: vec3<f32>) -> vec3<f32> {
         primary = pow(sin_th, 80.0);
         secondary = pow(sin_th, 20.0);
     }
-    return base * scene.kajiya_kay.rgb * (0.35 * diffuse + 0.25 * secondary)
-        + vec3<f32>(scene.kajiya_kay.w * primary);
+    return base * weights.rgb * (0.35 * diffuse + 0.25 * secondary) + vec3<f32>(weights.w * primary);
 }

@@ -1,6 +1,6 @@
 // Marschner shading without multiple scattering: single scattering (`hair_single`),
 // attenuated by the forward transmittance of the `n` fibres between the point and the light.
-fn hair_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, sigma_a: vec3<f32>) -> vec3<f32> {
+fn hair_single(wo: vec3<f32>, wi: vec3<f32>, h: f32, sigma_a: vec3<f32>, light: u32) -> vec3<f32> {
     return hair_bsdf(wo, wi, h, sigma_a);
 }
 

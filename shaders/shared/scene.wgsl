@@ -9,6 +9,9 @@ struct SceneLight {
     vector: vec4<f32>,
     // rgb: colour × intensity; w: the light's shadow slot, or −1 when it casts none.
     radiance: vec4<f32>,
+    // Kajiya-Kay's weights for this light (light/kajiya_kay.wgsl; 0 under Marschner): rgb
+    // the tint of its diffuse and secondary lobes, w its primary highlight's weight.
+    kajiya_kay: vec4<f32>,
 }
 
 struct ShadowView {
@@ -40,9 +43,6 @@ struct SceneUniforms {
     body_color: vec4<f32>,
     // x: Gauss-Legendre offsets averaged across thin fibres (1 to 3).
     quality: vec4<u32>,
-    // Kajiya-Kay's weights for the material (light/kajiya_kay.wgsl): rgb the tint of its
-    // diffuse and secondary lobes, w its primary highlight's weight.
-    kajiya_kay: vec4<f32>,
 }
 
 @group(1) @binding(0) var<uniform> scene: SceneUniforms;

@@ -129,22 +129,25 @@ impl HairBsdf {
         a
     }
 
-    /// Each lobe's attenuation `A_p` for outgoing `wo` at offset `h` and absorption `sigma_a`:
-    /// what the lobe scatters in all (`∫ M_p N_p dω_i = 1`).
-    pub fn attenuations(&self, wo: DVec3, h: f64, sigma_a: [f64; 3]) -> [[f64; 3]; P_MAX + 1] {
-        let inside = self.inside(wo, h, sigma_a);
-        self.ap(inside.cos_theta_o, inside.h, inside.transmittance)
-    }
-
     /// The scattering function `f_s(wo, wi)` at offset `h` (see the module's conventions).
     pub fn hair_bsdf(&self, wo: DVec3, wi: DVec3, h: f64, sigma_a: [f64; 3]) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for lobe in self.lobes(wo, wi, h, sigma_a) {
+            for c in 0..3 {
+                sum[c] += lobe[c];
+            }
+        }
+        sum.map(|v| if v.is_finite() { v } else { 0.0 })
+    }
+
+    /// [`Self::hair_bsdf`] lobe by lobe: R, TT, TRT and the residual.
+    pub fn lobes(&self, wo: DVec3, wi: DVec3, h: f64, sigma_a: [f64; 3]) -> [[f64; 3]; P_MAX + 1] {
         let inside = self.inside(wo, h, sigma_a);
         let sin_theta_i = wi.x.clamp(-1.0, 1.0);
         let cos_theta_i = safe_sqrt(1.0 - sin_theta_i * sin_theta_i);
         let phi = azimuth(wi) - azimuth(wo);
         let ap = self.ap(inside.cos_theta_o, inside.h, inside.transmittance);
-        let mut sum = [0.0; 3];
-        for (p, a) in ap.iter().enumerate() {
+        std::array::from_fn(|p| {
             let (sin_op, cos_op) = self.tilted(p, inside.sin_theta_o, inside.cos_theta_o);
             let m = mp(cos_theta_i, cos_op, sin_theta_i, sin_op, self.v[p]);
             let n = if p < P_MAX {
@@ -152,11 +155,8 @@ impl HairBsdf {
             } else {
                 1.0 / std::f64::consts::TAU
             };
-            for c in 0..3 {
-                sum[c] += m * a[c] * n;
-            }
-        }
-        sum.map(|v| if v.is_finite() { v } else { 0.0 })
+            ap[p].map(|a| m * a * n)
+        })
     }
 
     /// How often [`Self::sample`] picks each lobe: its attenuation, averaged over colour.

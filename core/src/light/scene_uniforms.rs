@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use crate::light::dual_scattering::DualScatteringTables;
 use crate::light::hair_bsdf::HairBsdf;
-use crate::light::kajiya_kay::KajiyaKayWeights;
+use crate::light::kajiya_kay::KajiyaKayTable;
 use crate::light::material::Fibre;
 use crate::light::opacity_maps::ShadowView;
 use crate::model::scene::{
@@ -23,6 +23,10 @@ pub struct GpuLight {
     pub vector: [f32; 4],
     /// rgb: colour × intensity; w: the light's shadow slot, or −1 when it casts none.
     pub radiance: [f32; 4],
+    /// Kajiya-Kay's weights for this light ([`SceneUniforms::match_kajiya_kay`]; 0 under
+    /// Marschner shading): rgb the tint of its diffuse and secondary lobes, w its primary
+    /// highlight's weight.
+    pub kajiya_kay: [f32; 4],
 }
 
 /// A shadow-casting light's view. Keep in sync with `shaders/shared/scene.wgsl` (`ShadowView`).
@@ -68,10 +72,6 @@ pub struct SceneUniforms {
     pub body_color: [f32; 4],
     /// x: Gauss-Legendre offsets across thin fibres (1 to 3); y, z, w: 0.
     pub quality: [u32; 4],
-    /// Kajiya-Kay's weights for this material (`KajiyaKayWeights::matching`; zero when the
-    /// scene shades with Marschner): rgb the tint of the diffuse and secondary lobes, w the
-    /// primary highlight's weight.
-    pub kajiya_kay: [f32; 4],
 }
 
 /// Deep opacity maps' default depth (the layers' span behind the first hair) as a fraction of
@@ -139,6 +139,7 @@ impl SceneUniforms {
                     light.color[2] * light.intensity,
                     slot,
                 ],
+                kajiya_kay: [0.0; 4],
             };
         }
         let effects = &scene.effects;
@@ -197,11 +198,39 @@ impl SceneUniforms {
         }
         uniforms.body_color = rgb(scene.body_color, 0.0);
         uniforms.quality = [effects.fibre_offsets.clamp(1, 3), 0, 0, 0];
-        if effects.shading == Shading::KajiyaKay {
-            let weights = KajiyaKayWeights::matching(&fibre);
-            uniforms.kajiya_kay = rgb(weights.tint.map(|t| t as f32), weights.primary as f32);
-        }
         uniforms
+    }
+
+    /// Kajiya-Kay's weights for each light of `scene` seen from `eye` at the hair's centre
+    /// `hair_center`, from the material's `table` ([`KajiyaKayTable`]: the Marschner model's
+    /// mean colour for the angle between this view and light); nothing when the scene shades
+    /// with Marschner.
+    pub fn match_kajiya_kay(
+        &mut self,
+        scene: &Scene,
+        hair_center: Vec3,
+        eye: Vec3,
+        table: &KajiyaKayTable,
+    ) {
+        if scene.effects.shading != Shading::KajiyaKay {
+            return;
+        }
+        let to_viewer = (eye - hair_center).as_dvec3();
+        for (light, gpu) in scene.lights.iter().zip(self.lights.iter_mut()) {
+            let to_light = match light.source {
+                LightSource::Directional { to_light } => Vec3::from(to_light).as_dvec3(),
+                LightSource::Point { position_m } => {
+                    (Vec3::from(position_m) - hair_center).as_dvec3()
+                }
+            };
+            let weights = table.at(to_viewer, to_light);
+            gpu.kajiya_kay = [
+                weights.tint[0] as f32,
+                weights.tint[1] as f32,
+                weights.tint[2] as f32,
+                weights.primary as f32,
+            ];
+        }
     }
 }
 

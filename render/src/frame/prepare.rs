@@ -198,7 +198,7 @@ pub fn prepare(
         .dual_scattering
         .as_ref()
         .map(|ds| &ds.tables);
-    let uniforms = SceneUniforms::new(
+    let mut uniforms = SceneUniforms::new(
         inputs.scene,
         &shadow_views,
         tables,
@@ -206,6 +206,9 @@ pub fn prepare(
         radius,
         inputs.strand_width_m,
     );
+    if let Some(table) = renderers.lighting.kajiya_kay_table() {
+        uniforms.match_kajiya_kay(inputs.scene, center, inputs.camera.eye, table);
+    }
     renderers.lighting.write(context, &uniforms);
     // Per-frame buffers (not kept, so not in the registry).
     let storage = |label: &str, contents: &[u8]| {

@@ -10,6 +10,7 @@
 
 use hairloom_core::light::dual_scattering::{DualScatteringTables, PHI_COUNT, THETA_COUNT};
 use hairloom_core::light::hair_bsdf::P_MAX;
+use hairloom_core::light::kajiya_kay::KajiyaKayTable;
 use hairloom_core::light::material::Fibre;
 use hairloom_core::light::scene_uniforms::SceneUniforms;
 use hairloom_core::model::scene::{
@@ -302,6 +303,9 @@ pub struct SceneLighting {
     /// The material's mean forward transmittance per fibre, with the material it was made
     /// from (shadows without dual scattering need it; computing it costs a table).
     mean_forward: Option<(HairMaterial, [f32; 3])>,
+    /// Kajiya-Kay's weights by the angle between view and light, with the material they were
+    /// made for (made when a scene shades with Kajiya-Kay; 65 × 4096 × 3 fibre evaluations).
+    kajiya_kay: Option<(HairMaterial, KajiyaKayTable)>,
     pub table_sampler: wgpu::Sampler,
     pub depth_sampler: wgpu::Sampler,
 }
@@ -337,6 +341,7 @@ impl SceneLighting {
             scene_group,
             dual_scattering: None,
             mean_forward: None,
+            kajiya_kay: None,
             table_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("dual_scattering_tables"),
                 address_mode_u: clamp,
@@ -376,6 +381,18 @@ impl SceneLighting {
         } else {
             self.dual_scattering = None;
         }
+        if effects.shading == Shading::KajiyaKay {
+            if self
+                .kajiya_kay
+                .as_ref()
+                .is_none_or(|(made_from, _)| made_from != material)
+            {
+                let table = KajiyaKayTable::new(&Fibre::new(material));
+                self.kajiya_kay = Some((material.clone(), table));
+            }
+        } else {
+            self.kajiya_kay = None;
+        }
         if let Some(ds) = &self.dual_scattering {
             return ds.tables.mean_forward;
         }
@@ -387,6 +404,12 @@ impl SceneLighting {
                 value
             }
         }
+    }
+
+    /// Kajiya-Kay's weights for the material of the last [`Self::sync`] (`None` unless the
+    /// scene shades with Kajiya-Kay).
+    pub fn kajiya_kay_table(&self) -> Option<&KajiyaKayTable> {
+        self.kajiya_kay.as_ref().map(|(_, table)| table)
     }
 
     /// The scene uniform buffer (what group 1 binds).
