@@ -492,6 +492,23 @@ fn a_groom_exports_for_the_client_picked_in_the_file_menu() {
 }
 
 #[test]
+fn after_new_and_import_scalp_the_title_names_the_scalp_not_the_sample() {
+    // Issue 35's bug: the title and the quit prompt said "head_long_wavy.hairloom (sample)".
+    let glb =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/head/LeePerrySmith.glb");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Chosen(glb)]),
+    );
+    assert!(harness.state().state.title().contains("(sample)"));
+    file_menu(&mut harness, "New");
+    file_menu(&mut harness, "Import scalp…");
+    let title = harness.state().state.title();
+    assert!(!title.contains("sample"), "{title}");
+    assert!(title.contains("LeePerrySmith"), "{title}");
+}
+
+#[test]
 fn importing_a_scalp_is_one_undo_step() {
     let glb =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/head/LeePerrySmith.glb");
@@ -541,6 +558,28 @@ fn without_a_native_dialog_a_typed_path_is_asked_for() {
     harness.run();
     assert!(path.exists(), "{}", harness.state().state.message);
     assert_eq!(harness.state().state.path.as_deref(), Some(path.as_path()));
+}
+
+#[test]
+fn save_as_suggests_a_project_opened_by_a_relative_path_where_it_is() {
+    // Issue 35's bug: a project opened as `work/look.hairloom` was suggested as
+    // `work/work/look.hairloom`.
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Unavailable]),
+    );
+    let relative = std::path::PathBuf::from("work").join("look.hairloom");
+    harness.state_mut().state.path = Some(relative.clone());
+    file_menu(&mut harness, "Save As…");
+    let prompt = harness
+        .state()
+        .prompt
+        .as_ref()
+        .expect("the typed-path prompt");
+    assert_eq!(prompt.text, relative.display().to_string());
+    // And the prompt shows it.
+    harness.get_by_role(Role::TextInput);
+    harness.get_by_label("OK");
 }
 
 /// A left-button drag from `from` to `to` in steps (a region selection in the viewport).

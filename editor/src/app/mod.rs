@@ -455,15 +455,22 @@ impl HairloomApp {
     /// Asks a dialog for a path; `None` when cancelled or when the typed-path prompt was
     /// opened instead (its OK continues the request).
     fn ask(&mut self, request: FileRequest, suggested: Option<PathBuf>) -> Option<PathBuf> {
-        // A bare suggested name lands next to the open project, not in the working folder.
+        // A bare suggested name lands next to the open project, not in the working folder. A
+        // suggestion with folders of its own (the project's path, which is relative when it
+        // was opened by a relative path) is kept as it is: joining it to its own folder
+        // doubled that folder (`work/work/…`).
         let folder = self
             .state
             .path
             .as_deref()
             .and_then(std::path::Path::parent)
             .filter(|p| !p.as_os_str().is_empty());
+        let bare_name = |s: &std::path::Path| {
+            s.parent()
+                .is_none_or(|parent| parent.as_os_str().is_empty())
+        };
         let suggested = suggested.map(|s| match folder {
-            Some(folder) if s.is_relative() => folder.join(s),
+            Some(folder) if s.is_relative() && bare_name(&s) => folder.join(s),
             _ => s,
         });
         match self.dialogs.ask(request, suggested.as_deref()) {

@@ -96,6 +96,9 @@ pub struct EditorState {
     unsaved: bool,
     /// The scene's motion played back (view state).
     pub playback: super::playback::Playback,
+    /// Whether the document is still the embedded sample (named as such until saved); an
+    /// import that replaces its scalp makes it the artist's own.
+    is_sample: bool,
 }
 
 impl EditorState {
@@ -114,6 +117,7 @@ impl EditorState {
             tool: ToolSettings::default(),
             unsaved: false,
             playback: Default::default(),
+            is_sample: false,
         }
     }
 
@@ -121,7 +125,10 @@ impl EditorState {
     pub fn sample() -> Self {
         let project = project::from_bytes(SAMPLE_PROJECT, Path::new(SAMPLE_NAME))
             .expect("the embedded sample is a valid project (checked by `make test`)");
-        Self::from_project(project, None, format!("opened {SAMPLE_NAME}"))
+        Self {
+            is_sample: true,
+            ..Self::from_project(project, None, format!("opened {SAMPLE_NAME}"))
+        }
     }
 
     /// A new, empty project (import a scalp to start).
@@ -154,6 +161,7 @@ impl EditorState {
         }
         self.commit_edit();
         self.selection.clear();
+        self.is_sample = false;
         self.message = format!("imported {summary}");
     }
 
@@ -217,8 +225,10 @@ impl EditorState {
     pub fn display_name(&self) -> String {
         match self.path.as_deref().and_then(Path::file_name) {
             Some(name) => name.to_string_lossy().into_owned(),
-            None if self.project.document.name == "untitled" => "untitled".into(),
-            None => SAMPLE_NAME.to_string(),
+            None if self.is_sample => SAMPLE_NAME.to_string(),
+            // Not saved yet: the document's own name (an imported scalp's, or "untitled").
+            None if self.project.document.name.is_empty() => "untitled".into(),
+            None => self.project.document.name.clone(),
         }
     }
 
