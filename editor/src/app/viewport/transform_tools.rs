@@ -232,13 +232,24 @@ pub(super) fn describe_transform(
         format!(" along {} [{convention}]", axis_name(a, z_up))
     });
     match transform {
-        VertexTransform::Translate { offset } => format!(
-            "{}{axis}: ({:.4}, {:.4}, {:.4}) m",
-            kind.label(),
-            offset[0],
-            offset[1],
-            offset[2]
-        ),
+        VertexTransform::Translate { offset } => {
+            // In the artist's axes, as the header names them: Z-up is the scene's (x, −z, y)
+            // (see `scene_axis`), so a move up reads (0, 0, d), not the scene's (0, d, 0).
+            let shown = if z_up {
+                [offset[0], -offset[2], offset[1]]
+            } else {
+                offset
+            }
+            // No "-0.0000" for an axis that did not move.
+            .map(|v| v + 0.0);
+            format!(
+                "{}{axis}: ({:.4}, {:.4}, {:.4}) m",
+                kind.label(),
+                shown[0],
+                shown[1],
+                shown[2]
+            )
+        }
         VertexTransform::Rotate { angle_rad, .. } => {
             format!("{}{axis}: {:.1}°", kind.label(), angle_rad.to_degrees())
         }
@@ -547,5 +558,34 @@ impl Viewport {
             state.commit_edit();
             self.transform = None;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_move_is_shown_in_the_axes_its_header_names() {
+        // Issue 35's bug: "Move along Z (up)" showed the scene's (0, 0.02, 0).
+        let up = VertexTransform::Translate {
+            offset: [0.0, 0.02, 0.0],
+        };
+        assert_eq!(
+            describe_transform(TransformKind::Move, Some(1), true, up),
+            "Move along Z (up) [Z-up]: (0.0000, 0.0000, 0.0200) m"
+        );
+        assert_eq!(
+            describe_transform(TransformKind::Move, Some(1), false, up),
+            "Move along Y (up) [Y-up]: (0.0000, 0.0200, 0.0000) m"
+        );
+        // Blender's +Y points away from the front view: the scene's −z.
+        let away = VertexTransform::Translate {
+            offset: [0.0, 0.0, -0.01],
+        };
+        assert_eq!(
+            describe_transform(TransformKind::Move, Some(2), true, away),
+            "Move along Y (depth) [Z-up]: (0.0000, 0.0100, 0.0000) m"
+        );
     }
 }
