@@ -561,6 +561,27 @@ fn without_a_native_dialog_a_typed_path_is_asked_for() {
 }
 
 #[test]
+fn the_typed_path_prompt_takes_typing_and_enter_without_a_click() {
+    // Issue 35's bug: Enter (and typing) worked only after clicking into the field.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("entered.hairloom");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Unavailable]),
+    );
+    file_menu(&mut harness, "Save As…");
+    harness.run();
+    // Replace the suggestion and press Enter, straight from the keyboard.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.event(egui::Event::Text(path.display().to_string()));
+    harness.run();
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    assert!(path.exists(), "{}", harness.state().state.message);
+    assert!(harness.state().prompt.is_none());
+}
+
+#[test]
 fn save_as_suggests_a_project_opened_by_a_relative_path_where_it_is() {
     // Issue 35's bug: a project opened as `work/look.hairloom` was suggested as
     // `work/work/look.hairloom`.

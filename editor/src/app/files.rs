@@ -147,6 +147,9 @@ impl FileDialogs for ScriptedDialogs {
 pub struct PathPrompt {
     pub request: FileRequest,
     pub text: String,
+    /// Whether the field has been given the keyboard (once, when the prompt opens: typing
+    /// and Enter then work without a click into it).
+    pub focused: bool,
 }
 
 /// Recently opened or saved projects, newest first, kept in a small text file.

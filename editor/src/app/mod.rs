@@ -480,6 +480,7 @@ impl HairloomApp {
                 self.prompt = Some(PathPrompt {
                     request,
                     text: suggested.map_or(String::new(), |p| p.display().to_string()),
+                    focused: false,
                 });
                 None
             }
@@ -817,6 +818,10 @@ impl HairloomApp {
                             .desired_width(420.0)
                             .hint_text("/path/to/file"),
                     );
+                    if !prompt.focused {
+                        field.request_focus();
+                        prompt.focused = true;
+                    }
                     let entered =
                         field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
                     ui.horizontal(|ui| {
