@@ -74,6 +74,49 @@ fn a_styling_slider_change_is_one_undo_step() {
 }
 
 #[test]
+fn a_typed_styling_value_is_one_undo_step() {
+    // Issue 35's bug: one typed noise value made two identical history steps (the value
+    // field applies each keystroke as it is typed).
+    let mut harness = harness();
+    // The value field beside the "Noise amplitude" slider (on its row, to its right).
+    let slider = harness
+        .get_by_role_and_label(Role::Slider, "Noise amplitude")
+        .rect();
+    let fields: Vec<_> = harness
+        .query_all_by_role(Role::SpinButton)
+        .filter(|node| {
+            let rect = node.rect();
+            (rect.center().y - slider.center().y).abs() < slider.height()
+                && rect.left() >= slider.left()
+        })
+        .collect();
+    assert_eq!(fields.len(), 1, "the noise amplitude's value field");
+    fields[0].click();
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    for c in "0.0042".chars() {
+        harness.event(egui::Event::Text(c.to_string()));
+        harness.run();
+    }
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    let state = &harness.state().state;
+    assert_eq!(state.document().styling.global.noise.amplitude_m, 0.0042);
+    let labels: Vec<_> = state
+        .project
+        .history
+        .undo
+        .iter()
+        .map(|command| command.label().to_string())
+        .collect();
+    assert_eq!(
+        labels,
+        ["set Noise amplitude"],
+        "one step for one typed value"
+    );
+}
+
+#[test]
 fn the_history_panel_jumps_to_a_clicked_step() {
     let mut harness = harness();
     let original = harness.state().state.document().clone();

@@ -1,6 +1,6 @@
 //! Styling panel: every op's parameters as sliders (with numeric entry by dragging or
 //! double-click), for the global parameters or one styling group. A slider drag is one undo
-//! step; keyboard and typed changes commit at once.
+//! step, and so is a typed value (committed when its field lets go of the keyboard).
 
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::styling::StylingParams;
@@ -287,10 +287,14 @@ impl StylingPanel {
     }
 }
 
-/// A drag is one undo step (committed on release); clicks, keys and typed values commit at
-/// once.
+/// A drag is one undo step (committed on release), and so is a value typed into the field
+/// (committed when the field lets go of the keyboard: it applies each keystroke as it is
+/// typed, which made one step per keystroke); clicks and keys commit at once.
 fn commit_when_done(state: &mut EditorState, response: &egui::Response) {
-    if response.drag_stopped() || (response.changed() && !response.dragged()) {
+    if response.drag_stopped()
+        || response.lost_focus()
+        || (response.changed() && !response.dragged() && !response.has_focus())
+    {
         state.commit_edit();
     }
 }
