@@ -125,14 +125,11 @@ pub struct KajiyaKayTable {
 
 impl KajiyaKayTable {
     pub fn new(fibre: &Fibre) -> Self {
+        let material = Material::of(fibre);
         let weights = (0..TABLE_ANGLES)
             .map(|k| {
                 let angle = PI * k as f64 / (TABLE_ANGLES - 1) as f64;
-                KajiyaKayWeights::matching(
-                    fibre,
-                    DVec3::Z,
-                    DVec3::new(angle.sin(), 0.0, angle.cos()),
-                )
+                material.matching(DVec3::Z, DVec3::new(angle.sin(), 0.0, angle.cos()))
             })
             .collect();
         Self { weights }
@@ -169,11 +166,32 @@ impl KajiyaKayWeights {
     /// tinted lobes as TT + TRT + the residual per channel, the primary highlight as R.
     /// Finite for any material and any directions (what cannot be matched gets 0).
     pub fn matching(fibre: &Fibre, to_viewer: DVec3, to_light: DVec3) -> Self {
-        let bsdf = HairBsdf::new(fibre);
+        Material::of(fibre).matching(to_viewer, to_light)
+    }
+}
+
+/// What the match needs of a material, made once per table.
+struct Material {
+    bsdf: HairBsdf,
+    /// The mean absorption (mid-strand, the mean strand) and the colour it shows.
+    sigma_a: [f64; 3],
+    base: [f64; 3],
+}
+
+impl Material {
+    fn of(fibre: &Fibre) -> Self {
         let sigma_a = fibre.sigma_a_mean();
-        let base = fibre.color(sigma_a);
+        Self {
+            bsdf: HairBsdf::new(fibre),
+            sigma_a,
+            base: fibre.color(sigma_a),
+        }
+    }
+
+    /// [`KajiyaKayWeights::matching`] for this material.
+    fn matching(&self, to_viewer: DVec3, to_light: DVec3) -> KajiyaKayWeights {
         let (Some(wo), Some(wi)) = (to_viewer.try_normalize(), to_light.try_normalize()) else {
-            return Self::NONE;
+            return KajiyaKayWeights::NONE;
         };
         let mut reflected = 0.0;
         let mut transmitted = [0.0; 3];
@@ -186,7 +204,7 @@ impl KajiyaKayWeights {
                 continue;
             };
             for (h, weight) in OFFSETS {
-                let lobes = bsdf.lobes(wo_local, wi_local, h, sigma_a);
+                let lobes = self.bsdf.lobes(wo_local, wi_local, h, self.sigma_a);
                 reflected += weight * lobes[0][0];
                 for lobe in &lobes[1..] {
                     for c in 0..3 {
@@ -199,8 +217,8 @@ impl KajiyaKayWeights {
             primary += p;
         }
         let finite = |v: f64| if v.is_finite() { v.max(0.0) } else { 0.0 };
-        Self {
-            tint: std::array::from_fn(|c| finite(transmitted[c] / (base[c] * tinted))),
+        KajiyaKayWeights {
+            tint: std::array::from_fn(|c| finite(transmitted[c] / (self.base[c] * tinted))),
             primary: finite(reflected / primary),
         }
     }

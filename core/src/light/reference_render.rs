@@ -25,7 +25,7 @@ use crate::light::hair_bsdf::HairBsdf;
 use crate::light::material::{Fibre, strand_shading_random};
 use crate::light::{linear_to_srgb, tonemap};
 use crate::model::document::BodyMesh;
-use crate::model::scene::{LightSource, Scene};
+use crate::model::scene::Scene;
 use crate::strands::random::SplitMix64;
 
 /// Strands as polylines for the reference: `points[first..first + count]` per strand.
@@ -416,25 +416,14 @@ impl<'a> World<'a> {
 /// Direction toward `light` from `point`, its irradiance there and the distance to it.
 fn light_at(light: &crate::model::scene::Light, point: DVec3) -> Option<(DVec3, [f64; 3], f64)> {
     let power = light.color.map(|c| c as f64 * light.intensity as f64);
-    match light.source {
-        LightSource::Directional { to_light } => {
-            let direction = DVec3::new(to_light[0] as f64, to_light[1] as f64, to_light[2] as f64)
-                .try_normalize()?;
-            Some((direction, power, f64::INFINITY))
-        }
-        LightSource::Point { position_m } => {
-            let offset = DVec3::new(
-                position_m[0] as f64,
-                position_m[1] as f64,
-                position_m[2] as f64,
-            ) - point;
-            let distance = offset.length();
-            (distance > 1e-9).then(|| {
-                let falloff = 1.0 / (distance * distance);
-                (offset / distance, power.map(|p| p * falloff), distance)
-            })
-        }
-    }
+    let (direction, distance) = light.source.toward(point)?;
+    // A point light's irradiance falls off with the squared distance.
+    let falloff = if distance.is_finite() {
+        1.0 / (distance * distance)
+    } else {
+        1.0
+    };
+    Some((direction, power.map(|p| p * falloff), distance))
 }
 
 /// Ray against a cylinder segment (axis `a`→`b`, radius `radius`): the nearest `t > t_min`
@@ -672,7 +661,7 @@ pub fn render_reference(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::scene::{HairMaterial, Light, Pigment};
+    use crate::model::scene::{HairMaterial, Light, LightSource, Pigment};
 
     /// A curtain of parallel vertical fibres in front of the camera.
     fn curtain(count: usize, spacing: f64, width: f64) -> Fibres {

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use crate::light::dual_scattering::DualScatteringTables;
 use crate::light::hair_bsdf::HairBsdf;
-use crate::light::kajiya_kay::KajiyaKayTable;
+use crate::light::kajiya_kay::{KajiyaKayTable, KajiyaKayWeights};
 use crate::light::material::Fibre;
 use crate::light::opacity_maps::ShadowView;
 use crate::model::scene::{
@@ -217,13 +217,12 @@ impl SceneUniforms {
         }
         let to_viewer = (eye - hair_center).as_dvec3();
         for (light, gpu) in scene.lights.iter().zip(self.lights.iter_mut()) {
-            let to_light = match light.source {
-                LightSource::Directional { to_light } => Vec3::from(to_light).as_dvec3(),
-                LightSource::Point { position_m } => {
-                    (Vec3::from(position_m) - hair_center).as_dvec3()
-                }
-            };
-            let weights = table.at(to_viewer, to_light);
+            let weights = light
+                .source
+                .toward(hair_center.as_dvec3())
+                .map_or(KajiyaKayWeights::NONE, |(to_light, _)| {
+                    table.at(to_viewer, to_light)
+                });
             gpu.kajiya_kay = [
                 weights.tint[0] as f32,
                 weights.tint[1] as f32,

@@ -32,6 +32,24 @@ pub enum LightSource {
     Point { position_m: [f32; 3] },
 }
 
+impl LightSource {
+    /// The unit direction from `point` toward the light and the distance to it (infinite for
+    /// a directional light); `None` for a zero direction or a point at the light.
+    pub fn toward(&self, point: glam::DVec3) -> Option<(glam::DVec3, f64)> {
+        match *self {
+            LightSource::Directional { to_light } => {
+                let direction = glam::Vec3::from(to_light).as_dvec3().try_normalize()?;
+                Some((direction, f64::INFINITY))
+            }
+            LightSource::Point { position_m } => {
+                let offset = glam::Vec3::from(position_m).as_dvec3() - point;
+                let distance = offset.length();
+                (distance > 1e-9).then(|| (offset / distance, distance))
+            }
+        }
+    }
+}
+
 /// One light of the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
