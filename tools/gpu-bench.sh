@@ -3,9 +3,10 @@
 # release binary, so a short window on a machine with a real GPU is enough:
 #
 #   tools/gpu-bench.sh pack          # here: build, strip into .gpu/hairloom (~20 MB)
-#   tools/gpu-bench.sh run [OUT]     # there: adapters, `bench gpu` side by side, `bench crowd`
+#   tools/gpu-bench.sh run [OUT]     # there: adapters, `bench gpu` side by side (with the LHS
+#                                    # baseline), `bench switches`, `bench crowd`, `bench effects`
 #
-# `run` names the adapter first and writes adapters.txt, gpu.txt, crowd_default.txt,
+# `run` names the adapter first and writes adapters.txt, gpu.txt, switches.txt, crowd_default.txt,
 # crowd_compute.txt and effects.txt into OUT (default $OUT when
 # set, else out/gpu-bench). It unpacks carried Vulkan loaders (.gl/*.deb, see the device
 # notes) when the machine has none, and points the loader at NVIDIA's ICD when it is there.
@@ -42,6 +43,10 @@ run)
     "$bin" adapters | tee "$out/adapters.txt"
     "$bin" bench gpu --strands "${STRANDS:-10000,100000,300000}" --runs "${RUNS:-3}" \
         --size "${SIZE:-1280x720}" --textures "${TEXTURES:-f16,f32}" | tee "$out/gpu.txt"
+    # Styling on vs off, MSAA 1× / 4× / 8×, exact vs hardware filtering and the game
+    # runtime's measured choice (seed 000 §5's switch costs).
+    "$bin" bench switches --strands "${STRANDS:-10000,100000,300000}" --runs "${RUNS:-3}" \
+        --size "${SIZE:-1280x720}" | tee "$out/switches.txt"
     # The paper's Fig. 1 scene: up to 100 characters of 100K strands each, LOD on; the game
     # runtime's default path (mesh shaders where the adapter has them), then compute.
     for generation in default compute; do

@@ -58,7 +58,7 @@ use glam::{Mat4, Vec3};
 use hairloom_core::model::scene::{Coverage, Scene};
 use hairloom_core::runtime::frame_plan::{FramePlan, LodSettings, plan_frame};
 use hairloom_core::runtime::hair::RuntimeHair;
-use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::strand_gen::{Filtering, FilteringMeasure};
 
 use crate::device::GpuContext;
 use crate::frame::{
@@ -134,6 +134,8 @@ pub struct GameHair {
     strand_width_m: f32,
     lod: LodSettings,
     filtering: Filtering,
+    /// What chose `filtering` on this adapter (see [`Self::filtering_measure`]).
+    filtering_measure: FilteringMeasure,
     vertex_count: u32,
     /// One frame's GPU state between [`GameHair::prepare`] and [`GameHair::draw`].
     frame: Option<PreparedFrame>,
@@ -180,18 +182,27 @@ impl GameHair {
         let generator = StrandGenRenderer::with_path(&context, path);
         let asset = HairAsset::upload(&context, &generator, hair.clone())?;
         let bounds = asset.bounds();
+        let strand_width_m = default_strand_width_m(bounds.0, bounds.1);
+        // Exact or the texture units' 8-bit weights: measured here, on the game's adapter.
+        let filtering_measure = StrandGenRenderer::new(&context).measure_filtering(
+            &context,
+            asset.gpu(),
+            (1u32 << max_log2) + 1,
+            0.5 * strand_width_m as f64,
+        )?;
         let mut this = Self {
             renderers: FrameRenderers::new(&context, targets),
             draw_body: true,
             scene: game_scene(&hair.scene),
-            strand_width_m: default_strand_width_m(bounds.0, bounds.1),
+            strand_width_m,
             lod: LodSettings {
                 alpha_strands: hair.lod.alpha_strands,
                 alpha_vertices: hair.lod.alpha_vertices,
                 lambda: hair.lod.lambda,
                 ..LodSettings::default()
             },
-            filtering: Filtering::Exact,
+            filtering: filtering_measure.choice(),
+            filtering_measure,
             vertex_count: (1u32 << max_log2) + 1,
             frame: None,
             generator,
@@ -252,6 +263,27 @@ impl GameHair {
         self.frame = None;
         let scene = self.scene.clone();
         self.set_lighting(&scene)
+    }
+
+    /// What [`Self::new`] measured of exact and hardware (8-bit) texture filtering on this
+    /// adapter: each one's generation time and the hardware weights' error. The default
+    /// filtering is its [`FilteringMeasure::choice`]: hardware weights where they are at
+    /// least 5 % faster and move no vertex more than half a strand's width.
+    pub fn filtering_measure(&self) -> &FilteringMeasure {
+        &self.filtering_measure
+    }
+
+    /// The filtering generation uses now.
+    pub fn filtering(&self) -> Filtering {
+        self.filtering
+    }
+
+    /// Overrides the measured choice (refused where the adapter cannot filter the textures).
+    pub fn set_filtering(&mut self, filtering: Filtering) -> Result<(), GameHairError> {
+        self.generator.check_filtering(&self.context, filtering)?;
+        self.filtering = filtering;
+        self.frame = None;
+        Ok(())
     }
 
     /// Where strands are generated now (see [`Self::set_generation`]).

@@ -103,7 +103,19 @@ impl PreviewRenderer {
     pub const UI_VIEW_FORMAT: wgpu::TextureFormat = crate::view::UI_VIEW_FORMAT;
 
     pub fn new(context: &GpuContext) -> Self {
-        let sample_count = crate::view::sample_count(context);
+        Self::with_sample_count(context, crate::view::sample_count(context))
+    }
+
+    /// A renderer drawing with `sample_count` MSAA samples (1, 4 or 8) where every target
+    /// format supports it (`bench switches` measures what MSAA costs); `None` where not.
+    pub fn try_with_sample_count(context: &GpuContext, sample_count: u32) -> Option<Self> {
+        // 4 samples are supported wherever 8 are (WebGPU guarantees 4 for these formats).
+        let supported =
+            [1, 4, 8].contains(&sample_count) && sample_count <= crate::view::sample_count(context);
+        supported.then(|| Self::with_sample_count(context, sample_count))
+    }
+
+    fn with_sample_count(context: &GpuContext, sample_count: u32) -> Self {
         Self {
             state: Mutex::new(FrameState {
                 view: None,
@@ -226,6 +238,16 @@ impl PreviewRenderer {
             HairSource::Stored { strand_count, .. } => {
                 stored_plan(*strand_count, scene.vertex_count)
             }
+            // The same bundle-level work as the generated strands it stores.
+            HairSource::Skinned { hair, lod, .. } => plan_frame(
+                &hair.bundles,
+                hair.per_bundle,
+                scene.vertex_count.saturating_sub(1).max(1).ilog2(),
+                &Self::frame_camera(scene, width, height).lod(),
+                lod,
+                batch_vertex_limit(scene.vertex_count),
+                &[],
+            ),
         }
     }
 

@@ -143,9 +143,12 @@ fn game_runtime_draws_what_the_preview_draws() {
     .expect("the bundle loads");
     game.set_lod(lod);
     game.set_vertices_log2(VERTICES_LOG2);
-    // The preview's path (the game's default is mesh shaders where the device has them).
+    // The preview's path (the game's default is mesh shaders where the device has them)
+    // and filtering (the game's is measured on the adapter).
     game.set_generation(GenerationPath::ComputePerStrand)
         .expect("compute per strand");
+    game.set_filtering(Filtering::Exact)
+        .expect("exact filtering");
     let game_camera = GameCamera {
         view_projection: camera.view_projection(1.0),
         eye: camera.eye,
@@ -270,6 +273,8 @@ fn a_restyle_reaches_the_game_in_place_and_matches_a_fresh_bundle() {
         game.set_vertices_log2(VERTICES_LOG2);
         game.set_generation(GenerationPath::ComputePerStrand)
             .expect("compute per strand");
+        game.set_filtering(Filtering::Exact)
+            .expect("exact filtering");
         game
     };
     let background = wgpu::Color::BLACK;
@@ -298,4 +303,39 @@ fn a_restyle_reaches_the_game_in_place_and_matches_a_fresh_bundle() {
         "restyled in place vs made afresh: mean difference {:.3}",
         mean_abs_difference(&expected, &curled)
     );
+}
+
+/// The game's default filtering is chosen by measuring both on its adapter: both timed,
+/// the 8-bit weights' error measured against exact filtering, and the choice follows the rule.
+#[test]
+fn the_game_measures_its_filtering_on_its_adapter() {
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let hair = bundle();
+    let (lo, hi) = hair.textures.hair_bounds().expect("hair");
+    let size = (hi - lo).length() as f64;
+    let game = GameHair::new(
+        &context.adapter,
+        &context.device,
+        &context.queue,
+        &hair,
+        Targets::view(1),
+    )
+    .expect("the bundle loads");
+    let measure = *game.filtering_measure();
+    assert!(measure.strands > 0, "{measure:?}");
+    assert!(
+        measure.exact_ms.is_finite() && measure.exact_ms > 0.0,
+        "{measure:?}"
+    );
+    // f16 textures filter on every adapter we run on.
+    let hardware_ms = measure.hardware_ms.expect("hardware filtering measured");
+    assert!(hardware_ms.is_finite() && hardware_ms > 0.0, "{measure:?}");
+    // 8-bit weights move vertices, but by a fraction of a millimetre on a head.
+    assert!(measure.hardware_error_max_m > 0.0, "{measure:?}");
+    assert!(measure.hardware_error_max_m < 2e-3 * size, "{measure:?}");
+    assert!(measure.hardware_error_mean_m <= measure.hardware_error_max_m);
+    assert!(measure.tolerance_m > 0.0 && measure.tolerance_m < 1e-2 * size);
+    assert_eq!(game.filtering(), measure.choice());
 }

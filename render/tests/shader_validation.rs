@@ -88,6 +88,10 @@ fn embedded() -> Vec<(String, String)> {
         ),
     ));
     sources.push((
+        "linear_hair_skinning".to_string(),
+        hairloom_render::renderer::linear_hair_skinning::SHADER_SOURCE.to_string(),
+    ));
+    sources.push((
         "viewport_blit".to_string(),
         hairloom_render::renderer::viewport_blit::VIEWPORT_BLIT_SHADER.to_string(),
     ));
@@ -182,6 +186,16 @@ fn gpu_structs_match_their_wgsl() {
             size_of::<hairloom_core::runtime::far_lod::FarLodParams>(),
         ),
         (hair, "StrandRun", size_of::<StrandRun>()),
+        (
+            hairloom_render::renderer::linear_hair_skinning::SHADER_SOURCE,
+            "SkinParams",
+            size_of::<hairloom_core::runtime::linear_hair_skinning::SkinParams>(),
+        ),
+        (
+            hairloom_render::renderer::linear_hair_skinning::SHADER_SOURCE,
+            "SkinBinding",
+            size_of::<hairloom_core::runtime::linear_hair_skinning::SkinBinding>(),
+        ),
         (hair, "HairUniforms", size_of::<HairUniforms>()),
         // Far hair binds the strands' view uniforms as its own.
         (far, "FarView", size_of::<HairUniforms>()),

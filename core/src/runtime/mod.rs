@@ -8,6 +8,7 @@ pub mod frame_plan;
 pub mod gpu_types;
 pub mod hair;
 pub mod half;
+pub mod linear_hair_skinning;
 pub mod preview_hair;
 pub mod strand_gen;
 pub mod strand_mesh;

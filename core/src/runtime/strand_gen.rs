@@ -39,6 +39,48 @@ pub enum Filtering {
     Hardware8Bit,
 }
 
+/// What a runtime measured of the two filterings on its own adapter, from which it chooses
+/// its default ([`FilteringMeasure::choice`]): the paper's "texture-unit interpolation"
+/// pays only where the adapter makes it faster, and only while the 8-bit weights move no
+/// vertex visibly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilteringMeasure {
+    /// Generation time of the measured strands with exact filtering.
+    pub exact_ms: f64,
+    /// With hardware weights; `None` where the adapter cannot filter the textures.
+    pub hardware_ms: Option<f64>,
+    /// Largest and mean distance of a hardware-filtered vertex from its exact one.
+    pub hardware_error_max_m: f64,
+    pub hardware_error_mean_m: f64,
+    /// The largest error allowed (half a strand's width).
+    pub tolerance_m: f64,
+    /// Strands measured.
+    pub strands: usize,
+}
+
+impl FilteringMeasure {
+    /// Hardware weights where they are at least [`Self::MIN_GAIN`] faster and their largest
+    /// error is within the tolerance; exact filtering otherwise (and on any non-finite
+    /// measure).
+    pub fn choice(&self) -> Filtering {
+        match self.hardware_ms {
+            Some(hardware)
+                if hardware.is_finite()
+                    && self.exact_ms.is_finite()
+                    && hardware <= self.exact_ms * (1.0 - Self::MIN_GAIN)
+                    && self.hardware_error_max_m <= self.tolerance_m =>
+            {
+                Filtering::Hardware8Bit
+            }
+            _ => Filtering::Exact,
+        }
+    }
+
+    /// The least time saved (a share of exact filtering's) worth 8-bit weights: below it a
+    /// measure on a shared machine is noise.
+    pub const MIN_GAIN: f64 = 0.05;
+}
+
 /// Trilinear sample at continuous texel coordinates (texel centres at `i + 0.5`), clamped
 /// to the edge: the CPU mirror of a filtered `textureSampleLevel`.
 pub fn fetch(texture: &Texture3d, coord: Vec3, filtering: Filtering) -> Vec4 {
@@ -364,6 +406,44 @@ mod tests {
     use crate::runtime::atlas::Atlas;
     use crate::runtime::test_meshes::curved_mesh;
     use crate::runtime::textures::Precision;
+
+    #[test]
+    fn hardware_filtering_is_chosen_only_where_faster_and_within_tolerance() {
+        let measure = FilteringMeasure {
+            exact_ms: 1.0,
+            hardware_ms: Some(0.8),
+            hardware_error_max_m: 1e-4,
+            hardware_error_mean_m: 1e-5,
+            tolerance_m: 2e-4,
+            strands: 100,
+        };
+        assert_eq!(measure.choice(), Filtering::Hardware8Bit);
+        for worse in [
+            FilteringMeasure {
+                hardware_ms: Some(0.97),
+                ..measure
+            },
+            FilteringMeasure {
+                hardware_ms: None,
+                ..measure
+            },
+            FilteringMeasure {
+                hardware_error_max_m: 3e-4,
+                ..measure
+            },
+            FilteringMeasure {
+                hardware_ms: Some(f64::NAN),
+                ..measure
+            },
+            FilteringMeasure {
+                exact_ms: f64::INFINITY,
+                hardware_ms: Some(1.0),
+                ..measure
+            },
+        ] {
+            assert_eq!(worse.choice(), Filtering::Exact, "{worse:?}");
+        }
+    }
 
     #[test]
     fn texture_path_matches_the_f64_reference() {

@@ -60,6 +60,10 @@ pub enum Which {
         /// Filtering to measure, comma-separated (exact, hardware).
         #[arg(long, value_enum, value_delimiter = ',', default_values = ["exact", "hardware"])]
         filtering: Vec<super::FilteringArg>,
+        /// Share of the strands that are guides in the linear hair skinning baseline (LHS,
+        /// seed 000 §5: 1 %); 0 leaves LHS out.
+        #[arg(long, default_value_t = hairloom_core::runtime::linear_hair_skinning::DEFAULT_GUIDE_SHARE)]
+        guides: f64,
     },
     /// Edit-to-frame latency in the editor's viewport setting: a styling slider tick through
     /// a full rebuild and re-upload (the old path) and through the in-place styling update
@@ -114,6 +118,25 @@ pub enum Which {
         samples: Vec<String>,
         #[command(flatten)]
         path_traced: PathTracedArgs,
+    },
+    /// What the method's switches cost, side by side in one run: styling on vs off, MSAA
+    /// 1× / 4× / 8×, exact vs hardware texture filtering with the hardware weights' error,
+    /// and the filtering the game runtime chooses on this adapter.
+    Switches {
+        #[arg(long)]
+        project: Option<std::path::PathBuf>,
+        /// Strand counts to measure, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 100_000])]
+        strands: Vec<usize>,
+        /// Frame size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x720")]
+        size: String,
+        /// Measured runs per row after one warm-up (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Vertices per strand at full detail: 2^N + 1.
+        #[arg(long, default_value_t = 5)]
+        vertices_log2: u32,
     },
     /// Many characters in one frame (the paper's Fig. 1 crowd): one uploaded bundle drawn N
     /// times with its own transform and LOD through the game runtime; frame time and GPU
@@ -271,6 +294,19 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             size,
             runs,
         } => super::bench_effects::run(project, &strands, &size, runs.max(1)),
+        Which::Switches {
+            project,
+            strands,
+            size,
+            runs,
+            vertices_log2,
+        } => super::bench_switches::run(&super::bench_switches::SwitchSettings {
+            project,
+            strands,
+            size,
+            runs,
+            vertices_log2,
+        }),
         Which::Crowd {
             project,
             characters,
@@ -308,6 +344,7 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             runs,
             paths,
             filtering,
+            guides,
         } => {
             let paths: Vec<_> = paths.into_iter().map(Into::into).collect();
             let filterings: Vec<_> = filtering.into_iter().map(Into::into).collect();
@@ -330,6 +367,7 @@ pub fn run(which: Which) -> anyhow::Result<()> {
                 runs,
                 &paths,
                 &filterings,
+                guides,
             )
         }
     }
@@ -430,7 +468,11 @@ pub(super) fn median_timing<T: Copy, E>(
 /// from submission to idle (marked `*`). A CPU adapter (lavapipe) runs passes on the same
 /// cores as everything else and its compute timestamps do not cover the work, so wall time is
 /// its true cost.
-fn gpu_or_wall(trust_timestamps: bool, gpu_ms: Option<f64>, wall_ms: f64) -> (f64, &'static str) {
+pub(super) fn gpu_or_wall(
+    trust_timestamps: bool,
+    gpu_ms: Option<f64>,
+    wall_ms: f64,
+) -> (f64, &'static str) {
     match gpu_ms {
         Some(ms) if ms > 0.0 && trust_timestamps => (ms, ""),
         _ => (wall_ms, "*"),
@@ -450,13 +492,16 @@ fn gpu(
     runs: usize,
     paths: &[hairloom_render::renderer::strand_gen::GenerationPath],
     filterings: &[hairloom_core::runtime::strand_gen::Filtering],
+    guide_share: f64,
 ) -> anyhow::Result<()> {
     use hairloom_core::runtime::frame_plan::LodSettings;
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::device::{GpuContext, describe};
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer};
     use hairloom_render::renderer::shader_composer::RibbonInput;
-    use hairloom_render::renderer::strand_gen::{StrandGenRenderer, full_detail_plan};
+    use hairloom_render::renderer::strand_gen::{
+        GenerationPath, StrandGenRenderer, full_detail_plan,
+    };
     let path = project.unwrap_or_else(hairloom_core::samples::default_sample_path);
     let (width, height) = super::render::parse_size(size)?;
     let document = hairloom_core::io::project::load(&path)?.document;
@@ -565,7 +610,13 @@ fn gpu(
                         versus.map_or("".into(), |v| format!("{v:.2}×")),
                         scratch as f64 / 1e6,
                         memory,
-                        ratio.map_or("".into(), |r| format!("{r:.0}×")),
+                        ratio.map_or("".into(), |r| {
+                            if r < 10.0 {
+                                format!("{r:.2}×")
+                            } else {
+                                format!("{r:.0}×")
+                            }
+                        }),
                     );
                 };
                 // Generation alone, per compute path (the vertex-shader path generates
@@ -640,13 +691,16 @@ fn gpu(
                         Some(explicit_mb / hair_mb),
                     );
                 }
+                let mut compute_frames = std::collections::HashMap::new();
+                // Each method's frames: near and four times further, LOD off and on.
+                let frame_modes = [
+                    ("frame, LOD off", near, false),
+                    ("frame, LOD on", near, true),
+                    ("frame ×4 far, LOD off", far, false),
+                    ("frame ×4 far, LOD on", far, true),
+                ];
                 for generator in &generators {
-                    for (mode, camera, enabled) in [
-                        ("frame, LOD off", near, false),
-                        ("frame, LOD on", near, true),
-                        ("frame ×4 far, LOD off", far, false),
-                        ("frame ×4 far, LOD on", far, true),
-                    ] {
+                    for (mode, camera, enabled) in frame_modes {
                         let lod = LodSettings {
                             enabled,
                             ..LodSettings::default()
@@ -663,6 +717,9 @@ fn gpu(
                             camera,
                         )?;
                         let ms = gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms);
+                        if generator.path() == GenerationPath::ComputePerStrand {
+                            compute_frames.insert(mode, ms.0);
+                        }
                         row(
                             generator.path().name(),
                             mode,
@@ -691,6 +748,97 @@ fn gpu(
                         hair.root_count, precision, filter_name, "stored", "frame, stored vertices"
                     ),
                 }
+                // The LHS baseline (seed 000 §5): these strands, generated once and read
+                // back, stored with 3 guides' weights and offsets, skinned every frame.
+                if guide_share > 0.0 {
+                    match skinned_baseline(
+                        &context,
+                        &generator,
+                        &hair,
+                        &full,
+                        filtering,
+                        vertex_count,
+                        guide_share,
+                    ) {
+                        Ok((skinner, skinned)) => {
+                            let lhs_mb = skinned.bytes as f64 / 1e6;
+                            let mut ratios = Vec::new();
+                            let skin = median_timing(
+                                || skinner.time_skinning(&context, &skinned, &full),
+                                runs,
+                                |t| t.wall_ms,
+                            )
+                            .map_err(|e| anyhow::anyhow!(e))?;
+                            let skin_ms = gpu_or_wall(trust, skin.gpu_ms, skin.wall_ms);
+                            if let Some((_, generated)) = generation
+                                .iter()
+                                .find(|(path, _)| *path == GenerationPath::ComputePerStrand)
+                            {
+                                let generated =
+                                    gpu_or_wall(trust, generated.gpu_ms, generated.wall_ms).0;
+                                ratios.push(format!(
+                                    "skin ÷ generate only {:.2}×",
+                                    skin_ms.0 / generated
+                                ));
+                            }
+                            row(
+                                "linear skinning",
+                                "skin only",
+                                full.vertices,
+                                skin_ms,
+                                None,
+                                skin.scratch_bytes,
+                                lhs_mb,
+                                Some(explicit_mb / lhs_mb),
+                            );
+                            for (mode, camera, enabled) in frame_modes {
+                                let lod = LodSettings {
+                                    enabled,
+                                    ..LodSettings::default()
+                                };
+                                let timing = frame(
+                                    HairSource::Skinned {
+                                        skinner: &skinner,
+                                        skinned: &skinned,
+                                        hair: &hair,
+                                        lod,
+                                    },
+                                    camera,
+                                )?;
+                                let ms = gpu_or_wall(trust, timing.gpu_ms, timing.wall_ms);
+                                if let Some(generated) = compute_frames.get(mode) {
+                                    ratios.push(format!("{mode} {:.2}×", ms.0 / generated));
+                                }
+                                row(
+                                    "linear skinning",
+                                    mode,
+                                    timing.vertices,
+                                    ms,
+                                    stored_ms.map(|s| s / ms.0),
+                                    timing.scratch_bytes,
+                                    lhs_mb,
+                                    Some(explicit_mb / lhs_mb),
+                                );
+                            }
+                            println!(
+                                "{:>8} {:>4?} {:>8}   LHS ({} guides, {:.1} %) frame ÷ generated (compute per strand): {}; memory {:.1} MB ÷ {:.2} MB = {:.0}×",
+                                hair.root_count,
+                                precision,
+                                filter_name,
+                                skinned.guide_count,
+                                guide_share * 100.0,
+                                ratios.join(", "),
+                                lhs_mb,
+                                hair_mb,
+                                lhs_mb / hair_mb
+                            );
+                        }
+                        Err(error) => println!(
+                            "{:>8} {:>4?} {:>8} {:<18} skipped: {error}",
+                            hair.root_count, precision, filter_name, "linear skinning"
+                        ),
+                    }
+                }
             }
         }
     }
@@ -698,9 +846,44 @@ fn gpu(
         "vs stored: stored-vertex frame time ÷ this row's time (> 1: faster than the baseline)."
     );
     println!(
+        "linear skinning (LHS): every strand stored with 3 guides' weights and offsets, guides' frames and every vertex skinned each frame; memory = offsets + bindings + guides (its mem ratio < 1: more than stored vertices). Seed 000 (RTX 4090, 300K strands, no LOD, no MSAA): generated 1.8 ms vs LHS 18 ms (LHS 10× slower); 39 KB of textures vs 340 MB for LHS (8,700×)."
+    );
+    println!(
         "memory: textures + bundle placements + root samples + styling on the GPU (stored: the vertex buffer); mem ratio: stored vertex bytes ÷ this memory."
     );
     Ok(())
+}
+
+/// The LHS baseline of `hair`: its strands generated at full detail (`full`), read back,
+/// bound to `guide_share` of them as guides and uploaded.
+fn skinned_baseline(
+    context: &hairloom_render::device::GpuContext,
+    generator: &hairloom_render::renderer::strand_gen::StrandGenRenderer,
+    hair: &hairloom_render::renderer::strand_gen::GpuHair,
+    full: &hairloom_core::runtime::frame_plan::FramePlan,
+    filtering: hairloom_core::runtime::strand_gen::Filtering,
+    vertex_count: u32,
+    guide_share: f64,
+) -> anyhow::Result<(
+    hairloom_render::renderer::linear_hair_skinning::LinearHairSkinningRenderer,
+    hairloom_render::renderer::linear_hair_skinning::GpuSkinnedHair,
+)> {
+    use hairloom_core::runtime::linear_hair_skinning::{SkinnedHair, check_size};
+    use hairloom_render::renderer::linear_hair_skinning::LinearHairSkinningRenderer;
+    check_size(full.vertices)?;
+    let generated = generator.generate_positions(context, hair, full, filtering)?;
+    let points: Vec<glam::Vec3> = generated
+        .iter()
+        .map(|p| glam::Vec3::from_slice(&p[..3]))
+        .collect();
+    drop(generated);
+    let skinned = SkinnedHair::bind(&points, vertex_count, guide_share)?;
+    drop(points);
+    let skinner = LinearHairSkinningRenderer::new(context);
+    let gpu = skinner
+        .upload(context, &skinned)
+        .map_err(|e| anyhow::anyhow!(e))?;
+    Ok((skinner, gpu))
 }
 
 /// See [`Which::Edit`].

@@ -19,6 +19,7 @@ mod bench_crowd;
 mod bench_effects;
 mod bench_shading;
 mod bench_sim;
+mod bench_switches;
 mod fit;
 mod render;
 mod simulate;

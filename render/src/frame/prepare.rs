@@ -14,10 +14,11 @@ use super::{FrameError, FrameRenderers};
 use crate::device::GpuContext;
 use crate::renderer::far_hair::PreparedFar;
 use crate::renderer::fur::{GpuFur, PreparedFur, strand_keep};
+use crate::renderer::linear_hair_skinning::{GpuSkinnedHair, LinearHairSkinningRenderer};
 use crate::renderer::preview_body::{BodyUniforms, GpuBody, PreparedBody};
 use crate::renderer::preview_hair::{HairUniforms, MeshLod, PreparedHair, RibbonInput};
 use crate::renderer::strand_gen::{
-    GenerationPath, GpuFarHair, GpuHair, StrandGenRenderer, check_mesh_groups,
+    GenerationPath, GpuFarHair, GpuHair, StrandGenRenderer, check_mesh_groups, scratch_buffer,
 };
 use crate::resources::Tracked;
 
@@ -43,6 +44,16 @@ pub enum HairSource<'a> {
         far: Option<&'a GpuFarHair>,
         /// Fur's textures and patches, where made (drawn when the scene asks).
         fur: Option<&'a GpuFur>,
+    },
+    /// Every strand stored and skinned to its guides in this frame: linear hair skinning,
+    /// the baseline seed 000 §5 measures against. Planned as generated `hair` (the same
+    /// strands, skinned from its generated vertices) is, so both draw the same strands at the
+    /// same detail through the same passes.
+    Skinned {
+        skinner: &'a LinearHairSkinningRenderer,
+        skinned: &'a GpuSkinnedHair,
+        hair: &'a GpuHair,
+        lod: LodSettings,
     },
 }
 
@@ -250,6 +261,10 @@ pub fn prepare(
         }
         HairSource::Generated { generator, .. } => {
             let scratch = generator.scratch(context, plan);
+            ((*scratch).clone(), Some(scratch))
+        }
+        HairSource::Skinned { .. } => {
+            let scratch = scratch_buffer(context, plan);
             ((*scratch).clone(), Some(scratch))
         }
     };

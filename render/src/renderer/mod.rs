@@ -17,12 +17,14 @@
 //! | [`viewport_blit`] | `viewport_blit.wgsl` | the editor's viewport (an egui paint callback) |
 //! | [`far_hair`], [`far_lod`], [`strand_gen`] (`ThickGenRenderer`) | `far_hair*.wgsl` + `light/aggregated_bcsdf.wgsl`, `far_lod.wgsl`, `strand_gen.wgsl` (`thick_main`) | far hair (`far: aggregated`) |
 //! | [`fur`] | `fur.wgsl` + `light/*` | fur (`fur: shells_fins`, seed 002) |
+//! | [`linear_hair_skinning`] | `linear_hair_skinning.wgsl` | the LHS baseline (`bench gpu`), in place of generation |
 
 pub mod body_shadow;
 pub mod far_hair;
 pub mod far_lod;
 pub mod fur;
 pub mod hair_shadow;
+pub mod linear_hair_skinning;
 pub mod oit_composite;
 pub mod preview_body;
 pub mod preview_hair;

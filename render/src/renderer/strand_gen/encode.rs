@@ -225,14 +225,20 @@ impl StrandGenRenderer {
 
     /// A scratch buffer for the largest batch of `plan`.
     pub fn scratch(&self, context: &GpuContext, plan: &FramePlan) -> Tracked<wgpu::Buffer> {
-        context.resources.buffer(
-            &context.device,
-            &wgpu::BufferDescriptor {
-                label: Some("strand_gen_scratch"),
-                size: scratch_bytes(plan),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            },
-        )
+        scratch_buffer(context, plan)
     }
+}
+
+/// A scratch buffer for the largest batch of `plan`: what generation, or skinning in its
+/// place, writes each batch's vertices into.
+pub fn scratch_buffer(context: &GpuContext, plan: &FramePlan) -> Tracked<wgpu::Buffer> {
+    context.resources.buffer(
+        &context.device,
+        &wgpu::BufferDescriptor {
+            label: Some("strand_gen_scratch"),
+            size: scratch_bytes(plan),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        },
+    )
 }

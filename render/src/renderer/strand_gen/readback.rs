@@ -2,7 +2,7 @@
 //! read back (tests against the CPU mirror).
 
 use hairloom_core::runtime::frame_plan::FramePlan;
-use hairloom_core::runtime::strand_gen::Filtering;
+use hairloom_core::runtime::strand_gen::{Filtering, FilteringMeasure};
 
 use super::*;
 use crate::device::{GpuContext, read_buffer};
@@ -172,4 +172,69 @@ impl StrandGenRenderer {
         )?;
         Ok(positions)
     }
+
+    /// Measures the two filterings on this adapter over up to [`FILTERING_MEASURE_STRANDS`]
+    /// of `hair`'s strands at `vertex_count` vertices: generation time of each (GPU
+    /// timestamps where they mean something, else wall time; median of three after a
+    /// warm-up) and the distance of every hardware-filtered vertex from its exact one.
+    /// `tolerance_m` is the error [`FilteringMeasure::choice`] allows.
+    pub fn measure_filtering(
+        &self,
+        context: &GpuContext,
+        hair: &GpuHair,
+        vertex_count: u32,
+        tolerance_m: f64,
+    ) -> Result<FilteringMeasure, StrandGenError> {
+        let strands = hair.root_count.min(FILTERING_MEASURE_STRANDS);
+        let plan = full_detail_plan(strands, vertex_count);
+        let trust_timestamps = !context.is_cpu();
+        let time = |filtering| -> Result<f64, StrandGenError> {
+            self.time_generation(context, hair, &plan, filtering)?;
+            let mut times = (0..3)
+                .map(|_| {
+                    let timing = self.time_generation(context, hair, &plan, filtering)?;
+                    Ok(match timing.gpu_ms {
+                        Some(ms) if ms > 0.0 && trust_timestamps => ms,
+                        _ => timing.wall_ms,
+                    })
+                })
+                .collect::<Result<Vec<f64>, StrandGenError>>()?;
+            times.sort_by(f64::total_cmp);
+            Ok(times[1])
+        };
+        let exact_ms = time(Filtering::Exact)?;
+        let mut measure = FilteringMeasure {
+            exact_ms,
+            hardware_ms: None,
+            hardware_error_max_m: 0.0,
+            hardware_error_mean_m: 0.0,
+            tolerance_m,
+            strands,
+        };
+        if self
+            .check_filtering(context, Filtering::Hardware8Bit)
+            .is_err()
+            || strands == 0
+        {
+            return Ok(measure);
+        }
+        measure.hardware_ms = Some(time(Filtering::Hardware8Bit)?);
+        let exact = self.generate_positions(context, hair, &plan, Filtering::Exact)?;
+        let hardware = self.generate_positions(context, hair, &plan, Filtering::Hardware8Bit)?;
+        let distances: Vec<f64> = exact
+            .iter()
+            .zip(&hardware)
+            .map(|(a, b)| {
+                glam::Vec3::from_slice(&a[..3]).distance(glam::Vec3::from_slice(&b[..3])) as f64
+            })
+            .collect();
+        measure.hardware_error_max_m = distances.iter().copied().fold(0.0, f64::max);
+        measure.hardware_error_mean_m =
+            distances.iter().sum::<f64>() / distances.len().max(1) as f64;
+        Ok(measure)
+    }
 }
+
+/// Strands [`StrandGenRenderer::measure_filtering`] generates each way (the first ones, in
+/// root order): a quarter of a batch, enough to fill a GPU and short on a CPU adapter.
+pub const FILTERING_MEASURE_STRANDS: usize = 8192;
