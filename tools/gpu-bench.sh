@@ -7,11 +7,11 @@
 #                                    # baseline), `bench switches`, `bench crowd`, `bench effects`
 #
 # `run` names the adapter first and writes adapters.txt, gpu.txt, switches.txt, crowd_default.txt,
-# crowd_compute.txt and effects.txt into OUT (default $OUT when
+# crowd_compute.txt, crowd_unique.txt, crowd_unique_no_lod.txt, teapots.txt and effects.txt into OUT (default $OUT when
 # set, else out/gpu-bench). It unpacks carried Vulkan loaders (.gl/*.deb, see the device
 # notes) when the machine has none, and points the loader at NVIDIA's ICD when it is there.
 # Knobs: STRANDS (default 10000,100000,300000), RUNS (3), SIZE (1280x720), TEXTURES (f16,f32),
-# CHARACTERS (1,10,100) and CROWD_STRANDS (100000) for the crowd,
+# CHARACTERS (1,10,100) and CROWD_STRANDS (100000) for the crowds, TEAPOTS (1,50,200),
 # BIN (the binary; default .gpu/hairloom, else target/release/hairloom).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -54,6 +54,14 @@ run)
         "$bin" bench crowd --characters "${CHARACTERS:-1,10,100}" --strands "${CROWD_STRANDS:-100000}" \
             --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" ${flag[@]+"${flag[@]}"} | tee "$out/crowd_$generation.txt"
     done
+    # Fig. 1 as the paper ran it: every character its own hair model (varied from the five
+    # head samples), with LOD and without; Fig. 9: 200 teapots of 50K strands, each its own.
+    "$bin" bench crowd --unique --characters "${CHARACTERS:-1,10,100}" --strands "${CROWD_STRANDS:-100000}" \
+        --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" | tee "$out/crowd_unique.txt"
+    "$bin" bench crowd --unique --no-lod --characters "${CHARACTERS:-1,10,100}" --strands "${CROWD_STRANDS:-100000}" \
+        --runs 1 --size "${SIZE:-1280x720}" | tee "$out/crowd_unique_no_lod.txt"
+    "$bin" bench crowd --unique --samples teapot_fur --characters "${TEAPOTS:-1,50,200}" --strands 50000 \
+        --runs "${RUNS:-3}" --size "${SIZE:-1280x720}" | tee "$out/teapots.txt"
     # What each lighting effect costs on this adapter (about 25 s on an H200).
     "$bin" bench effects --size "${SIZE:-1280x720}" --runs "${RUNS:-3}" | tee "$out/effects.txt"
     ;;

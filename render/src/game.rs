@@ -126,8 +126,10 @@ pub fn game_scene(scene: &Scene) -> Scene {
 pub struct GameHair {
     context: GpuContext,
     generator: StrandGenRenderer,
-    /// The bundle's runtime data and its GPU side.
-    asset: HairAsset,
+    /// The hair models' runtime data and GPU sides (the bundle's first, then each
+    /// [`Self::add_hair`]); frames draw `assets[current]`.
+    assets: Vec<HairAsset>,
+    current: usize,
     renderers: FrameRenderers,
     draw_body: bool,
     scene: Scene,
@@ -150,7 +152,13 @@ pub enum GameHairError {
     Asset(#[from] HairAssetError),
     #[error(transparent)]
     EffectLimit(#[from] FrameError),
+    #[error("no hair model {id} (this runtime holds {count})")]
+    UnknownHair { id: usize, count: usize },
 }
+
+/// One hair model of a [`GameHair`] (see [`GameHair::add_hair`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct HairId(pub usize);
 
 impl GameHair {
     /// Uploads `hair` (its five textures, placements, samples and styling: nothing per
@@ -206,7 +214,8 @@ impl GameHair {
             vertex_count: (1u32 << max_log2) + 1,
             frame: None,
             generator,
-            asset,
+            assets: vec![asset],
+            current: 0,
             context,
         };
         let scene = this.scene.clone();
@@ -219,18 +228,21 @@ impl GameHair {
     /// left out (see [`game_scene`]).
     pub fn set_lighting(&mut self, scene: &Scene) -> Result<(), GameHairError> {
         let scene = game_scene(scene);
-        let active = ActiveEffects::new(&scene, !self.asset.body().is_empty());
+        let active = ActiveEffects::new(&scene, !self.asset().body().is_empty());
         check_effect_limits(&self.context.device.limits(), &active)?;
         if active.far_hair {
             // Refused where it is not drawn (the mesh-shader path), before anything is made;
             // a bundle without its far-hair file builds the hierarchy here.
             self.hair_source()
                 .check(&self.context, self.vertex_count, true)?;
-            self.asset.ensure_far_hair(&self.context)?;
+            for asset in &mut self.assets {
+                asset.ensure_far_hair(&self.context)?;
+            }
         }
         if active.fur {
-            self.asset
-                .ensure_fur(&self.context, &scene.effects.fur_shells)?;
+            for asset in &mut self.assets {
+                asset.ensure_fur(&self.context, &scene.effects.fur_shells)?;
+            }
         }
         let input = self.generator.path().ribbon_input();
         self.renderers.sync(&self.context, &active, &scene, input);
@@ -254,8 +266,8 @@ impl GameHair {
         if path == GenerationPath::MeshShader {
             check_mesh_groups(
                 &self.context.device.limits(),
-                self.asset.gpu().bundles.len(),
-                self.asset.gpu().per_bundle,
+                self.asset().gpu().bundles.len(),
+                self.asset().gpu().per_bundle,
                 self.vertex_count,
             )?;
         }
@@ -297,19 +309,12 @@ impl GameHair {
     /// limits), and refused with the asset left as it was; the strand width and the effects
     /// that depend on the body follow the new hair.
     pub fn apply(&mut self, change: AssetChange) -> Result<(), GameHairError> {
-        if let AssetChange::Hair { hair, .. } = &change
-            && self.generator.path() == GenerationPath::MeshShader
-        {
-            check_mesh_groups(
-                &self.context.device.limits(),
-                hair.textures.atlas.blocks.len(),
-                hair.strands_per_bundle,
-                self.vertex_count,
-            )?;
+        if let AssetChange::Hair { hair, .. } = &change {
+            self.check_mesh_path(hair)?;
         }
-        self.asset.apply(&self.context, &self.generator, change)?;
+        self.assets[self.current].apply(&self.context, &self.generator, change)?;
         self.frame = None;
-        let (lo, hi) = self.asset.bounds();
+        let (lo, hi) = self.asset().bounds();
         self.strand_width_m = default_strand_width_m(lo, hi);
         let scene = self.scene.clone();
         self.set_lighting(&scene)
@@ -321,10 +326,10 @@ impl GameHair {
         self.draw_body = draw;
     }
 
-    /// Bytes the bundle keeps on the GPU (textures, placements, root samples, styling):
-    /// what every frame and every copy drawn from it share.
+    /// Bytes the selected model keeps on the GPU (textures, placements, root samples,
+    /// styling): what every frame and every copy drawn from it share.
     pub fn resident_bytes(&self) -> u64 {
-        self.asset.gpu().bytes
+        self.asset().gpu().bytes
     }
 
     /// Level of detail and culling (the bundle's settings by default).
@@ -346,7 +351,7 @@ impl GameHair {
 
     /// The box around the hair (to frame a camera).
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.asset.bounds()
+        self.asset().bounds()
     }
 
     /// The scene being drawn.
@@ -385,7 +390,7 @@ impl GameHair {
             GenerationPath::VertexShader | GenerationPath::MeshShader => usize::MAX / 2,
         };
         let (far_levels, lod) = {
-            let hair = self.asset.source(&self.generator, self.filtering, self.lod);
+            let hair = self.assets[self.current].source(&self.generator, self.filtering, self.lod);
             let lod = LodSettings {
                 strand_keep: strand_keep(&self.scene, &hair, &camera),
                 ..self.lod
@@ -393,8 +398,8 @@ impl GameHair {
             (self.renderers.far_levels(&self.scene, &hair, &camera), lod)
         };
         let mut plan = plan_frame(
-            &self.asset.gpu().bundles,
-            self.asset.gpu().per_bundle,
+            &self.asset().gpu().bundles,
+            self.asset().gpu().per_bundle,
             self.vertex_count.saturating_sub(1).max(1).ilog2(),
             &camera.lod(),
             &lod,
@@ -426,11 +431,11 @@ impl GameHair {
         let hair = self.hair_source();
         let inputs = FrameInputs {
             hair,
-            body: self.asset.body(),
+            body: self.asset().body(),
             vertex_count: self.vertex_count,
             strand_width_m: self.strand_width_m,
             scene: &self.scene,
-            hair_bounds: self.asset.bounds(),
+            hair_bounds: self.asset().bounds(),
             camera,
         };
         let frame = prepare(context, &self.renderers, &inputs, &plan);
@@ -438,7 +443,7 @@ impl GameHair {
         // Generation, then the shadow passes per shadow-casting light into the shadow maps
         // (not the game's targets).
         let mut recorder =
-            FrameRecorder::new(context, &self.renderers, &frame, self.asset.body(), &hair);
+            FrameRecorder::new(context, &self.renderers, &frame, self.asset().body(), &hair);
         recorder.generate(encoder, 0);
         recorder.shadow_views(encoder);
         stats.far_bundles = plan.far_bundles;
@@ -446,7 +451,7 @@ impl GameHair {
         self.frame = Some(frame);
         // Far hair: the next frame's levels from this frame's widths (a failed measurement
         // keeps the levels as they are).
-        let hair = self.asset.source(&self.generator, self.filtering, self.lod);
+        let hair = self.assets[self.current].source(&self.generator, self.filtering, self.lod);
         let _kept = self.renderers.advance_far_levels(
             &self.context,
             &self.scene,
@@ -461,11 +466,73 @@ impl GameHair {
     /// Far hair's hierarchy as the bundle carries it (`LoadedBundle::far_hair`), so that a
     /// scene naming far hair does not build it again.
     pub fn set_far_hair(&mut self, table: hairloom_core::runtime::thick_hair::FarHair) {
-        self.asset.set_far_hair(&self.context, table);
+        self.assets[self.current].set_far_hair(&self.context, table);
+    }
+
+    /// Uploads another hair model (its own textures, placements, samples and styling) that
+    /// shares this runtime's pipelines: a crowd of different hairstyles, each a few tens of
+    /// kilobytes. Checked as [`Self::new`] checks a bundle; the scene's effects are made for
+    /// it too. Draw it after [`Self::select_hair`].
+    pub fn add_hair(&mut self, hair: &RuntimeHair) -> Result<HairId, GameHairError> {
+        self.check_mesh_path(hair)?;
+        let mut asset = HairAsset::upload(&self.context, &self.generator, hair.clone())?;
+        let active = ActiveEffects::new(&self.scene, !asset.body().is_empty());
+        if active.far_hair {
+            asset.ensure_far_hair(&self.context)?;
+        }
+        if active.fur {
+            asset.ensure_fur(&self.context, &self.scene.effects.fur_shells)?;
+        }
+        self.assets.push(asset);
+        Ok(HairId(self.assets.len() - 1))
+    }
+
+    /// The model [`Self::prepare`] and [`Self::draw`] draw from now on (the bundle's is
+    /// `HairId(0)`); the strand width follows its size. Far hair's level choice starts again
+    /// from its first guess when the model changes.
+    pub fn select_hair(&mut self, id: HairId) -> Result<(), GameHairError> {
+        if id.0 >= self.assets.len() {
+            return Err(GameHairError::UnknownHair {
+                id: id.0,
+                count: self.assets.len(),
+            });
+        }
+        if id.0 != self.current {
+            self.current = id.0;
+            self.frame = None;
+            self.renderers.far_levels.clear();
+            let (lo, hi) = self.asset().bounds();
+            self.strand_width_m = default_strand_width_m(lo, hi);
+        }
+        Ok(())
+    }
+
+    /// The model drawn now.
+    pub fn selected_hair(&self) -> HairId {
+        HairId(self.current)
+    }
+
+    /// On the mesh path, refuses `hair` whose bundles do not fit the device's mesh
+    /// workgroup limits (as [`Self::new`] checks a bundle).
+    fn check_mesh_path(&self, hair: &RuntimeHair) -> Result<(), GameHairError> {
+        if self.generator.path() == GenerationPath::MeshShader {
+            check_mesh_groups(
+                &self.context.device.limits(),
+                hair.textures.atlas.blocks.len(),
+                hair.strands_per_bundle,
+                self.vertex_count,
+            )?;
+        }
+        Ok(())
+    }
+
+    fn asset(&self) -> &HairAsset {
+        &self.assets[self.current]
     }
 
     fn hair_source(&self) -> HairSource<'_> {
-        self.asset.source(&self.generator, self.filtering, self.lod)
+        self.asset()
+            .source(&self.generator, self.filtering, self.lod)
     }
 
     /// Records the body (when on) and the lit hair into the game's pass, depth-tested
@@ -480,7 +547,7 @@ impl GameHair {
             &self.context,
             &self.renderers,
             frame,
-            self.asset.body(),
+            self.asset().body(),
             &self.hair_source(),
         )
         .draw_into(pass, self.draw_body);

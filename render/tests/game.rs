@@ -8,7 +8,9 @@ use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
 use hairloom_render::device::headless_for_test;
-use hairloom_render::game::{GameCamera, GameFrameStats, GameHair, game_scene};
+use hairloom_render::game::{
+    GameCamera, GameFrameStats, GameHair, GameHairError, HairId, game_scene,
+};
 use hairloom_render::hair_asset::AssetChange;
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::Targets;
@@ -303,6 +305,27 @@ fn a_restyle_reaches_the_game_in_place_and_matches_a_fresh_bundle() {
         "restyled in place vs made afresh: mean difference {:.3}",
         mean_abs_difference(&expected, &curled)
     );
+
+    // A second model in the same runtime (a crowd of hairstyles sharing its pipelines): the
+    // straight cut added to the curled runtime draws as its own runtime did, and selecting
+    // the first model again draws the curls.
+    let straight_id = fresh.add_hair(&hair).expect("a second model");
+    assert_eq!(straight_id, HairId(1));
+    fresh.select_hair(straight_id).expect("select");
+    let (_, second) = draw(&context, &mut fresh, &view, &game_camera, background);
+    assert!(
+        second == straight,
+        "second model vs its own runtime: mean difference {:.3}",
+        mean_abs_difference(&second, &straight)
+    );
+    fresh.select_hair(HairId(0)).expect("select");
+    let (_, first) = draw(&context, &mut fresh, &view, &game_camera, background);
+    assert!(first == curled, "the first model again");
+    assert!(matches!(
+        fresh.select_hair(HairId(2)),
+        Err(GameHairError::UnknownHair { id: 2, count: 2 })
+    ));
+    assert_eq!(fresh.selected_hair(), HairId(0));
 }
 
 /// The game's default filtering is chosen by measuring both on its adapter: both timed,

@@ -167,6 +167,17 @@ pub enum Which {
         /// where the adapter has them, else compute per strand).
         #[arg(long, value_enum)]
         generation: Option<super::GenerationArg>,
+        /// Every character with its own hair model, varied from `--samples` (styling,
+        /// colour, strand count): seed 000 Fig. 1 (heads) and Fig. 9 (`--samples teapot_fur
+        /// --strands 50000`).
+        #[arg(long)]
+        unique: bool,
+        /// Level of detail off: every strand at full detail (the paper's "without LOD").
+        #[arg(long)]
+        no_lod: bool,
+        /// Samples the unique models are varied from, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [String::from("head_long_wavy"), String::from("head_curly"), String::from("head_short_straight"), String::from("head_long_straight"), String::from("head_ponytail")])]
+        samples: Vec<String>,
     },
     /// What each lighting effect costs: the frame with none, each alone, the scene's own
     /// combination and everything, at 10K and 100K strands (time and GPU memory).
@@ -316,7 +327,13 @@ pub fn run(which: Which) -> anyhow::Result<()> {
             out,
             vertex_shader,
             generation,
+            unique,
+            samples,
+            no_lod,
         } => super::bench_crowd::run(&super::bench_crowd::CrowdSettings {
+            unique,
+            samples,
+            no_lod,
             project,
             characters,
             strands,

@@ -31,6 +31,80 @@ pub struct CrowdSettings {
     /// Where strands are generated; `None`: the game runtime's default
     /// ([`GenerationPath::preferred`]).
     pub generation: Option<GenerationPath>,
+    /// Every character with its own hair model (seed 000 Fig. 1 and Fig. 9), made from
+    /// `samples` by [`variant`]; otherwise one model drawn N times.
+    pub unique: bool,
+    /// The samples unique models are varied from (names in `assets/samples/`).
+    pub samples: Vec<String>,
+    /// Level of detail off (every strand at full detail): the paper's "without LOD" rows.
+    pub no_lod: bool,
+}
+
+/// A number in `[0, 1)` for character `i`'s `k`-th choice (SplitMix64): the variants are
+/// the same in every run.
+fn pick(i: usize, k: u64) -> f64 {
+    let mut z =
+        (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ k.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Character `i`'s own hair model: sample `i mod n` with its styling varied (curl, wave,
+/// noise and clump amplitudes ×0.5-1.5, curl and wave rates ×0.7-1.3, length variation
+/// ±0.1, a seed of its own, per group as well as globally), its colour (eumelanin 0.2-8,
+/// pheomelanin 0-0.6) and its strand count (×0.8-1.2 of `strands`). A variation outside
+/// the styling ranges keeps the sample's own styling.
+fn default_sample_path_of(name: &str) -> PathBuf {
+    hairloom_core::samples::default_sample_path().with_file_name(format!("{name}.hairloom"))
+}
+
+fn variant(
+    documents: &[hairloom_core::model::document::Document],
+    i: usize,
+    strands: usize,
+) -> anyhow::Result<(RuntimeHair, usize)> {
+    use hairloom_core::model::scene::Pigment;
+    use hairloom_core::model::styling::StylingParams;
+    let mut document = documents[i % documents.len()].clone();
+    let vary = |p: &mut StylingParams| {
+        let scale = |k: u64| 0.5 + pick(i, k);
+        let rate = |k: u64| 0.7 + 0.6 * pick(i, k);
+        p.curl.radius_m *= scale(1);
+        p.curl.turns_per_m *= rate(2);
+        p.wave.amplitude_m *= scale(3);
+        p.wave.frequency_per_m *= rate(4);
+        p.noise.amplitude_m *= scale(5);
+        p.clump.strength = (p.clump.strength * scale(6)).min(1.0);
+        p.length.fraction = (p.length.fraction + 0.2 * pick(i, 7) - 0.1).clamp(0.0, 0.9);
+        p.seed = p.seed.wrapping_add(i as u32 * 7919 + 1);
+    };
+    let mut styling = document.styling.clone();
+    vary(&mut styling.global);
+    for group in &mut styling.groups {
+        vary(&mut group.params);
+    }
+    if styling.validate().is_ok() {
+        document.styling = styling;
+    }
+    document.scene.material.pigment = Pigment::Melanin {
+        eumelanin: (0.2 * 40f64.powf(pick(i, 8))) as f32,
+        pheomelanin: (0.6 * pick(i, 9)) as f32,
+    };
+    // f16 textures, as compact as the paper's (the accuracy table: 0.07 mm more error).
+    let mut hair = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            precision: hairloom_core::runtime::textures::Precision::F16,
+            ..RuntimeOptions::default()
+        },
+    );
+    let bundles = hair.textures.atlas.blocks.len().max(1);
+    let target = strands as f64 * (0.8 + 0.4 * pick(i, 10));
+    hair.set_strands_per_bundle((target as usize).div_ceil(bundles).clamp(1, 4096) as u32)?;
+    hair.scene.effects = hair.scene.effects.none();
+    Ok((hair, document.hair_mesh.vertex_count()))
 }
 
 pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
@@ -45,6 +119,31 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
     hair.set_strands_per_bundle(settings.strands.div_ceil(bundles).clamp(1, 4096) as u32)?;
     // The method's own cost, as in `bench gpu`: no optional effect.
     hair.scene.effects = hair.scene.effects.none();
+    // Unique models: one per character of the largest crowd, varied from the samples.
+    let (models, mesh_vertices): (Vec<RuntimeHair>, Vec<usize>) = if settings.unique {
+        let documents = settings
+            .samples
+            .iter()
+            .map(|name| {
+                let path = default_sample_path_of(name);
+                hairloom_core::io::project::load(&path)
+                    .map(|p| p.document)
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        anyhow::ensure!(!documents.is_empty(), "--unique needs at least one sample");
+        let most = settings.characters.iter().copied().max().unwrap_or(1);
+        (0..most)
+            .map(|i| variant(&documents, i, settings.strands))
+            .collect::<anyhow::Result<Vec<_>>>()?
+            .into_iter()
+            .unzip()
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    if let Some(first) = models.first() {
+        hair = first.clone();
+    }
     let context = GpuContext::new_headless()?;
     let sample_count = PreviewRenderer::new(&context).sample_count;
     let mut game = GameHair::new(
@@ -57,18 +156,56 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
     if let Some(path) = settings.generation {
         game.set_generation(path)?;
     }
+    if settings.no_lod {
+        game.set_lod(hairloom_core::runtime::frame_plan::LodSettings {
+            enabled: false,
+            ..hairloom_core::runtime::frame_plan::LodSettings::default()
+        });
+    }
+    let lod = if settings.no_lod { "LOD off" } else { "LOD on" };
+    // The other unique models, sharing the runtime's pipelines.
+    let mut ids = vec![game.selected_hair()];
+    for model in models.iter().skip(1) {
+        ids.push(game.add_hair(model)?);
+    }
+    let model_bytes: Vec<u64> = ids
+        .iter()
+        .map(|&id| {
+            game.select_hair(id)?;
+            Ok(game.resident_bytes())
+        })
+        .collect::<Result<_, hairloom_render::game::GameHairError>>()?;
     let view = View::new(&context, width, height, sample_count);
-    let (lo, hi) = hair
+    let (mut lo, mut hi) = hair
         .textures
         .hair_bounds()
         .ok_or_else(|| anyhow::anyhow!("no bundle grows hair"))?;
+    for (model_lo, model_hi) in models.iter().filter_map(|m| m.textures.hair_bounds()) {
+        lo = lo.min(model_lo);
+        hi = hi.max(model_hi);
+    }
     let extent = hi - lo;
     let spacing = extent.x.max(extent.z) * 1.6;
     let strands_per_character = hair.strand_roots().len();
-    println!(
-        "Crowd: N characters of {strands_per_character} strands each, one frame, {width}x{height}, {sample_count}× MSAA, LOD on: {}",
-        path.display()
-    );
+    // Strands of each unique model (the one model otherwise).
+    let model_strands: Vec<usize> = if models.is_empty() {
+        vec![strands_per_character]
+    } else {
+        models.iter().map(|m| m.strand_roots().len()).collect()
+    };
+    if settings.unique {
+        println!(
+            "Crowd of unique hair models: N characters, each its own model varied from {} (styling, colour, {}-{} strands), one frame, {width}x{height}, {sample_count}× MSAA, {lod}",
+            settings.samples.join(", "),
+            model_strands.iter().min().unwrap_or(&0),
+            model_strands.iter().max().unwrap_or(&0),
+        );
+    } else {
+        println!(
+            "Crowd: N characters of {strands_per_character} strands each, one frame, {width}x{height}, {sample_count}× MSAA, {lod}: {}",
+            path.display()
+        );
+    }
     println!("adapter: {}", describe(&context.adapter_info));
     println!("machine: {}", super::machine());
     println!(
@@ -122,6 +259,9 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
                     fov_y_rad: camera.fov_y_rad,
                     viewport_height_px: height,
                 };
+                if settings.unique {
+                    game.select_hair(ids[i % ids.len()])?;
+                }
                 let mut encoder =
                     context
                         .device
@@ -205,12 +345,25 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
                 height,
             )?;
         }
-        let memory = game.resident_bytes() + scratch;
-        // One character's strands at full detail, 16 B per vertex, stored explicitly: what an
-        // explicit renderer instancing one stored copy keeps, whatever the count.
-        let full_vertices =
-            strands_per_character * ((1usize << hair.lod.max_vertices_log2.min(8)) + 1);
-        let stored = (full_vertices * 16) as u64;
+        let full_vertex_count = (1usize << hair.lod.max_vertices_log2.min(8)) + 1;
+        let (memory, stored) = if settings.unique {
+            // Every character's own model, and every character's strands stored.
+            let drawn = count.min(model_bytes.len());
+            (
+                model_bytes[..drawn].iter().sum::<u64>() + scratch,
+                model_strands[..drawn]
+                    .iter()
+                    .map(|&n| (n * full_vertex_count * 16) as u64)
+                    .sum::<u64>(),
+            )
+        } else {
+            // One character's strands at full detail, 16 B per vertex, stored explicitly:
+            // what an explicit renderer instancing one stored copy keeps, whatever the count.
+            (
+                game.resident_bytes() + scratch,
+                (strands_per_character * full_vertex_count * 16) as u64,
+            )
+        };
         println!(
             "{:>10} {:>12} {:>12} {:>10.1} {:>14.1} {:>12.2} {:>13.1} {:>9.0}×",
             count,
@@ -223,8 +376,59 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
             stored as f64 / memory as f64
         );
     }
-    println!(
-        "memory: the bundle's textures, placements, samples and styling once (shared by every character) + the largest scratch; stored: one character's strands at full detail, 16 B per vertex (one copy instanced by every character)."
-    );
+    if settings.unique {
+        let kb: Vec<f64> = model_bytes.iter().map(|&b| b as f64 / 1e3).collect();
+        let per_vertex = model_bytes.iter().sum::<u64>() as f64
+            / mesh_vertices.iter().sum::<usize>().max(1) as f64;
+        println!(
+            "memory: every character's own model (f16 textures, placements, samples, styling: {:.1}-{:.1} KB a model for {}-{} hair-mesh vertices, {per_vertex:.0} B a vertex) + the largest scratch; stored: every character's strands at full detail, 16 B per vertex. {}",
+            kb.iter().copied().fold(f64::INFINITY, f64::min),
+            kb.iter().copied().fold(0.0, f64::max),
+            mesh_vertices.iter().min().unwrap_or(&0),
+            mesh_vertices.iter().max().unwrap_or(&0),
+            if settings.samples.iter().all(|s| s.starts_with("teapot")) {
+                "Seed 000 Fig. 9: 200 teapots of 50K strands in 3.2 MB (11-27 KB a teapot of 198-378 vertices, 71 B a vertex), 1.8 ms with LOD at 8× MSAA, 1.1 ms without MSAA, 150 ms without LOD (RTX 4090)."
+            } else {
+                "Seed 000 Fig. 1: 100 models of 100K strands in 1.7 MB (13-21 KB a model of 185 vertices; 71 B a vertex across its Fig. 10), 2 ms with LOD, 47 ms without (RTX 4090, 8× MSAA)."
+            }
+        );
+    } else {
+        println!(
+            "memory: the bundle's textures, placements, samples and styling once (shared by every character) + the largest scratch; stored: one character's strands at full detail, 16 B per vertex (one copy instanced by every character)."
+        );
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unique_models_differ_in_styling_colour_and_strand_count() -> anyhow::Result<()> {
+        let sample = hairloom_core::io::project::load(&default_sample_path_of("head_curly"))?;
+        let documents = [sample.document.clone()];
+        let models = (0..6)
+            .map(|i| variant(&documents, i, 2000))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        for (i, (a, vertices)) in models.iter().enumerate() {
+            assert_eq!(*vertices, sample.document.hair_mesh.vertex_count());
+            a.styling.validate().map_err(anyhow::Error::msg)?;
+            let strands = a.strand_roots().len() as f64;
+            // ×0.8-1.2 of the target, up to a bundle's worth of rounding and density.
+            assert!((1000.0..3000.0).contains(&strands), "{i}: {strands}");
+            assert_ne!(
+                a.styling, sample.document.styling,
+                "{i} kept the sample's styling"
+            );
+            assert_ne!(a.scene.material, sample.document.scene.material);
+            for (j, (b, _)) in models.iter().enumerate().skip(i + 1) {
+                assert_ne!(a.styling, b.styling, "{i} and {j}");
+                assert_ne!(a.scene.material, b.scene.material, "{i} and {j}");
+            }
+        }
+        // The same character gets the same model in every run.
+        assert_eq!(variant(&documents, 3, 2000)?.0.styling, models[3].0.styling);
+        Ok(())
+    }
 }
