@@ -491,3 +491,36 @@ fn opening_a_project_frames_the_camera_on_its_own_hair() {
         common::drawn_pixels(&image, background) > (image.width() * image.height()) as usize / 10
     );
 }
+
+/// Issue 35's bug: after importing a scalp (no bundle grows hair yet) the viewport was black
+/// with "no bundle grows hair". It draws the body and says how to start instead.
+#[test]
+fn a_scalp_with_no_hair_yet_shows_the_body() {
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    let with_hair = viewport_image(&mut harness);
+    let mut scalp = harness.state().state.document().clone();
+    scalp.name = "scalp".into();
+    scalp.hair_mesh = hairloom_core::model::mesh::HairMesh::empty();
+    harness.state_mut().state.import_scalp(scalp, "a scalp");
+    let image = viewport_image(&mut harness);
+    let viewport = &harness.state().viewport;
+    assert!(viewport.error().is_none(), "{:?}", viewport.error());
+    assert_eq!(viewport.drawn().0, 0, "no strand is drawn");
+    let hint = viewport.hint().expect("a hint");
+    assert!(hint.contains("extrude"), "{hint}");
+    let background = image.get_pixel(2, 2).0;
+    let drawn = common::drawn_pixels(&image, background);
+    let pixels = (image.width() * image.height()) as usize;
+    assert!(
+        drawn > pixels / 20,
+        "only {drawn} of {pixels} pixels show the body"
+    );
+    // The body alone, not the hair's picture left over.
+    let hair_drawn = common::drawn_pixels(&with_hair, background);
+    assert!(
+        drawn < hair_drawn,
+        "{drawn} pixels with no hair, {hair_drawn} with it"
+    );
+}

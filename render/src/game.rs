@@ -191,13 +191,19 @@ impl GameHair {
         let asset = HairAsset::upload(&context, &generator, hair.clone())?;
         let bounds = asset.bounds();
         let strand_width_m = default_strand_width_m(bounds.0, bounds.1);
-        // Exact or the texture units' 8-bit weights: measured here, on the game's adapter.
-        let filtering_measure = StrandGenRenderer::new(&context).measure_filtering(
-            &context,
-            asset.gpu(),
-            (1u32 << max_log2) + 1,
-            0.5 * strand_width_m as f64,
-        )?;
+        // Exact or the texture units' 8-bit weights: measured here, on the game's adapter (a
+        // failed measurement leaves exact filtering, its times unknown).
+        let tolerance_m = 0.5 * strand_width_m as f64;
+        let filtering_measure = StrandGenRenderer::new(&context)
+            .measure_filtering(&context, asset.gpu(), (1u32 << max_log2) + 1, tolerance_m)
+            .unwrap_or(FilteringMeasure {
+                exact_ms: f64::NAN,
+                hardware_ms: None,
+                hardware_error_max_m: f64::NAN,
+                hardware_error_mean_m: f64::NAN,
+                tolerance_m,
+                strands: 0,
+            });
         let mut this = Self {
             renderers: FrameRenderers::new(&context, targets),
             draw_body: true,
@@ -264,12 +270,15 @@ impl GameHair {
         }
         StrandGenRenderer::check_path(&self.context, path)?;
         if path == GenerationPath::MeshShader {
-            check_mesh_groups(
-                &self.context.device.limits(),
-                self.asset().gpu().bundles.len(),
-                self.asset().gpu().per_bundle,
-                self.vertex_count,
-            )?;
+            // Every model must fit the mesh path's workgroups, not only the one drawn now.
+            for asset in &self.assets {
+                check_mesh_groups(
+                    &self.context.device.limits(),
+                    asset.gpu().bundles.len(),
+                    asset.gpu().per_bundle,
+                    self.vertex_count,
+                )?;
+            }
         }
         self.generator = StrandGenRenderer::with_path(&self.context, path);
         self.frame = None;
@@ -470,11 +479,16 @@ impl GameHair {
     }
 
     /// Uploads another hair model (its own textures, placements, samples and styling) that
-    /// shares this runtime's pipelines: a crowd of different hairstyles, each a few tens of
-    /// kilobytes. Checked as [`Self::new`] checks a bundle; the scene's effects are made for
-    /// it too. Draw it after [`Self::select_hair`].
+    /// shares this runtime's pipelines and scene (lights, material and effects: `hair`'s own
+    /// scene is not used): a crowd of different hairstyles, each a few tens of kilobytes.
+    /// Checked as [`Self::new`] checks a bundle; the scene's effects are made for it too.
+    /// Draw it after [`Self::select_hair`].
     pub fn add_hair(&mut self, hair: &RuntimeHair) -> Result<HairId, GameHairError> {
-        self.check_mesh_path(hair)?;
+        // A model the mesh path's workgroups cannot hold moves every model to compute, as
+        // `new` does for the first.
+        if self.check_mesh_path(hair).is_err() {
+            self.set_generation(GenerationPath::ComputePerStrand)?;
+        }
         let mut asset = HairAsset::upload(&self.context, &self.generator, hair.clone())?;
         let active = ActiveEffects::new(&self.scene, !asset.body().is_empty());
         if active.far_hair {
@@ -488,8 +502,9 @@ impl GameHair {
     }
 
     /// The model [`Self::prepare`] and [`Self::draw`] draw from now on (the bundle's is
-    /// `HairId(0)`); the strand width follows its size. Far hair's level choice starts again
-    /// from its first guess when the model changes.
+    /// `HairId(0)`); the strand width follows its size, as after [`Self::apply`] (a width
+    /// set with [`Self::set_strand_width_m`] is set again after a switch). Far hair's level
+    /// choice starts again from its first guess when the model changes.
     pub fn select_hair(&mut self, id: HairId) -> Result<(), GameHairError> {
         if id.0 >= self.assets.len() {
             return Err(GameHairError::UnknownHair {
@@ -498,11 +513,17 @@ impl GameHair {
             });
         }
         if id.0 != self.current {
+            let had_body = !self.asset().body().is_empty();
             self.current = id.0;
             self.frame = None;
             self.renderers.far_levels.clear();
             let (lo, hi) = self.asset().bounds();
             self.strand_width_m = default_strand_width_m(lo, hi);
+            // Body shadows and their slots follow whether this model has a body.
+            if had_body == self.asset().body().is_empty() {
+                let scene = self.scene.clone();
+                self.set_lighting(&scene)?;
+            }
         }
         Ok(())
     }

@@ -239,10 +239,18 @@ impl PreviewRenderer {
                 stored_plan(*strand_count, scene.vertex_count)
             }
             // The same bundle-level work as the generated strands it stores.
-            HairSource::Skinned { hair, lod, .. } => plan_frame(
+            // No more vertices than were stored and bound.
+            HairSource::Skinned {
+                hair, lod, skinned, ..
+            } => plan_frame(
                 &hair.bundles,
                 hair.per_bundle,
-                scene.vertex_count.saturating_sub(1).max(1).ilog2(),
+                scene
+                    .vertex_count
+                    .min(skinned.vertex_count)
+                    .saturating_sub(1)
+                    .max(1)
+                    .ilog2(),
                 &Self::frame_camera(scene, width, height).lod(),
                 lod,
                 batch_vertex_limit(scene.vertex_count),

@@ -355,10 +355,24 @@ fn the_game_measures_its_filtering_on_its_adapter() {
     // f16 textures filter on every adapter we run on.
     let hardware_ms = measure.hardware_ms.expect("hardware filtering measured");
     assert!(hardware_ms.is_finite() && hardware_ms > 0.0, "{measure:?}");
-    // 8-bit weights move vertices, but by a fraction of a millimetre on a head.
-    assert!(measure.hardware_error_max_m > 0.0, "{measure:?}");
+    // 8-bit weights move vertices by a fraction of a millimetre on a head (an adapter that
+    // filters in float, as llvmpipe does, by nothing at all).
+    assert!(measure.hardware_error_max_m >= 0.0, "{measure:?}");
     assert!(measure.hardware_error_max_m < 2e-3 * size, "{measure:?}");
     assert!(measure.hardware_error_mean_m <= measure.hardware_error_max_m);
-    assert!(measure.tolerance_m > 0.0 && measure.tolerance_m < 1e-2 * size);
-    assert_eq!(game.filtering(), measure.choice());
+    // Half the width of a strand, which is a little over a thousandth of the hair's size.
+    let width = hairloom_render::preview::default_strand_width_m(lo, hi) as f64;
+    assert!(
+        (measure.tolerance_m - 0.5 * width).abs() < 1e-9,
+        "{measure:?}"
+    );
+    // The rule, from the numbers: hardware weights only where faster by 5 % and within it.
+    let hardware_pays = hardware_ms <= 0.95 * measure.exact_ms
+        && measure.hardware_error_max_m <= measure.tolerance_m;
+    let expected = if hardware_pays {
+        Filtering::Hardware8Bit
+    } else {
+        Filtering::Exact
+    };
+    assert_eq!(game.filtering(), expected, "{measure:?}");
 }

@@ -96,6 +96,32 @@ fn gpu_skinning_matches_the_cpu_mirror() {
         })
         .fold(0.0f32, f32::max);
     assert!(worst < 2e-6 * size, "worst {worst} m of {size} m");
+    // The same in batches small enough that a frame takes several (runs after the first
+    // batch's, batch-relative offsets).
+    let batched = plan_frame(&hair.bundles, 16, 5, &camera, &lod, 4000, &[]);
+    assert!(
+        batched.batches.len() > 2,
+        "{} batches",
+        batched.batches.len()
+    );
+    let on_gpu_batched = skinner
+        .skin_positions(&context, &gpu, &batched)
+        .expect("skin");
+    let mirror_batched: Vec<[f32; 4]> = batched
+        .batches
+        .iter()
+        .flat_map(|batch| skinned.skin_main(&pose, &frames, batch))
+        .collect();
+    assert_eq!(on_gpu_batched.len(), mirror_batched.len());
+    let worst_batched = on_gpu_batched
+        .iter()
+        .zip(&mirror_batched)
+        .map(|(a, b)| Vec3::from_slice(a).distance(Vec3::from_slice(b)))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst_batched < 2e-6 * size,
+        "batched: worst {worst_batched} m"
+    );
     // And the pose moved the hair: the mirror is not the rest.
     let rest = skinned.skin_main(&skinned.rest, &guide_frames(&skinned.rest, VERTICES), &runs);
     let moved = mirror

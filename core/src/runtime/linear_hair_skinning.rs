@@ -430,7 +430,7 @@ pub fn guide_frames(pose: &GuidePose, vertex_count: u32) -> Vec<GuideFrame> {
         let mut previous: Option<GuideFrame> = None;
         for s in 0..v {
             let d = points[(s + 1).min(v - 1)] - points[s.saturating_sub(1)];
-            let tangent = match (d.try_normalize(), previous) {
+            let tangent = match (try_normalize(d), previous) {
                 (Some(t), _) => t,
                 (None, Some(frame)) => frame.tangent,
                 (None, None) => duff_basis(*reference).0,
@@ -439,12 +439,11 @@ pub fn guide_frames(pose: &GuidePose, vertex_count: u32) -> Vec<GuideFrame> {
                 Some(frame) => frame.normal,
                 None => *reference,
             };
-            let normal = (carried - tangent * tangent.dot(carried))
-                .try_normalize()
+            let normal = try_normalize(carried - tangent * tangent.dot(carried))
                 .or_else(|| {
                     previous.and_then(|frame| {
                         let b = frame.binormal();
-                        (b - tangent * tangent.dot(b)).try_normalize()
+                        try_normalize(b - tangent * tangent.dot(b))
                     })
                 })
                 .unwrap_or_else(|| duff_basis(tangent).1);
@@ -456,11 +455,17 @@ pub fn guide_frames(pose: &GuidePose, vertex_count: u32) -> Vec<GuideFrame> {
     frames
 }
 
+/// `v` made unit where its squared length is above 1e-30, as the shader's `try_normalize`.
+fn try_normalize(v: Vec3) -> Option<Vec3> {
+    let length_squared = v.length_squared();
+    (length_squared > 1e-30).then(|| v / length_squared.sqrt())
+}
+
 /// A unit `z` (from `direction`, +z when it has no length) and a unit vector ⟂ it (Duff et
 /// al. 2017's branchless basis).
 fn duff_basis(direction: Vec3) -> (Vec3, Vec3) {
-    let n = direction.try_normalize().unwrap_or(Vec3::Z);
-    let sign = 1.0f32.copysign(n.z);
+    let n = try_normalize(direction).unwrap_or(Vec3::Z);
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
     (

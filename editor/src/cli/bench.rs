@@ -168,7 +168,7 @@ pub enum Which {
         #[arg(long, value_enum)]
         generation: Option<super::GenerationArg>,
         /// Every character with its own hair model, varied from `--samples` (styling,
-        /// colour, strand count): seed 000 Fig. 1 (heads) and Fig. 9 (`--samples teapot_fur
+        /// strand count): seed 000 Fig. 1 (heads) and Fig. 9 (`--samples teapot_fur
         /// --strands 50000`).
         #[arg(long)]
         unique: bool,

@@ -51,21 +51,21 @@ fn pick(i: usize, k: u64) -> f64 {
     (z >> 11) as f64 / (1u64 << 53) as f64
 }
 
-/// Character `i`'s own hair model: sample `i mod n` with its styling varied (curl, wave,
-/// noise and clump amplitudes ×0.5-1.5, curl and wave rates ×0.7-1.3, length variation
-/// ±0.1, a seed of its own, per group as well as globally), its colour (eumelanin 0.2-8,
-/// pheomelanin 0-0.6) and its strand count (×0.8-1.2 of `strands`). A variation outside
-/// the styling ranges keeps the sample's own styling.
+/// Where the sample `name` lives (`assets/samples/NAME.hairloom`).
 fn default_sample_path_of(name: &str) -> PathBuf {
     hairloom_core::samples::default_sample_path().with_file_name(format!("{name}.hairloom"))
 }
 
+/// Character `i`'s own hair model: sample `i mod n` with its styling varied (curl, wave,
+/// noise and clump amplitudes ×0.5-1.5, curl and wave rates ×0.7-1.3, length variation
+/// ±0.1, a seed of its own, per group as well as globally) and its strand count (×0.8-1.2
+/// of `strands`). A variation outside the styling ranges keeps the sample's own styling.
+/// The colour is the runtime's scene's, shared by every model (`GameHair::add_hair`).
 fn variant(
     documents: &[hairloom_core::model::document::Document],
     i: usize,
     strands: usize,
 ) -> anyhow::Result<(RuntimeHair, usize)> {
-    use hairloom_core::model::scene::Pigment;
     use hairloom_core::model::styling::StylingParams;
     let mut document = documents[i % documents.len()].clone();
     let vary = |p: &mut StylingParams| {
@@ -88,10 +88,6 @@ fn variant(
     if styling.validate().is_ok() {
         document.styling = styling;
     }
-    document.scene.material.pigment = Pigment::Melanin {
-        eumelanin: (0.2 * 40f64.powf(pick(i, 8))) as f32,
-        pheomelanin: (0.6 * pick(i, 9)) as f32,
-    };
     // f16 textures, as compact as the paper's (the accuracy table: 0.07 mm more error).
     let mut hair = RuntimeHair::from_document(
         &document,
@@ -195,7 +191,7 @@ pub fn run(settings: &CrowdSettings) -> anyhow::Result<()> {
     };
     if settings.unique {
         println!(
-            "Crowd of unique hair models: N characters, each its own model varied from {} (styling, colour, {}-{} strands), one frame, {width}x{height}, {sample_count}× MSAA, {lod}",
+            "Crowd of unique hair models: N characters, each its own model varied from {} (styling, {}-{} strands), one frame, {width}x{height}, {sample_count}× MSAA, {lod}",
             settings.samples.join(", "),
             model_strands.iter().min().unwrap_or(&0),
             model_strands.iter().max().unwrap_or(&0),
@@ -405,7 +401,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn unique_models_differ_in_styling_colour_and_strand_count() -> anyhow::Result<()> {
+    fn unique_models_differ_in_styling_and_strand_count() -> anyhow::Result<()> {
         let sample = hairloom_core::io::project::load(&default_sample_path_of("head_curly"))?;
         let documents = [sample.document.clone()];
         let models = (0..6)
@@ -421,10 +417,8 @@ mod tests {
                 a.styling, sample.document.styling,
                 "{i} kept the sample's styling"
             );
-            assert_ne!(a.scene.material, sample.document.scene.material);
             for (j, (b, _)) in models.iter().enumerate().skip(i + 1) {
                 assert_ne!(a.styling, b.styling, "{i} and {j}");
-                assert_ne!(a.scene.material, b.scene.material, "{i} and {j}");
             }
         }
         // The same character gets the same model in every run.

@@ -160,6 +160,12 @@ pub struct Viewport {
     /// The box of the last built hair: `Some(None)` when no bundle grows hair, `None` before
     /// the first is built.
     hair_bounds: Option<Option<(Vec3, Vec3)>>,
+    /// The box of the last built hair's body: framed and drawn alone while no bundle grows
+    /// hair (a scalp just imported).
+    body_bounds: Option<(Vec3, Vec3)>,
+    /// What the viewport says over its picture while there is nothing wrong, as of its last
+    /// pass (see [`Self::hint`]).
+    hint: Option<&'static str>,
     /// The serial of the first build request since the last reframe: older builds (of the
     /// document shown before) never set `hair_bounds`; `None` until that request is made.
     frame_from_serial: Option<u64>,
@@ -296,6 +302,8 @@ impl Viewport {
             builder,
             requested: None,
             hair_bounds: None,
+            body_bounds: None,
+            hint: None,
             frame_from_serial: None,
             device_problem,
             orbit: Orbit::default(),

@@ -8,7 +8,8 @@
 use super::*;
 use eframe::egui_wgpu::{CallbackResources, CallbackTrait, ScreenDescriptor};
 use hairloom_core::model::scene::Scene;
-use hairloom_render::hair_asset::{AssetBuilder, AssetChange, HairAsset};
+use hairloom_render::hair_asset::{AssetBuilder, AssetChange, HairAsset, HairAssetError};
+use hairloom_render::renderer::preview_body::GpuBody;
 use hairloom_render::renderer::strand_gen::GenerationPath;
 use hairloom_render::renderer::viewport_blit::ViewportBlitRenderer;
 
@@ -21,6 +22,9 @@ pub(super) struct ViewportGpu {
     blit: ViewportBlitRenderer,
     /// The shown document's hair on the GPU, changed only through [`HairAsset::apply`].
     hair: Option<HairAsset>,
+    /// The body and its box when no bundle grows hair yet (a scalp just imported): drawn
+    /// alone, so the artist sees the head to extrude from.
+    bare_body: Option<(GpuBody, (Vec3, Vec3))>,
     /// The last rendered picture (the preview's kept colour target) and its blit binding.
     picture: Option<(wgpu::Texture, wgpu::BindGroup)>,
 }
@@ -39,6 +43,7 @@ impl ViewportGpu {
             blit: ViewportBlitRenderer::new(&context, target_format, 1),
             context,
             hair: None,
+            bare_body: None,
             picture: None,
         }
     }
@@ -46,8 +51,29 @@ impl ViewportGpu {
     /// Does what the panel asked for, in order: the asset's change, then a frame.
     fn apply(&mut self, work: PendingWork, shared: &CallbackShared, ctx: &egui::Context) {
         if let Some(change) = work.change {
+            // Hair with no bundle that grows: its body is drawn alone.
+            let bare = match &change {
+                AssetChange::Hair { hair, .. } if hair.textures.hair_bounds().is_none() => {
+                    body_bounds(&hair.body)
+                        .map(|bounds| (GpuBody::upload(&self.context, &hair.body), bounds))
+                }
+                _ => None,
+            };
+            if let AssetChange::Hair { .. } = &change {
+                self.bare_body = None;
+            }
             let applied =
                 HairAsset::apply_to(&mut self.hair, &self.context, &self.generator, change);
+            if let (Err(HairAssetError::NoHair), Some(bare)) = (&applied, bare) {
+                self.bare_body = Some(bare);
+                let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
+                report.upload_error = None;
+                drop(report);
+                if let Some(frame) = work.frame {
+                    self.draw_bare_body(frame, shared, ctx);
+                }
+                return;
+            }
             let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
             match applied {
                 // Nothing changed (a restyle of hair that could not be uploaded): the
@@ -71,6 +97,7 @@ impl ViewportGpu {
             return;
         };
         let Some(hair) = self.hair.as_mut() else {
+            self.draw_bare_body(frame, shared, ctx);
             return;
         };
         if frame.lighting.effects.far_hair == hairloom_core::model::scene::FarHair::Aggregated
@@ -94,12 +121,67 @@ impl ViewportGpu {
             frame.camera,
             &frame.lighting,
         );
+        Self::render_and_report(
+            &self.context,
+            &self.preview,
+            &self.blit,
+            &mut self.picture,
+            &scene,
+            &frame,
+            shared,
+            ctx,
+        );
+    }
+
+    /// The body alone, where no bundle grows hair yet (nothing when there is no body).
+    fn draw_bare_body(
+        &mut self,
+        frame: FrameRequest,
+        shared: &CallbackShared,
+        ctx: &egui::Context,
+    ) {
+        let Some((body, bounds)) = &self.bare_body else {
+            return;
+        };
+        let scene = default_scene(
+            body,
+            hairloom_render::preview::HairSource::Vertices(&[]),
+            17,
+            *bounds,
+            frame.camera,
+            &frame.lighting,
+        );
+        Self::render_and_report(
+            &self.context,
+            &self.preview,
+            &self.blit,
+            &mut self.picture,
+            &scene,
+            &frame,
+            shared,
+            ctx,
+        );
+    }
+
+    /// Renders `scene` into the kept picture and reports its counts, time and any error.
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "disjoint fields of the viewport's GPU side, borrowed apart from the scene"
+    )]
+    fn render_and_report(
+        context: &GpuContext,
+        preview: &PreviewRenderer,
+        blit: &ViewportBlitRenderer,
+        picture: &mut Option<(wgpu::Texture, wgpu::BindGroup)>,
+        scene: &hairloom_render::preview::PreviewScene,
+        frame: &FrameRequest,
+        shared: &CallbackShared,
+        ctx: &egui::Context,
+    ) {
         let [width, height] = frame.size;
-        let plan = self.preview.plan(&scene, width, height);
+        let plan = preview.plan(scene, width, height);
         let started = std::time::Instant::now();
-        let rendered = self
-            .preview
-            .render_texture(&self.context, &scene, &plan, width, height);
+        let rendered = preview.render_texture(context, scene, &plan, width, height);
         // The status bar says what generating and drawing this frame cost, from submission
         // to the GPU finishing it, without waiting here: egui's own submission on the same
         // queue orders the picture before its use.
@@ -109,7 +191,7 @@ impl ViewportGpu {
             ctx.clone(),
             frame.quality,
         );
-        self.context.queue.on_submitted_work_done(move || {
+        context.queue.on_submitted_work_done(move || {
             if let (Ok(mut slot), Ok(mut timed)) = (frame_ms.lock(), timed_quality.lock()) {
                 *slot = Some(started.elapsed().as_secs_f64() * 1e3);
                 *timed = Some(quality);
@@ -122,8 +204,8 @@ impl ViewportGpu {
         match rendered {
             Ok(texture) => {
                 report.error = None;
-                let group = self.blit.bind(&self.context, &texture);
-                self.picture = Some((texture, group));
+                let group = blit.bind(context, &texture);
+                *picture = Some((texture, group));
             }
             Err(error) => report.error = Some(error.to_string()),
         }
@@ -339,8 +421,14 @@ impl Viewport {
             size: full_size,
             quality,
         };
+        // No bundle grows hair yet: the body alone, framed as the hair would be (and the view
+        // stays put when the first hair grows).
+        let bare_body = match self.hair_bounds {
+            Some(None) => self.body_bounds,
+            _ => None,
+        };
         if self.drawn != Some(drawn) {
-            if let Some(Some(bounds)) = self.hair_bounds {
+            if let Some(bounds) = self.hair_bounds.flatten().or(bare_body) {
                 if !self.framed_from_hair {
                     self.camera_bounds = Some(bounds);
                     self.framed_from_hair = true;
@@ -371,7 +459,12 @@ impl Viewport {
             self.drawn = Some(drawn);
         }
         // No hair first: an older upload or frame error is about hair no longer shown.
+        self.hint = bare_body.map(
+            |_| "No bundle grows hair yet: select scalp faces, then E extrudes them into bundles",
+        );
         self.error = match (self.hair_bounds, &report.upload_error, &report.error) {
+            (Some(None), _, Some(error)) if bare_body.is_some() => Some(error.clone()),
+            (Some(None), _, None) if bare_body.is_some() => None,
             (Some(None), _, _) => Some("no bundle grows hair".into()),
             // Not built yet: nothing to say.
             (None, _, _) => None,
@@ -397,12 +490,27 @@ impl Viewport {
                 ui.visuals().error_fg_color,
             );
         }
+        if let (Some(hint), None) = (self.hint, &self.error) {
+            ui.painter().text(
+                rect.center_bottom() - egui::vec2(0.0, 24.0),
+                egui::Align2::CENTER_BOTTOM,
+                hint,
+                egui::FontId::proportional(14.0),
+                ui.visuals().strong_text_color(),
+            );
+        }
     }
 
     /// Strands and vertices of the last frame, after culling and LOD.
     pub fn drawn(&self) -> (usize, usize) {
         let report = self.report();
         (report.drawn_strands, report.drawn_vertices)
+    }
+
+    /// What the viewport says over a picture that is not wrong (the body alone while no
+    /// bundle grows hair).
+    pub fn hint(&self) -> Option<&'static str> {
+        self.hint
     }
 
     /// Why the viewport shows no picture: no usable device, no hair, the hair above the
@@ -504,6 +612,7 @@ impl Viewport {
                 .is_some_and(|first| built.serial >= first);
             if let (AssetChange::Hair { hair, .. }, true) = (&built.change, current) {
                 self.hair_bounds = Some(hair.textures.hair_bounds());
+                self.body_bounds = body_bounds(&hair.body);
             }
             self.shared
                 .pending
@@ -534,4 +643,15 @@ impl Viewport {
     pub fn uploads(&self) -> UploadCounts {
         self.report().uploads
     }
+}
+
+/// The box around `body`'s vertices; `None` without a finite one.
+pub(super) fn body_bounds(body: &hairloom_core::model::document::BodyMesh) -> Option<(Vec3, Vec3)> {
+    let mut points = body
+        .positions
+        .iter()
+        .map(|p| Vec3::from_array(*p))
+        .filter(|p| p.is_finite());
+    let first = points.next()?;
+    Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }

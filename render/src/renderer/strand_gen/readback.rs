@@ -228,7 +228,14 @@ impl StrandGenRenderer {
                 glam::Vec3::from_slice(&a[..3]).distance(glam::Vec3::from_slice(&b[..3])) as f64
             })
             .collect();
-        measure.hardware_error_max_m = distances.iter().copied().fold(0.0, f64::max);
+        // A non-finite distance is an unbounded error (`f64::max` would drop a NaN).
+        measure.hardware_error_max_m = distances.iter().copied().fold(0.0, |max, d| {
+            if d.is_finite() {
+                max.max(d)
+            } else {
+                f64::INFINITY
+            }
+        });
         measure.hardware_error_mean_m =
             distances.iter().sum::<f64>() / distances.len().max(1) as f64;
         Ok(measure)
