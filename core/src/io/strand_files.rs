@@ -4,7 +4,7 @@
 
 use crate::model::mesh::HairMesh;
 use crate::model::scene::HairMaterial;
-use crate::strands::reference::{Strand, root_indices, strands_per_bundle_of};
+use crate::strands::reference::{Strand, root_indices};
 
 /// How exported strands look, the same in every format: each point's width (the root
 /// width tapering to the tip as the renderers draw it) and colour (linear RGB, from the
@@ -20,7 +20,7 @@ pub struct StrandLook {
 
 impl StrandLook {
     pub fn new(strands: &[Strand], root_width_m: f32, material: &HairMaterial) -> Self {
-        let roots = root_indices(strands, strands_per_bundle_of(strands));
+        let roots = root_indices(strands);
         Self {
             root_width_m,
             widths_m: strands
@@ -591,5 +591,76 @@ mod tests {
             .expect("primitive");
         assert_eq!(primitive.mode(), gltf::mesh::Mode::Lines);
         assert_eq!(primitive.indices().map(|a| a.count()), Some(20 * 8 * 2));
+    }
+
+    /// Issue 37: where every bundle is thinned (a hairline everywhere), the export's colours
+    /// used to guess the strands per bundle from the strands (half the real count here) and
+    /// hashed each strand's variation from the wrong root. Now each strand carries the
+    /// renderers' root number.
+    #[test]
+    fn thinned_bundles_keep_the_renderers_root_numbers() {
+        let mut document = Document::new("grid", grid(3, 2, 2, 0.5));
+        for bundle in &mut document.hair_mesh.bundles {
+            bundle.density = 0.5;
+        }
+        // A bald bundle first: the renderers number roots by atlas block, which skips it.
+        document.hair_mesh.bundles[0].layers = 0;
+        let per_bundle = 6u32;
+        let strands = generate(
+            &document,
+            &StrandOptions {
+                strands_per_bundle: per_bundle,
+                vertices_log2: 2,
+                ..StrandOptions::default()
+            },
+        );
+        let bundles = document.hair_mesh.bundles.len();
+        assert_eq!(
+            strands.len(),
+            (bundles - 1) * 3,
+            "each bundle but the bald one grows half its strands"
+        );
+        // Bundle b's k-th strand is root (b − 1) · 6 + k, as the GPU numbers it.
+        let expected: Vec<u32> = strands
+            .chunk_by(|a, b| a.bundle == b.bundle)
+            .flat_map(|run| {
+                (0..run.len() as u32).map(move |k| (run[0].bundle - 1) * per_bundle + k)
+            })
+            .collect();
+        assert_eq!(root_indices(&strands), expected);
+        let material = &document.scene.material;
+        let look = StrandLook::new(&strands, 1e-4, material);
+        assert_eq!(
+            look.colors,
+            crate::light::material::strand_point_colors(material, &strands, &expected)
+        );
+        // The old guess (3 per bundle, numbered by bundle) gives other colours: the test can
+        // tell them apart.
+        let guessed: Vec<u32> = expected
+            .iter()
+            .map(|&root| (root / per_bundle + 1) * 3 + root % per_bundle)
+            .collect();
+        assert_ne!(
+            look.colors,
+            crate::light::material::strand_point_colors(material, &strands, &guessed)
+        );
+        // The runtime mirror numbers its strands the same way.
+        let runtime = crate::runtime::hair::RuntimeHair::from_document(
+            &document,
+            &crate::runtime::hair::RuntimeOptions {
+                strands_per_bundle: per_bundle,
+                ..Default::default()
+            },
+        );
+        let mirrored = crate::runtime::strand_gen::runtime_strands(
+            &runtime,
+            5,
+            crate::runtime::strand_gen::Filtering::Exact,
+        );
+        let mut mirrored_roots = root_indices(&mirrored);
+        mirrored_roots.sort_unstable();
+        let mut sorted = expected.clone();
+        sorted.sort_unstable();
+        assert_eq!(mirrored_roots, sorted);
     }
 }

@@ -368,6 +368,7 @@ pub fn runtime_strands(
             let sample = samples.get(i % per_bundle).copied().unwrap_or_default();
             crate::strands::reference::Strand {
                 bundle: block.bundle,
+                root: i as u32,
                 coord: crate::geometry::curve::FaceCoord {
                     s: sample[0] as f64,
                     t: sample[1] as f64,

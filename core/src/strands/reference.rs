@@ -49,6 +49,12 @@ impl Default for StrandOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Strand {
     pub bundle: u32,
+    /// The renderers' number for its root: its bundle's atlas block × strands per bundle +
+    /// its sample's place in the bundle, what per-strand values (the shading variation) are
+    /// hashed from. Set
+    /// by whoever knows the strands per bundle (`StrandPlan`, the runtime mirror); 0 for a
+    /// strand made alone ([`StrandContext::strand`]).
+    pub root: u32,
     /// Root position on the face: bilinear `(s, t)` for quads, barycentric for triangles.
     pub coord: FaceCoord,
     pub root_uv: DVec2,
@@ -60,6 +66,9 @@ pub struct StrandContext<'a> {
     pub document: &'a Document,
     /// `frames[layer][column]`.
     frames: Vec<Vec<Option<Frame>>>,
+    /// Each bundle's place among the bundles that grow hair: its block in the runtime
+    /// atlas, which blocks sort by bundle (`runtime::atlas::build_atlas`).
+    blocks: Vec<u32>,
 }
 
 impl<'a> StrandContext<'a> {
@@ -68,7 +77,20 @@ impl<'a> StrandContext<'a> {
         let frames = (0..=mesh.max_layers())
             .map(|k| layer_frames(mesh, k))
             .collect();
-        Self { document, frames }
+        let blocks = mesh
+            .bundles
+            .iter()
+            .scan(0u32, |next, bundle| {
+                let block = *next;
+                *next += u32::from(!bundle.removed && bundle.layers > 0);
+                Some(block)
+            })
+            .collect();
+        Self {
+            document,
+            frames,
+            blocks,
+        }
     }
 
     /// Frame and w at `τ` of the strand with corner `weights` in `bundle`.
@@ -157,6 +179,7 @@ impl<'a> StrandContext<'a> {
             .collect();
         Some(Strand {
             bundle: bundle as u32,
+            root: 0,
             coord,
             root_uv: reference.root_uv,
             points,
@@ -210,49 +233,26 @@ impl StrandPlan {
         let count = crate::strands::lod::density_count(bundle.density, self.count as u32);
         samples[..count as usize]
             .iter()
-            .filter_map(|sample| {
+            .enumerate()
+            .filter_map(|(i, sample)| {
                 let coord = FaceCoord {
                     s: sample.x,
                     t: sample.y,
                 };
-                context.strand(index, coord, self.vertex_count, &self.options)
+                let mut strand = context.strand(index, coord, self.vertex_count, &self.options)?;
+                // The renderers number roots by atlas block, which skips bald bundles.
+                strand.root = context.blocks[index]
+                    .wrapping_mul(self.count as u32)
+                    .wrapping_add(i as u32);
+                Some(strand)
             })
             .collect()
     }
 }
 
-/// The root index of each of `strands` (in generation order, bundle by bundle) as the
-/// renderers number roots: bundle × `strands_per_bundle` + the strand's place in its bundle,
-/// which is what per-strand values (the shading variation) are hashed from. A strand that
-/// could not grow shifts the later ones of its bundle down by one, so the values match the
-/// GPU's exactly for every bundle that grew all of its strands.
-pub fn root_indices(strands: &[Strand], strands_per_bundle: u32) -> Vec<u32> {
-    let mut in_bundle = 0u32;
-    let mut last_bundle = None;
-    strands
-        .iter()
-        .map(|strand| {
-            if last_bundle != Some(strand.bundle) {
-                (last_bundle, in_bundle) = (Some(strand.bundle), 0);
-            }
-            let root = strand
-                .bundle
-                .wrapping_mul(strands_per_bundle)
-                .wrapping_add(in_bundle);
-            in_bundle += 1;
-            root
-        })
-        .collect()
-}
-
-/// The most strands any one bundle has in `strands` (listed bundle by bundle): the
-/// strands-per-bundle count they were generated with, unless every bundle lost some.
-pub fn strands_per_bundle_of(strands: &[Strand]) -> u32 {
-    strands
-        .chunk_by(|a, b| a.bundle == b.bundle)
-        .map(|run| run.len() as u32)
-        .max()
-        .unwrap_or(1)
+/// The renderers' root number of each of `strands` ([`Strand::root`]).
+pub fn root_indices(strands: &[Strand]) -> Vec<u32> {
+    strands.iter().map(|strand| strand.root).collect()
 }
 
 /// Every strand of the document: `strands_per_bundle` per bundle that grows hair.

@@ -484,7 +484,7 @@ pub fn reference_fibres(
         width_m,
         ..Fibres::default()
     };
-    let roots = hairloom_core::strands::reference::root_indices(&strands, strands_per_bundle);
+    let roots = hairloom_core::strands::reference::root_indices(&strands);
     for (strand, root) in strands.iter().zip(roots) {
         fibres.push(&strand.points, root);
     }
