@@ -19,6 +19,17 @@ pub struct BodyMesh {
 }
 
 impl BodyMesh {
+    /// Axis-aligned bounds `(min, max)` of its finite vertices; `None` without one.
+    pub fn bounds(&self) -> Option<(glam::Vec3, glam::Vec3)> {
+        let mut points = self
+            .positions
+            .iter()
+            .map(|p| glam::Vec3::from_array(*p))
+            .filter(|p| p.is_finite());
+        let first = points.next()?;
+        Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+
     pub fn validate(&self) -> Result<(), InvalidMesh> {
         for (i, p) in self.positions.iter().enumerate() {
             if !p.iter().all(|c| c.is_finite()) {

@@ -14,7 +14,7 @@ use hairloom_core::runtime::linear_hair_skinning::{
 use wgpu::util::DeviceExt;
 
 use crate::device::GpuContext;
-use crate::renderer::strand_gen::{GenerationTiming, scratch_buffer};
+use crate::renderer::strand_gen::{GenerationTiming, scratch_buffer, upload_runs};
 use crate::resources::Tracked;
 
 /// The WGSL source: `shaders/shared/strand_run.wgsl`, then
@@ -105,11 +105,11 @@ impl LinearHairSkinningRenderer {
         };
         let guide_points = storage(
             "lhs_guide_points",
-            bytemuck::cast_slice(&pose_points(&hair.rest)),
+            bytemuck::cast_slice(&vec4s(&hair.rest.points)),
         );
         let references = storage(
             "lhs_references",
-            bytemuck::cast_slice(&pose_references(&hair.rest)),
+            bytemuck::cast_slice(&vec4s(&hair.rest.references)),
         );
         let frames = context.resources.buffer(
             device,
@@ -149,12 +149,12 @@ impl LinearHairSkinningRenderer {
         context.queue.write_buffer(
             &gpu.guide_points,
             0,
-            bytemuck::cast_slice(&pose_points(pose)),
+            bytemuck::cast_slice(&vec4s(&pose.points)),
         );
         context.queue.write_buffer(
             &gpu.references,
             0,
-            bytemuck::cast_slice(&pose_references(pose)),
+            bytemuck::cast_slice(&vec4s(&pose.references)),
         );
         Ok(())
     }
@@ -268,7 +268,7 @@ impl LinearHairSkinningRenderer {
         plan: &FramePlan,
     ) -> Result<GenerationTiming, String> {
         let output = scratch_buffer(context, plan);
-        let runs = runs_buffer(context, plan);
+        let runs = upload_runs(context, plan);
         let timer = crate::device::PassTimer::new(context, plan.batches.len() + 1);
         let mut encoder = context
             .device
@@ -312,7 +312,7 @@ impl LinearHairSkinningRenderer {
         gpu: &GpuSkinnedHair,
         plan: &FramePlan,
     ) -> Result<Vec<[f32; 4]>, String> {
-        let runs_buffer = runs_buffer(context, plan);
+        let runs_buffer = upload_runs(context, plan);
         let mut positions = Vec::with_capacity(plan.vertices);
         let mut first_run = 0;
         let mut encoder = context
@@ -358,21 +358,6 @@ impl LinearHairSkinningRenderer {
     }
 }
 
-/// The runs of every batch of `plan`, one after another.
-fn runs_buffer(context: &GpuContext, plan: &FramePlan) -> wgpu::Buffer {
-    let mut runs: Vec<StrandRun> = plan.batches.iter().flatten().copied().collect();
-    if runs.is_empty() {
-        runs.push(StrandRun::default());
-    }
-    context
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("lhs_runs"),
-            contents: bytemuck::cast_slice(&runs),
-            usage: wgpu::BufferUsages::STORAGE,
-        })
-}
-
 fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry {
         binding,
@@ -380,26 +365,11 @@ fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     }
 }
 
-fn pose_points(pose: &GuidePose) -> Vec<[f32; 4]> {
-    let mut points: Vec<[f32; 4]> = pose
-        .points
-        .iter()
-        .map(|p| p.extend(0.0).to_array())
-        .collect();
-    if points.is_empty() {
-        points.push([0.0; 4]);
+/// `points` as `vec4<f32>`s (w = 0), at least one (a storage binding is never empty).
+fn vec4s(points: &[glam::Vec3]) -> Vec<[f32; 4]> {
+    let mut out: Vec<[f32; 4]> = points.iter().map(|p| p.extend(0.0).to_array()).collect();
+    if out.is_empty() {
+        out.push([0.0; 4]);
     }
-    points
-}
-
-fn pose_references(pose: &GuidePose) -> Vec<[f32; 4]> {
-    let mut references: Vec<[f32; 4]> = pose
-        .references
-        .iter()
-        .map(|r| r.extend(0.0).to_array())
-        .collect();
-    if references.is_empty() {
-        references.push([0.0; 4]);
-    }
-    references
+    out
 }

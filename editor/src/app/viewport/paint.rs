@@ -53,10 +53,10 @@ impl ViewportGpu {
         if let Some(change) = work.change {
             // Hair with no bundle that grows: its body is drawn alone.
             let bare = match &change {
-                AssetChange::Hair { hair, .. } if hair.textures.hair_bounds().is_none() => {
-                    body_bounds(&hair.body)
-                        .map(|bounds| (GpuBody::upload(&self.context, &hair.body), bounds))
-                }
+                AssetChange::Hair { hair, .. } if hair.textures.hair_bounds().is_none() => hair
+                    .body
+                    .bounds()
+                    .map(|bounds| (GpuBody::upload(&self.context, &hair.body), bounds)),
                 _ => None,
             };
             if let AssetChange::Hair { .. } = &change {
@@ -612,7 +612,7 @@ impl Viewport {
                 .is_some_and(|first| built.serial >= first);
             if let (AssetChange::Hair { hair, .. }, true) = (&built.change, current) {
                 self.hair_bounds = Some(hair.textures.hair_bounds());
-                self.body_bounds = body_bounds(&hair.body);
+                self.body_bounds = hair.body.bounds();
             }
             self.shared
                 .pending
@@ -643,15 +643,4 @@ impl Viewport {
     pub fn uploads(&self) -> UploadCounts {
         self.report().uploads
     }
-}
-
-/// The box around `body`'s vertices; `None` without a finite one.
-pub(super) fn body_bounds(body: &hairloom_core::model::document::BodyMesh) -> Option<(Vec3, Vec3)> {
-    let mut points = body
-        .positions
-        .iter()
-        .map(|p| Vec3::from_array(*p))
-        .filter(|p| p.is_finite());
-    let first = points.next()?;
-    Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }

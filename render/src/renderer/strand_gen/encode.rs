@@ -89,19 +89,9 @@ impl StrandGenRenderer {
         Ok(())
     }
 
-    /// Uploads the runs of every batch of `plan`, one after another.
+    /// Uploads the runs of every batch of `plan`, one after another ([`upload_runs`]).
     pub fn upload_runs(&self, context: &GpuContext, plan: &FramePlan) -> wgpu::Buffer {
-        let mut runs: Vec<StrandRun> = plan.batches.iter().flatten().copied().collect();
-        if runs.is_empty() {
-            runs.push(StrandRun::default());
-        }
-        context
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("strand_gen_runs"),
-                contents: bytemuck::cast_slice(&runs),
-                usage: wgpu::BufferUsages::STORAGE,
-            })
+        upload_runs(context, plan)
     }
 
     /// Records the generation of one batch (`runs[first_run..][..batch.len()]` of the uploaded
@@ -241,4 +231,20 @@ pub fn scratch_buffer(context: &GpuContext, plan: &FramePlan) -> Tracked<wgpu::B
             mapped_at_creation: false,
         },
     )
+}
+
+/// The runs of every batch of `plan`, one after another (one empty run where there is none:
+/// a storage binding is never empty): what generation, or skinning in its place, reads.
+pub fn upload_runs(context: &GpuContext, plan: &FramePlan) -> wgpu::Buffer {
+    let mut runs: Vec<StrandRun> = plan.batches.iter().flatten().copied().collect();
+    if runs.is_empty() {
+        runs.push(StrandRun::default());
+    }
+    context
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("strand_gen_runs"),
+            contents: bytemuck::cast_slice(&runs),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
 }
