@@ -27,8 +27,8 @@ use hairloom_core::runtime::textures::Precision;
 use hairloom_core::strands::lod::{morph_odd_vertices, strand_count, thickness_factor, vertex_lod};
 use hairloom_core::strands::random::{hash_to_unit, hash_values, pcg_hash};
 use hairloom_core::strands::styling::{
-    StylingInput, clump_pull, strand_length_fraction, strand_random, styling_offset, twist,
-    value_noise_1d,
+    StrandStyling, StylingInput, clump_pull, clump_pull_on, lock_phase, strand_cell_random,
+    strand_length_fraction, strand_random, styling_offset, twist, value_noise_1d,
 };
 
 const DOC: &str = include_str!("../../docs/runtime-format.md");
@@ -342,13 +342,45 @@ fn example_tables() -> Vec<Table> {
             vec![fixed(&[strand_random(&params, root_uv, channel)], 7)],
         );
     }
+    for channel in 9..=12 {
+        t.row(
+            &format!("cell_random({channel})"),
+            vec![fixed(&[strand_cell_random(&params, root_uv, channel)], 7)],
+        );
+    }
+    let stray_value = strand_cell_random(&params, root_uv, 9);
+    t.row(
+        "stray (cell_random(9) < stray.fraction): 1 yes, 0 no",
+        vec![u8::from(stray_value < params.stray.fraction).to_string()],
+    );
     t.row(
         "λ_len",
         vec![fixed(&[strand_length_fraction(&params, root_uv)], 7)],
     );
     let xi = |channel| strand_random(&params, root_uv, channel);
     let radius = params.curl.radius_m * (1.0 + params.curl.radius_jitter * (2.0 * xi(2) - 1.0));
-    t.row("curl radius (m)", vec![fixed(&[radius], 7)]);
+    t.row("curl radius at the root (m)", vec![fixed(&[radius], 7)]);
+    let x_clump = root_uv * params.clump.clumps_per_uv;
+    let strand_styling = StrandStyling::new(&params, root_uv);
+    t.row(
+        "lock_phase(x_c, 44), lock_phase(x_c, 45)",
+        vec![fixed(
+            &[
+                lock_phase(x_clump, params.seed, 44).to_array(),
+                lock_phase(x_clump, params.seed, 45).to_array(),
+            ]
+            .concat(),
+            7,
+        )],
+    );
+    t.row(
+        "curl e (blended phase)",
+        vec![fixed(&strand_styling.curl_phase.to_array(), 7)],
+    );
+    t.row(
+        "wave e (blended phase)",
+        vec![fixed(&strand_styling.wave_phase.to_array(), 7)],
+    );
     let (key_u, key_v, key_frizz) = (16.0 * xi(3), 16.0 * xi(4), 16.0 * xi(7));
     t.row("noise keys k_u, k_v", vec![fixed(&[key_u, key_v], 6)]);
     t.row("frizz key k_f", vec![fixed(&[key_frizz], 6)]);
@@ -356,13 +388,14 @@ fn example_tables() -> Vec<Table> {
         "frizz applies (ξ₆ < fraction): 1 yes, 0 no",
         vec![u8::from(xi(6) < params.frizz.fraction).to_string()],
     );
-    let x_clump = root_uv * params.clump.clumps_per_uv;
     t.row(
-        "clump x = root uv × clumps_per_uv",
+        "clump x_c = root uv × clumps_per_uv",
         vec![fixed(&x_clump.to_array(), 6)],
     );
     let pull = clump_pull(x_clump, params.seed);
     t.row("clump pull Δ", vec![fixed(&pull.to_array(), 7)]);
+    let sub_pull = clump_pull_on(root_uv * params.clump.sub_clumps_per_uv, params.seed, 42);
+    t.row("sub-clump pull Δ_s", vec![fixed(&sub_pull.to_array(), 7)]);
     let centre = root.centre_texel;
     t.row("centre strand texel", vec![exact(&centre)]);
     tables.push(t);
@@ -435,10 +468,17 @@ fn example_tables() -> Vec<Table> {
             along,
         };
         let op = |keep: Op| styling_offset(&only(&params, keep), &styling);
-        let [curl, noise, clump, frizz, wave] =
-            [Op::Curl, Op::Noise, Op::Clump, Op::Frizz, Op::Wave].map(op);
+        let [curl, noise, clump, frizz, wave, stray] = [
+            Op::Curl,
+            Op::Noise,
+            Op::Clump,
+            Op::Frizz,
+            Op::Wave,
+            Op::Stray,
+        ]
+        .map(op);
         let styled = mirror.styled_vertex(&input, k, n);
-        let sum = twisted + curl + noise + clump + frizz + wave;
+        let sum = twisted + curl + noise + clump + frizz + wave + stray;
         assert!(
             sum.as_vec3().distance(styled) < 1e-7,
             "k {k}: the ops add up to the mirror's vertex"
@@ -473,8 +513,11 @@ fn example_tables() -> Vec<Table> {
             t * t * (3.0 - 2.0 * t)
         };
         let tau_f64 = std::f64::consts::TAU;
-        let curl_phase = tau_f64 * params.curl.turns_per_m * w + tau_f64 * xi(1);
-        push("curl φ (rad)", index, fixed(&[curl_phase], 6));
+        let curl_psi = tau_f64
+            * params.curl.turns_per_m
+            * w
+            * (1.0 + (params.curl.rate_tip_scale - 1.0) * along * 0.5);
+        push("curl ψ (rad)", index, fixed(&[curl_psi], 6));
         push(
             "ramp(curl.ramp_in_m, w)",
             index,
@@ -495,9 +538,8 @@ fn example_tables() -> Vec<Table> {
             value_noise_1d(fw + 500.0, params.seed, 31),
         ];
         push("frizz (a, b)", index, fixed(&frizz_ab, 7));
-        let wave_phase =
-            tau_f64 * params.wave.frequency_per_m * w + params.wave.phase_spread * tau_f64 * xi(8);
-        push("wave φ (rad)", index, fixed(&[wave_phase], 6));
+        let wave_psi = tau_f64 * params.wave.frequency_per_m * w;
+        push("wave ψ (rad)", index, fixed(&[wave_psi], 6));
         push(
             "ramp(wave.ramp_in_m, w)",
             index,
@@ -509,6 +551,7 @@ fn example_tables() -> Vec<Table> {
         push("clump offset", index, m3(clump));
         push("frizz offset", index, m3(frizz));
         push("wave offset", index, m3(wave));
+        push("stray offset", index, m3(stray));
         push("styled vertex", index, m3f(styled));
     }
     // The prose under the region walks through these four cases.
@@ -627,6 +670,7 @@ enum Op {
     Clump,
     Frizz,
     Wave,
+    Stray,
 }
 
 /// `params` with every offset op but `keep` switched off.
@@ -640,6 +684,11 @@ fn only(params: &StylingParams, keep: Op) -> StylingParams {
     }
     if keep != Op::Clump {
         p.clump.strength = 0.0;
+        p.clump.sub_strength = 0.0;
+    }
+    // The stray selection stays (it decides clump and frizz); only its drift is kept or not.
+    if keep != Op::Stray {
+        p.stray.amplitude_m = 0.0;
     }
     if keep != Op::Frizz {
         p.frizz.amplitude_m = 0.0;
@@ -856,24 +905,52 @@ mod from_the_document {
         t * t * (3.0 - 2.0 * t)
     }
 
-    fn clump_pull(x: Vec2, seed: u32) -> Vec2 {
+    /// The 3×3 centres around `x` on lattice channels `k`, `k + 1`: `(cx, cy, d, K)`, dy outer.
+    fn centres(x: Vec2, seed: u32, k: u32) -> Vec<(u32, u32, Vec2, f32)> {
         let base = x.floor();
-        let (mut weighted, mut total) = (Vec2::ZERO, 0.0);
+        let mut out = Vec::with_capacity(9);
         for dy in -1..=1 {
             for dx in -1..=1 {
                 let c = base + Vec2::new(dx as f32, dy as f32);
                 let (ix, iy) = (cell(c.x), cell(c.y));
                 let centre = c + Vec2::new(
-                    unit(hash(&[seed, 40, ix, iy])),
-                    unit(hash(&[seed, 41, ix, iy])),
+                    unit(hash(&[seed, k, ix, iy])),
+                    unit(hash(&[seed, k + 1, ix, iy])),
                 );
                 let d = centre - x;
-                let k = (1.0 - d.dot(d)).max(0.0);
-                weighted += k * k * d;
-                total += k * k;
+                let weight = (1.0 - d.dot(d)).max(0.0);
+                out.push((ix, iy, d, weight * weight));
             }
         }
+        out
+    }
+
+    fn clump_pull(x: Vec2, seed: u32, k: u32) -> Vec2 {
+        let (mut weighted, mut total) = (Vec2::ZERO, 0.0);
+        for (_, _, d, weight) in centres(x, seed, k) {
+            weighted += weight * d;
+            total += weight;
+        }
         weighted / (total + 0.25)
+    }
+
+    fn lock_phase(x: Vec2, seed: u32, k: u32) -> Vec2 {
+        let (mut weighted, mut total) = (Vec2::ZERO, 0.0);
+        for (cx, cy, _, weight) in centres(x, seed, 40) {
+            let beta = TAU * unit(hash(&[seed, k, cx, cy]));
+            weighted += weight * Vec2::new(beta.cos(), beta.sin());
+            total += weight;
+        }
+        weighted / (total + 0.25)
+    }
+
+    fn blend(own: Vec2, coherence: f32, lock: impl FnOnce() -> Vec2) -> Vec2 {
+        if coherence <= 0.0 {
+            return own;
+        }
+        let c = coherence.min(1.0);
+        let e = own * (1.0 - c) + lock() * c;
+        e / e.length().max(0.5)
     }
 
     /// One bundle as the manifest gives it.
@@ -938,13 +1015,21 @@ mod from_the_document {
         let (p, centre) = (origin + st, origin + centre_st);
         let root_uv = fetch(t.uv, p.extend(0.5)).truncate().truncate();
         let seed = params.seed;
-        let xi = |channel| noise2(root_uv * params.variation_per_uv as f32, seed, channel);
+        let cells = root_uv * params.variation_per_uv as f32;
+        let xi = |channel| noise2(cells, seed, channel);
+        let cell_random = |channel| unit(hash(&[seed, channel, cell(cells.x), cell(cells.y)]));
+        let stray = params.stray.fraction > 0.0 && cell_random(9) < params.stray.fraction as f32;
         let fraction = params.length.fraction.clamp(0.0, 1.0) as f32;
-        let length = if fraction > 0.0 {
+        let mut length = if fraction > 0.0 {
             1.0 - fraction * xi(5)
         } else {
             1.0
         };
+        if stray {
+            let shortest = params.stray.length_min.clamp(0.0, 1.0) as f32;
+            length *= shortest + (1.0 - shortest) * cell_random(10);
+        }
+        let x_c = root_uv * params.clump.clumps_per_uv.max(1.0) as f32;
         let layers = bundle.layers;
         (0..n)
             .map(|k| {
@@ -975,11 +1060,22 @@ mod from_the_document {
                 let mut offset = Vec3::ZERO;
                 let curl = &params.curl;
                 if curl.radius_m != 0.0 {
-                    let phase = TAU * curl.turns_per_m as f32 * w + TAU * xi(1);
+                    let own = Vec2::new((TAU * xi(1)).cos(), (TAU * xi(1)).sin());
+                    let e = blend(own, curl.clump_coherence as f32, || {
+                        lock_phase(x_c, seed, 44)
+                    });
+                    let psi = TAU
+                        * curl.turns_per_m as f32
+                        * w
+                        * (1.0 + (curl.rate_tip_scale as f32 - 1.0) * along / 2.0);
+                    let (a, b) = (
+                        e.x * psi.cos() - e.y * psi.sin(),
+                        e.x * psi.sin() + e.y * psi.cos(),
+                    );
                     let r = curl.radius_m as f32
-                        * (1.0 + curl.radius_jitter as f32 * (2.0 * xi(2) - 1.0));
-                    offset +=
-                        ramp(curl.ramp_in_m as f32, w) * r * (phase.cos() * u + phase.sin() * v);
+                        * (1.0 + curl.radius_jitter as f32 * (2.0 * xi(2) - 1.0))
+                        * (1.0 + (curl.radius_tip_scale as f32 - 1.0) * along);
+                    offset += ramp(curl.ramp_in_m as f32, w) * r * (a * u + b * v);
                 }
                 let noise = &params.noise;
                 if noise.amplitude_m != 0.0 {
@@ -995,15 +1091,24 @@ mod from_the_document {
                     offset += noise.amplitude_m as f32 * along * (nu * u + nv * v);
                 }
                 let clump = &params.clump;
-                if clump.strength != 0.0 && clump.clumps_per_uv > 0.0 {
-                    let pull = clump_pull(root_uv * clump.clumps_per_uv as f32, seed);
-                    offset += clump.strength as f32
-                        * along.powf(clump.tightening.max(0.0) as f32)
-                        * clump.radius_m as f32
-                        * (pull.x * u + pull.y * v);
+                if (clump.strength != 0.0 || clump.sub_strength != 0.0) && !stray {
+                    let main = if clump.strength != 0.0 {
+                        clump_pull(x_c, seed, 40)
+                    } else {
+                        Vec2::ZERO
+                    };
+                    let sub = if clump.sub_strength != 0.0 {
+                        clump_pull(root_uv * clump.sub_clumps_per_uv as f32, seed, 42)
+                    } else {
+                        Vec2::ZERO
+                    };
+                    let pull = main * (clump.strength * clump.radius_m) as f32
+                        + sub * (clump.sub_strength * clump.sub_radius_m) as f32;
+                    offset +=
+                        along.powf(clump.tightening.max(0.0) as f32) * (pull.x * u + pull.y * v);
                 }
                 let frizz = &params.frizz;
-                if frizz.amplitude_m != 0.0 && xi(6) < frizz.fraction as f32 {
+                if frizz.amplitude_m != 0.0 && (stray || xi(6) < frizz.fraction as f32) {
                     let key = 16.0 * xi(7);
                     let f = frizz.frequency_per_m as f32 * w + key;
                     let a = noise1(f, seed, 30);
@@ -1012,12 +1117,28 @@ mod from_the_document {
                 }
                 let wave = &params.wave;
                 if wave.amplitude_m != 0.0 {
-                    let phase = TAU * wave.frequency_per_m as f32 * w
-                        + wave.phase_spread as f32 * TAU * xi(8);
+                    let phi = wave.phase_spread as f32 * TAU * xi(8);
+                    let e = blend(
+                        Vec2::new(phi.cos(), phi.sin()),
+                        wave.clump_coherence as f32,
+                        || lock_phase(x_c, seed, 45),
+                    );
+                    let psi = TAU * wave.frequency_per_m as f32 * w;
+                    let s = e.x * psi.sin() + e.y * psi.cos();
                     let alpha = wave.direction_rad as f32;
                     let d = alpha.cos() * u + alpha.sin() * v;
-                    offset +=
-                        ramp(wave.ramp_in_m as f32, w) * wave.amplitude_m as f32 * phase.sin() * d;
+                    offset += ramp(wave.ramp_in_m as f32, w) * wave.amplitude_m as f32 * s * d;
+                }
+                let drift = &params.stray;
+                if drift.amplitude_m != 0.0 && stray {
+                    let alpha = TAU * cell_random(11);
+                    let key = 16.0 * cell_random(12);
+                    let f = drift.frequency_per_m as f32 * w + key;
+                    let (a, b) = (noise1(f, seed, 50), noise1(f + 500.0, seed, 51));
+                    offset += drift.amplitude_m as f32
+                        * along
+                        * along
+                        * ((alpha.cos() + a / 2.0) * u + (alpha.sin() + b / 2.0) * v);
                 }
                 x + offset
             })
@@ -1066,6 +1187,16 @@ fn an_implementation_of_the_document_matches_the_cpu_mirror() {
     }
     eprintln!("from the document vs the CPU mirror: {worst:.3e} m (size {size:.3} m)");
     assert!(worst <= 1e-5 * size, "{worst} m");
+    // The strands compared include strays and clumped strands both.
+    let strays: Vec<bool> = hair
+        .strand_roots()
+        .iter()
+        .map(|root| mirror.strand_input(root, &params).styling.stray)
+        .collect();
+    assert!(
+        strays.contains(&true) && strays.contains(&false),
+        "{strays:?}"
+    );
     // The document's hash check values.
     assert_eq!(from_the_document::pcg(0), pcg_hash(0));
     assert_eq!(

@@ -628,3 +628,29 @@ fn strand_exports_at_the_documented_maxima_are_refused_with_their_size() {
         .collect();
     assert!(written.is_empty(), "written: {written:?}");
 }
+
+/// Curls need vertices: the curly sample (45 turns/m, 1.2× at the tip, ~9.5 cm of w) is
+/// drawn with 65 vertices per strand by default; plain straight hair keeps 17. Seventeen
+/// vertices drew its ringlets as straw-like zigzags.
+#[test]
+fn renders_give_curly_styles_the_vertices_their_turns_need() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/samples");
+    let log2 = |name: &str| {
+        let project = hairloom_core::io::project::load(&dir.join(format!("{name}.hairloom")))
+            .expect("sample loads");
+        let document = project.document;
+        let runtime = hairloom_core::runtime::hair::RuntimeHair::from_document(
+            &document,
+            &hairloom_core::runtime::hair::RuntimeOptions::default(),
+        );
+        assert_eq!(
+            runtime.strand_vertices_log2(),
+            document.strand_vertices_log2(),
+            "{name}: the runtime reads the w the document has"
+        );
+        document.strand_vertices_log2()
+    };
+    assert_eq!(log2("head_curly"), 6);
+    assert_eq!(log2("head_long_straight"), 4);
+    assert!(log2("head_long_wavy") >= 5, "7 cycles/m over 30 cm");
+}

@@ -346,7 +346,7 @@ fn file_menu_path(harness: &mut Harness<'static, HairloomApp>, items: &[&str]) {
 fn make_unsaved_change(harness: &mut Harness<'static, HairloomApp>) {
     harness
         .get_by_role_and_label(Role::Slider, "Wave amplitude")
-        .set_value_accesskit(0.013);
+        .set_value_accesskit(0.017);
     harness.run();
     assert!(harness.state().state.is_dirty());
 }
@@ -1131,7 +1131,7 @@ fn quit_then_save_through_the_path_prompt_saves_and_quits() {
 #[test]
 fn every_press_counts_alt_a_deselects_and_tab_toggles_the_mode() {
     let mut harness = harness();
-    for (i, amplitude) in [0.011, 0.012, 0.013].into_iter().enumerate() {
+    for (i, amplitude) in [0.015, 0.016, 0.017].into_iter().enumerate() {
         harness
             .get_by_role_and_label(Role::Slider, "Wave amplitude")
             .set_value_accesskit(amplitude);

@@ -47,7 +47,7 @@ pub enum HairAssetError {
 /// The CPU side of a change, ready for the GPU.
 pub enum AssetChange {
     /// New styling for the asset on the GPU.
-    Restyle(StylingSet),
+    Restyle(Box<StylingSet>),
     /// The runtime data made again: taken in place when only positions moved
     /// ([`ChangeKind::Reshape`]), uploaded afresh otherwise.
     Hair {
@@ -63,7 +63,7 @@ impl AssetChange {
     pub fn build(document: &Document, kind: ChangeKind, options: &RuntimeOptions) -> Option<Self> {
         match kind {
             ChangeKind::Scene => None,
-            ChangeKind::Restyle => Some(AssetChange::Restyle(document.styling.clone())),
+            ChangeKind::Restyle => Some(AssetChange::Restyle(Box::new(document.styling.clone()))),
             ChangeKind::Reshape | ChangeKind::Rebuild => Some(AssetChange::Hair {
                 hair: Box::new(RuntimeHair::from_document(document, options)),
                 kind,

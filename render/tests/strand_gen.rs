@@ -32,17 +32,14 @@ fn gpu_strands_match_the_cpu_mirror() {
     for name in ["head_curly", "head_long_wavy", "teapot_fur"] {
         let mut document = common::sample(name);
         // The sample's own ops plus twist (the one that reads the centre strand), and a group
-        // with other parameters on a few bundles (the per-root styling index).
+        // with every op on a few bundles (the per-root styling index): ringlet and lock-wave
+        // phases, sub-clumps and strays.
         document.styling.global.twist = Twist { turns_per_m: 4.0 };
         let mut group = StylingParams {
             seed: 9,
-            ..document.styling.global.clone()
+            ..StylingParams::every_op()
         };
-        group.curl.radius_m = 0.006;
-        group.noise.amplitude_m = 0.002;
-        group.clump.strength = 0.5;
-        group.frizz.amplitude_m = 0.001;
-        group.wave.amplitude_m = 0.004;
+        group.stray.fraction = 0.4;
         group.length.fraction = 0.4;
         document.styling.groups.push(StylingGroup {
             name: "group".into(),
@@ -67,6 +64,20 @@ fn gpu_strands_match_the_cpu_mirror() {
             let textures = &runtime.textures;
             let roots = runtime.strand_roots();
             assert!(roots.iter().any(|r| r.styling == 1) && roots.iter().any(|r| r.styling == 0));
+            // Strays and clumped strands both among the group's.
+            let generator = StrandGen {
+                textures,
+                filtering: Filtering::Exact,
+            };
+            let strays = roots
+                .iter()
+                .filter(|r| r.styling == 1)
+                .map(|r| generator.strand_input(r, params[1]).styling.stray)
+                .collect::<Vec<_>>();
+            assert!(
+                strays.contains(&true) && strays.contains(&false),
+                "{name}: {strays:?}"
+            );
             let hair = renderer.upload(&context, &runtime).expect("upload");
             assert_eq!(hair.root_count, roots.len());
             let vertex_count = 17u32;

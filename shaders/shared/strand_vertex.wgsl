@@ -63,7 +63,19 @@ struct Styling {
     wave_ramp_in_m: f32,
     variation_per_uv: f32,
     seed: u32,
-    _padding: u32,
+    curl_clump_coherence: f32,
+    curl_radius_tip_scale: f32,
+    curl_rate_tip_scale: f32,
+    clump_sub_strength: f32,
+    clump_sub_clumps_per_uv: f32,
+    clump_sub_radius_m: f32,
+    wave_clump_coherence: f32,
+    stray_fraction: f32,
+    stray_amplitude_m: f32,
+    stray_frequency_per_m: f32,
+    stray_length_min: f32,
+    _padding0: u32,
+    _padding1: u32,
 }
 
 // Mirror: SLICES_PER_SEGMENT in core/src/runtime/textures.rs (p_k, q0, q1 per segment).
@@ -73,6 +85,9 @@ const FILTERING_EXACT: u32 = 0u;
 const TURN_RAD: f32 = 6.283185307179586;
 // Mirror: NOISE_KEY_SPAN in core/src/strands/styling.rs.
 const NOISE_KEY_SPAN: f32 = 16.0;
+// Mirror: CLUMP_CHANNEL and SUB_CLUMP_CHANNEL in core/src/strands/styling.rs.
+const CLUMP_CHANNEL: u32 = 40u;
+const SUB_CLUMP_CHANNEL: u32 = 42u;
 
 // Trilinear filtering in f32 with textureLoad: the "exact" switch (mirror: sample_trilinear
 // with Filtering::Exact). Texel centres sit at i + 0.5; clamp to the edge.
@@ -200,21 +215,35 @@ fn ramp(edge: f32, x: f32) -> f32 {
     return t * t * (3.0 - 2.0 * t);
 }
 
-fn clump_pull(x: vec2<f32>, seed: u32) -> vec2<f32> {
+// Mirror: styling::strand_cell_random (uniform, constant over a random-value cell).
+fn strand_cell_random(s: Styling, root_uv: vec2<f32>, channel: u32) -> f32 {
+    let p = root_uv * s.variation_per_uv;
+    return hash_to_unit(hash4(s.seed, channel, cell_index(floor(p.x)), cell_index(floor(p.y))));
+}
+
+fn unit_phase(angle_rad: f32) -> vec2<f32> {
+    return vec2<f32>(cos(angle_rad), sin(angle_rad));
+}
+
+// The jittered centre of lattice cell c (mirror: styling::for_each_centre).
+fn clump_centre(c: vec2<f32>, seed: u32, channel: u32) -> vec2<f32> {
+    let ix = cell_index(c.x);
+    let iy = cell_index(c.y);
+    return c + vec2<f32>(
+        hash_to_unit(hash4(seed, channel, ix, iy)),
+        hash_to_unit(hash4(seed, channel + 1u, ix, iy)),
+    );
+}
+
+// Mirror: styling::clump_pull_on.
+fn clump_pull(x: vec2<f32>, seed: u32, channel: u32) -> vec2<f32> {
     let cell = floor(x);
     var weighted = vec2<f32>(0.0);
     var total = 0.0;
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let c = cell + vec2<f32>(f32(dx), f32(dy));
-            let ix = cell_index(c.x);
-            let iy = cell_index(c.y);
-            let jitter = vec2<f32>(
-                hash_to_unit(hash4(seed, 40u, ix, iy)),
-                hash_to_unit(hash4(seed, 41u, ix, iy)),
-            );
-            let centre = c + jitter;
-            let d = centre - x;
+            let d = clump_centre(c, seed, channel) - x;
             let k = max(1.0 - dot(d, d), 0.0);
             weighted += k * k * d;
             total += k * k;
@@ -223,24 +252,69 @@ fn clump_pull(x: vec2<f32>, seed: u32) -> vec2<f32> {
     return weighted / (total + 0.25);
 }
 
+// Mirror: styling::lock_phase (the main clump lattice's centres).
+fn lock_phase(x: vec2<f32>, seed: u32, channel: u32) -> vec2<f32> {
+    let cell = floor(x);
+    var weighted = vec2<f32>(0.0);
+    var total = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let c = cell + vec2<f32>(f32(dx), f32(dy));
+            let d = clump_centre(c, seed, CLUMP_CHANNEL) - x;
+            let k = max(1.0 - dot(d, d), 0.0);
+            let angle = hash_to_unit(hash4(seed, channel, cell_index(c.x), cell_index(c.y)));
+            weighted += k * k * unit_phase(TURN_RAD * angle);
+            total += k * k;
+        }
+    }
+    return weighted / (total + 0.25);
+}
+
+// Mirror: styling::blend_phase.
+fn blend_phase(own: vec2<f32>, coherence: f32, lock: vec2<f32>) -> vec2<f32> {
+    let c = min(coherence, 1.0);
+    let e = own * (1.0 - c) + lock * c;
+    return e / max(length(e), 0.5);
+}
+
+// e · exp(i angle) (mirror: styling::rotate).
+fn rotate_phase(e: vec2<f32>, angle_rad: f32) -> vec2<f32> {
+    let c = cos(angle_rad);
+    let s = sin(angle_rad);
+    return vec2<f32>(e.x * c - e.y * s, e.x * s + e.y * c);
+}
+
 // What the styling ops need of a strand that does not change along it (mirror:
-// styling::StrandStyling): random phases, keys and the clump pull, seeded by the root uv.
+// styling::StrandStyling): random phases, keys and the clump pulls, seeded by the root uv.
 struct StrandConstants {
-    curl_phase_rad: f32,
+    curl_phase: vec2<f32>,
     curl_radius_m: f32,
     noise_key_u: f32,
     noise_key_v: f32,
     clump_pull: vec2<f32>,
+    sub_clump_pull: vec2<f32>,
     frizz: bool,
     frizz_key: f32,
-    wave_phase_rad: f32,
+    wave_phase: vec2<f32>,
+    stray: bool,
+    stray_direction: vec2<f32>,
+    stray_key: f32,
 }
 
 // Mirror: StrandStyling::new.
 fn strand_constants(s: Styling, root_uv: vec2<f32>) -> StrandConstants {
     var c: StrandConstants;
+    let lock_uv = root_uv * max(s.clump_clumps_per_uv, 1.0);
+    c.stray = s.stray_fraction > 0.0 && strand_cell_random(s, root_uv, 9u) < s.stray_fraction;
     if s.curl_radius_m != 0.0 {
-        c.curl_phase_rad = TURN_RAD * strand_random(s, root_uv, 1u);
+        c.curl_phase = unit_phase(TURN_RAD * strand_random(s, root_uv, 1u));
+        if s.curl_clump_coherence > 0.0 {
+            c.curl_phase = blend_phase(
+                c.curl_phase,
+                s.curl_clump_coherence,
+                lock_phase(lock_uv, s.seed, 44u),
+            );
+        }
         c.curl_radius_m = s.curl_radius_m
             * (1.0 + s.curl_radius_jitter * (2.0 * strand_random(s, root_uv, 2u) - 1.0));
     }
@@ -248,17 +322,46 @@ fn strand_constants(s: Styling, root_uv: vec2<f32>) -> StrandConstants {
         c.noise_key_u = NOISE_KEY_SPAN * strand_random(s, root_uv, 3u);
         c.noise_key_v = NOISE_KEY_SPAN * strand_random(s, root_uv, 4u);
     }
-    if s.clump_strength != 0.0 && s.clump_clumps_per_uv > 0.0 {
-        c.clump_pull = clump_pull(root_uv * s.clump_clumps_per_uv, s.seed);
+    if !c.stray && s.clump_strength != 0.0 && s.clump_clumps_per_uv > 0.0 {
+        c.clump_pull = clump_pull(lock_uv, s.seed, CLUMP_CHANNEL);
     }
-    if s.frizz_amplitude_m != 0.0 && strand_random(s, root_uv, 6u) < s.frizz_fraction {
+    if !c.stray && s.clump_sub_strength != 0.0 && s.clump_sub_clumps_per_uv > 0.0 {
+        c.sub_clump_pull =
+            clump_pull(root_uv * s.clump_sub_clumps_per_uv, s.seed, SUB_CLUMP_CHANNEL);
+    }
+    if s.frizz_amplitude_m != 0.0
+        && (c.stray || strand_random(s, root_uv, 6u) < s.frizz_fraction) {
         c.frizz = true;
         c.frizz_key = NOISE_KEY_SPAN * strand_random(s, root_uv, 7u);
     }
     if s.wave_amplitude_m != 0.0 {
-        c.wave_phase_rad = s.wave_phase_spread * TURN_RAD * strand_random(s, root_uv, 8u);
+        c.wave_phase = unit_phase(s.wave_phase_spread * TURN_RAD * strand_random(s, root_uv, 8u));
+        if s.wave_clump_coherence > 0.0 {
+            c.wave_phase = blend_phase(
+                c.wave_phase,
+                s.wave_clump_coherence,
+                lock_phase(lock_uv, s.seed, 45u),
+            );
+        }
+    }
+    if c.stray && s.stray_amplitude_m != 0.0 {
+        c.stray_direction = unit_phase(TURN_RAD * strand_cell_random(s, root_uv, 11u));
+        c.stray_key = NOISE_KEY_SPAN * strand_cell_random(s, root_uv, 12u);
     }
     return c;
+}
+
+// Mirror: styling::strand_length_fraction.
+fn strand_length_fraction(s: Styling, root_uv: vec2<f32>) -> f32 {
+    var fraction = 1.0;
+    if s.length_fraction > 0.0 {
+        fraction -= s.length_fraction * strand_random(s, root_uv, 5u);
+    }
+    if s.stray_fraction > 0.0 && strand_cell_random(s, root_uv, 9u) < s.stray_fraction {
+        fraction *= s.stray_length_min
+            + (1.0 - s.stray_length_min) * strand_cell_random(s, root_uv, 10u);
+    }
+    return fraction;
 }
 
 // Mirror: styling::styling_offset_of (without twist).
@@ -275,8 +378,10 @@ fn styling_offset(
     }
     var offset = vec3<f32>(0.0);
     if s.curl_radius_m != 0.0 {
-        let phase = TURN_RAD * s.curl_turns_per_m * w + c.curl_phase_rad;
-        offset += ramp(s.curl_ramp_in_m, w) * c.curl_radius_m * (cos(phase) * u + sin(phase) * v);
+        let rate = 1.0 + (s.curl_rate_tip_scale - 1.0) * along * 0.5;
+        let turned = rotate_phase(c.curl_phase, TURN_RAD * s.curl_turns_per_m * w * rate);
+        let radius = c.curl_radius_m * (1.0 + (s.curl_radius_tip_scale - 1.0) * along);
+        offset += ramp(s.curl_ramp_in_m, w) * radius * (turned.x * u + turned.y * v);
     }
     if s.noise_amplitude_m != 0.0 {
         var nu = 0.0;
@@ -291,9 +396,11 @@ fn styling_offset(
         }
         offset += s.noise_amplitude_m * along * (nu * u + nv * v);
     }
-    if s.clump_strength != 0.0 && s.clump_clumps_per_uv > 0.0 {
-        let scale = s.clump_strength * pow(along, s.clump_tightening) * s.clump_radius_m;
-        offset += scale * (c.clump_pull.x * u + c.clump_pull.y * v);
+    if (s.clump_strength != 0.0 || s.clump_sub_strength != 0.0) && !c.stray {
+        let profile = pow(along, s.clump_tightening);
+        let pull = c.clump_pull * (s.clump_strength * s.clump_radius_m)
+            + c.sub_clump_pull * (s.clump_sub_strength * s.clump_sub_radius_m);
+        offset += profile * (pull.x * u + pull.y * v);
     }
     if s.frizz_amplitude_m != 0.0 && c.frizz {
         let a = value_noise_1d(s.frizz_frequency_per_m * w + c.frizz_key, s.seed, 30u);
@@ -301,9 +408,15 @@ fn styling_offset(
         offset += s.frizz_amplitude_m * along * along * (a * u + b * v);
     }
     if s.wave_amplitude_m != 0.0 {
-        let phase = TURN_RAD * s.wave_frequency_per_m * w + c.wave_phase_rad;
+        let turned = rotate_phase(c.wave_phase, TURN_RAD * s.wave_frequency_per_m * w);
         let direction = cos(s.wave_direction_rad) * u + sin(s.wave_direction_rad) * v;
-        offset += ramp(s.wave_ramp_in_m, w) * s.wave_amplitude_m * sin(phase) * direction;
+        offset += ramp(s.wave_ramp_in_m, w) * s.wave_amplitude_m * turned.y * direction;
+    }
+    if s.stray_amplitude_m != 0.0 && c.stray {
+        let a = value_noise_1d(s.stray_frequency_per_m * w + c.stray_key, s.seed, 50u);
+        let b = value_noise_1d(s.stray_frequency_per_m * w + c.stray_key + 500.0, s.seed, 51u);
+        let drift = c.stray_direction + 0.5 * vec2<f32>(a, b);
+        offset += s.stray_amplitude_m * along * along * (drift.x * u + drift.y * v);
     }
     return offset;
 }
@@ -388,11 +501,7 @@ fn strand_input(root_index: u32) -> StrandInput {
     input.style = styling[style_index];
     // Root uv: always exact (it seeds every per-strand random value).
     input.root_uv = fetch_exact(uv_texture, vec3<f32>(root.texel, 0.5)).xy;
-    input.length_fraction = 1.0;
-    if input.style.length_fraction > 0.0 {
-        input.length_fraction = 1.0
-            - input.style.length_fraction * strand_random(input.style, input.root_uv, 5u);
-    }
+    input.length_fraction = strand_length_fraction(input.style, input.root_uv);
     input.constants = strand_constants(input.style, input.root_uv);
     return input;
 }

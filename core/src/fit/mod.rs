@@ -236,6 +236,9 @@ pub fn fit(
         None,
     );
     drop(probe);
+    // Locks that coil together (ringlets) leave the mesh's residual nearly curl-free: look
+    // for the curl in each strand against its own axis instead.
+    let first_curl = first_curl.or_else(|| styling::curl_from_own_axes(groom, min_curl_radius));
     let fitted_mesh = match first_curl {
         Some((turns_per_m, radius_m)) => {
             mesh_of(&styling::strand_axes(groom, turns_per_m, radius_m))?

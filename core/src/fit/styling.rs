@@ -167,7 +167,7 @@ fn residual(
 /// component is strongest over the strands (its radius is [`curl_radius`]'s). The residual's mean is
 /// removed per strand first (a bundle-scale offset is not a curl). `None` when no rotating
 /// component stands out of the rest of the spectrum.
-fn fit_curl(residuals: &[Residual], near: Option<f64>) -> Option<f64> {
+fn fit_curl(residuals: &[Residual], near: Option<f64>, mirror_ratio: f64) -> Option<f64> {
     let ratio =
         (CURL_MAX_TURNS_PER_M / CURL_MIN_TURNS_PER_M).powf(1.0 / (CURL_FREQUENCIES - 1) as f64);
     let frequencies: Vec<f64> = (0..CURL_FREQUENCIES)
@@ -214,8 +214,9 @@ fn fit_curl(residuals: &[Residual], near: Option<f64>) -> Option<f64> {
     let mirror = power[best ^ 1];
     // A curl turns one way: its peak stands well above the spectrum and above its mirror
     // frequency (a planar wave has both).
-    // Power ratios: the peak's amplitude at least 3× the median's and 2× its mirror's.
-    if peak <= 0.0 || peak < 9.0 * median || peak < 4.0 * mirror {
+    // Power ratios: the peak's amplitude at least 3× the median's, and its power
+    // `mirror_ratio` × its mirror's.
+    if peak <= 0.0 || peak < 9.0 * median || peak < mirror_ratio * mirror {
         return None;
     }
     Some(frequencies[best])
@@ -294,7 +295,8 @@ pub fn fit_curl_styling(
             )
         })
         .collect();
-    let turns_per_m = fit_curl(&residuals, near)?;
+    // In the styling frame a helix is a circle: its mirror is weak (power 4× below).
+    let turns_per_m = fit_curl(&residuals, near, 4.0)?;
     let radius = curl_radius(&residuals, turns_per_m, near.is_some())?;
     // A "curl" wider than a styling parameter may be (a groom in centimetres or
     // millimetres: the fit works in file units) is left out rather than failing the fit.
@@ -309,6 +311,73 @@ pub fn fit_curl_styling(
     curl.turns_per_m = turns_per_m;
     curl.radius_m = radius;
     Some((turns_per_m, radius))
+}
+
+/// Curl found from the strands alone, with no hair mesh: each strand's residual from its own
+/// axis (three moving means a third of its length long), in a frame parallel-transported
+/// along that axis (û ⟂ the axis, v̂ = axis × û: the styling frame's handedness), scanned as
+/// [`fit_curl`] scans the mesh's residuals. For locks that coil together (ringlets: the
+/// strands of a clump share their helix), the hair mesh fitted to the strands coils with them
+/// and the residual from it keeps little of the curl, so the mesh's first pass finds none.
+/// Returns the rate and the rough radius (about the one-turn mean) that size
+/// [`strand_axes`]' smoothing; `None` when no curl stands out or it is under `min_radius`.
+pub fn curl_from_own_axes(groom: &InputGroom, min_radius: f64) -> Option<(f64, f64)> {
+    const SAMPLES: usize = 128;
+    let stride = groom.curve_count().div_ceil(CURL_STRANDS).max(1);
+    let residuals: Vec<Residual> = (0..groom.curve_count())
+        .step_by(stride)
+        .filter_map(|i| {
+            let points = groom.curve(i);
+            let length = super::columns::arc_length(points);
+            if length.is_nan() || length <= 0.0 {
+                return None;
+            }
+            let samples: Vec<DVec3> = super::columns::sample_at_arc_length(points, length, SAMPLES)
+                .into_iter()
+                .map_while(|p| p)
+                .collect();
+            if samples.len() < 16 {
+                return None;
+            }
+            let mut axis = samples.clone();
+            for _ in 0..3 {
+                axis = moving_mean(&axis, samples.len() / 6);
+            }
+            let mut w = Vec::with_capacity(samples.len());
+            let mut z = Vec::with_capacity(samples.len());
+            let mut along = 0.0;
+            let mut u: Option<DVec3> = None;
+            for j in 0..samples.len() {
+                let tangent = if j + 1 < axis.len() {
+                    axis[j + 1] - axis[j]
+                } else {
+                    axis[j] - axis[j - 1]
+                };
+                let t = tangent.try_normalize()?;
+                if j > 0 {
+                    along += (axis[j] - axis[j - 1]).length();
+                }
+                // Parallel transport: the previous û with its component along t removed.
+                let next = match u {
+                    Some(previous) => previous - t * previous.dot(t),
+                    None => t.any_orthogonal_vector(),
+                };
+                let unit_u = next.try_normalize()?;
+                u = Some(unit_u);
+                let unit_v = t.cross(unit_u);
+                let d = samples[j] - axis[j];
+                w.push(along);
+                z.push(DVec2::new(d.dot(unit_u), d.dot(unit_v)));
+            }
+            Some(Residual { w, z })
+        })
+        .collect();
+    // The styling directions û, v̂ are not orthonormal, so in this orthonormal frame a
+    // helix is an ellipse and its mirror frequency carries power too (0.58 × the peak's on
+    // the curly sample's ringlets); a planar wave still has both alike.
+    let turns_per_m = fit_curl(&residuals, None, 1.5)?;
+    let radius = curl_radius(&residuals, turns_per_m, false)?;
+    (radius >= min_radius).then_some((turns_per_m, radius))
 }
 
 /// Each strand with its curl averaged away: its axis. Three passes of a moving mean one turn

@@ -144,6 +144,18 @@ pub struct InvalidDocument {
 }
 
 impl Document {
+    /// Vertices per strand (2^N + 1, as N) that draw this project's styling as curves
+    /// ([`crate::strands::styling::strand_vertices_log2`] over its longest column's w).
+    pub fn strand_vertices_log2(&self) -> u32 {
+        let longest_w = self
+            .hair_mesh
+            .columns
+            .iter()
+            .filter_map(|c| c.w.last().copied())
+            .fold(0.0, f64::max);
+        crate::strands::styling::strand_vertices_log2(&self.styling, longest_w)
+    }
+
     pub fn new(name: impl Into<String>, hair_mesh: HairMesh) -> Self {
         Self {
             name: name.into(),

@@ -5,8 +5,12 @@
 use serde::{Deserialize, Serialize};
 
 /// Curl: a helix around the strand. Offset
-/// `ramp(w) · r · (cos φ û + sin φ v̂)`, `φ = 2π · turns_per_m · w + 2π · ξ₁`,
-/// `r = radius_m · (1 + radius_jitter · (2ξ₂ − 1))`, `ramp(w) = smoothstep(0, ramp_in_m, w)`.
+/// `ramp(w) · r(τ̂) · rotate(e, ψ)` in (û, v̂): `e` is the strand's phase as a unit vector
+/// `(cos 2πξ₁, sin 2πξ₁)`, blended toward its lock's phase by `clump_coherence` (ringlets:
+/// the strands of a clump coil together), `ψ = 2π · turns_per_m · w · (1 + (rate_tip_scale
+/// − 1) τ̂ / 2)` (the rate moves linearly from root to tip), `r(τ̂) = radius_m · (1 +
+/// radius_jitter · (2ξ₂ − 1)) · (1 + (radius_tip_scale − 1) τ̂)`,
+/// `ramp(w) = smoothstep(0, ramp_in_m, w)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Curl {
@@ -17,6 +21,13 @@ pub struct Curl {
     pub ramp_in_m: f64,
     /// Relative spread of radii between strands, in `[0, 1]`.
     pub radius_jitter: f64,
+    /// 0: every strand its own phase (a frizzy mass of helices); 1: the strands of a clump
+    /// share their lock's helix (ringlets).
+    pub clump_coherence: f64,
+    /// The radius at the tip as a multiple of the radius at the root.
+    pub radius_tip_scale: f64,
+    /// The turns per metre at the tip as a multiple of those at the root.
+    pub rate_tip_scale: f64,
 }
 
 impl Default for Curl {
@@ -26,6 +37,9 @@ impl Default for Curl {
             turns_per_m: 20.0,
             ramp_in_m: 0.02,
             radius_jitter: 0.3,
+            clump_coherence: 0.0,
+            radius_tip_scale: 1.0,
+            rate_tip_scale: 1.0,
         }
     }
 }
@@ -64,6 +78,10 @@ impl Default for Noise {
 /// centres, continuous everywhere:
 /// `Δ = Σ K_i (c_i − x) / (Σ K_i + ¼)`, `K_i = max(0, 1 − |c_i − x|² / h²)²`, `h` one cell;
 /// offset `strength · τ̂^tightening · radius_m · (Δ.x û + Δ.y v̂)`.
+///
+/// A second level of sub-clumps (locks within the lock) gathers strands the same way on its
+/// own, finer lattice (`sub_clumps_per_uv`, centres hashed on their own channels) with its
+/// own strength and reach, and the same profile along the strand.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Clump {
@@ -74,6 +92,11 @@ pub struct Clump {
     pub radius_m: f64,
     /// Profile exponent along the strand: larger keeps roots spread and tightens only tips.
     pub tightening: f64,
+    /// Sub-clumps: 0 (none) to 1.
+    pub sub_strength: f64,
+    pub sub_clumps_per_uv: f64,
+    /// Object-space size of one sub-clump cell.
+    pub sub_radius_m: f64,
 }
 
 impl Default for Clump {
@@ -83,6 +106,9 @@ impl Default for Clump {
             clumps_per_uv: 40.0,
             radius_m: 0.01,
             tightening: 1.5,
+            sub_strength: 0.0,
+            sub_clumps_per_uv: 160.0,
+            sub_radius_m: 0.003,
         }
     }
 }
@@ -108,8 +134,10 @@ impl Default for Frizz {
 }
 
 /// Wave: a planar wave across the strand. Offset
-/// `ramp(w) · amplitude_m · sin(2π · frequency_per_m · w + phase_spread · 2π ξ₈) · d`, with
-/// `d = cos α û + sin α v̂` (`α` = `direction_rad`).
+/// `ramp(w) · amplitude_m · Im(e · exp(i 2π · frequency_per_m · w)) · d`, with
+/// `d = cos α û + sin α v̂` (`α` = `direction_rad`) and the phase `e` the unit vector of
+/// angle `phase_spread · 2π ξ₈`, blended toward its lock's phase by `clump_coherence` (the
+/// strands of a lock wave together, locks apart: waves that read from the front).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Wave {
@@ -119,6 +147,8 @@ pub struct Wave {
     /// 0: neighbouring strands wave together; 1: fully random phases.
     pub phase_spread: f64,
     pub ramp_in_m: f64,
+    /// 0: the phase above; 1: every strand of a lock takes its lock's phase.
+    pub clump_coherence: f64,
 }
 
 impl Default for Wave {
@@ -129,6 +159,35 @@ impl Default for Wave {
             direction_rad: 0.0,
             phase_spread: 0.15,
             ramp_in_m: 0.03,
+            clump_coherence: 0.0,
+        }
+    }
+}
+
+/// Strays and flyaways: the strands of a `fraction` of the random-value cells leave their
+/// clump (no clump or sub-clump pull), always frizz (with the frizz parameters), drift off
+/// the mass by `amplitude_m · τ̂² · (cos α + n_a / 2, sin α + n_b / 2)` in (û, v̂) — a
+/// direction `α` of their own wandering with slow noise `n` of `frequency_per_m` — and keep
+/// `length_min … 1` of their length. A stray cell's strands share direction, noise and
+/// length: they leave as one small wisp.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Stray {
+    /// Share of strands that stray, 0 (off) to 1.
+    pub fraction: f64,
+    pub amplitude_m: f64,
+    pub frequency_per_m: f64,
+    /// The shortest a stray gets, as a share of the length it would have.
+    pub length_min: f64,
+}
+
+impl Default for Stray {
+    fn default() -> Self {
+        Self {
+            fraction: 0.0,
+            amplitude_m: 0.01,
+            frequency_per_m: 6.0,
+            length_min: 0.4,
         }
     }
 }
@@ -151,6 +210,7 @@ pub struct StylingParams {
     pub frizz: Frizz,
     pub wave: Wave,
     pub length: LengthVariation,
+    pub stray: Stray,
     /// Cells per uv unit of the per-strand random fields ξ.
     pub variation_per_uv: f64,
     pub seed: u32,
@@ -166,6 +226,7 @@ impl Default for StylingParams {
             frizz: Frizz::default(),
             wave: Wave::default(),
             length: LengthVariation::default(),
+            stray: Stray::default(),
             variation_per_uv: 200.0,
             seed: 1,
         }
@@ -251,6 +312,9 @@ impl StylingSet {
                 ("curl.turns_per_m", p.curl.turns_per_m),
                 ("curl.ramp_in_m", p.curl.ramp_in_m),
                 ("curl.radius_jitter", p.curl.radius_jitter),
+                ("curl.clump_coherence", p.curl.clump_coherence),
+                ("curl.radius_tip_scale", p.curl.radius_tip_scale),
+                ("curl.rate_tip_scale", p.curl.rate_tip_scale),
                 ("twist.turns_per_m", p.twist.turns_per_m),
                 ("noise.amplitude_m", p.noise.amplitude_m),
                 ("noise.frequency_per_m", p.noise.frequency_per_m),
@@ -258,6 +322,9 @@ impl StylingSet {
                 ("clump.clumps_per_uv", p.clump.clumps_per_uv),
                 ("clump.radius_m", p.clump.radius_m),
                 ("clump.tightening", p.clump.tightening),
+                ("clump.sub_strength", p.clump.sub_strength),
+                ("clump.sub_clumps_per_uv", p.clump.sub_clumps_per_uv),
+                ("clump.sub_radius_m", p.clump.sub_radius_m),
                 ("frizz.amplitude_m", p.frizz.amplitude_m),
                 ("frizz.frequency_per_m", p.frizz.frequency_per_m),
                 ("frizz.fraction", p.frizz.fraction),
@@ -266,7 +333,12 @@ impl StylingSet {
                 ("wave.direction_rad", p.wave.direction_rad),
                 ("wave.phase_spread", p.wave.phase_spread),
                 ("wave.ramp_in_m", p.wave.ramp_in_m),
+                ("wave.clump_coherence", p.wave.clump_coherence),
                 ("length.fraction", p.length.fraction),
+                ("stray.fraction", p.stray.fraction),
+                ("stray.amplitude_m", p.stray.amplitude_m),
+                ("stray.frequency_per_m", p.stray.frequency_per_m),
+                ("stray.length_min", p.stray.length_min),
                 ("variation_per_uv", p.variation_per_uv),
             ];
             for (name, value) in values {
@@ -309,6 +381,10 @@ pub const HARD_RANGES: &[(&str, f64, f64)] = &[
     ("curl.turns_per_m", -1000.0, 1000.0),
     ("curl.ramp_in_m", 0.0, 10.0),
     ("curl.radius_jitter", 0.0, 1.0),
+    ("curl.clump_coherence", 0.0, 1.0),
+    // A helix may shrink to nothing or grow 4× toward the tip, never turn inside out.
+    ("curl.radius_tip_scale", 0.0, 4.0),
+    ("curl.rate_tip_scale", 0.0, 4.0),
     ("twist.turns_per_m", -1000.0, 1000.0),
     ("noise.amplitude_m", 0.0, 0.5),
     ("noise.frequency_per_m", 0.0, 10_000.0),
@@ -316,6 +392,9 @@ pub const HARD_RANGES: &[(&str, f64, f64)] = &[
     ("clump.clumps_per_uv", 1.0, 10_000.0),
     ("clump.radius_m", 0.0, 1.0),
     ("clump.tightening", 0.0, 100.0),
+    ("clump.sub_strength", 0.0, 1.0),
+    ("clump.sub_clumps_per_uv", 1.0, 10_000.0),
+    ("clump.sub_radius_m", 0.0, 1.0),
     ("frizz.amplitude_m", 0.0, 0.5),
     ("frizz.frequency_per_m", 0.0, 10_000.0),
     ("frizz.fraction", 0.0, 1.0),
@@ -328,7 +407,12 @@ pub const HARD_RANGES: &[(&str, f64, f64)] = &[
     ),
     ("wave.phase_spread", 0.0, 1.0),
     ("wave.ramp_in_m", 0.0, 10.0),
+    ("wave.clump_coherence", 0.0, 1.0),
     ("length.fraction", 0.0, 1.0),
+    ("stray.fraction", 0.0, 1.0),
+    ("stray.amplitude_m", 0.0, 0.5),
+    ("stray.frequency_per_m", 0.0, 1000.0),
+    ("stray.length_min", 0.0, 1.0),
     ("variation_per_uv", 1.0, 10_000.0),
 ];
 
@@ -339,6 +423,9 @@ impl StylingParams {
         StylingParams {
             curl: Curl {
                 radius_m: 0.004,
+                clump_coherence: 0.5,
+                radius_tip_scale: 0.7,
+                rate_tip_scale: 1.3,
                 ..Curl::default()
             },
             noise: Noise {
@@ -347,6 +434,7 @@ impl StylingParams {
             },
             clump: Clump {
                 strength: 0.7,
+                sub_strength: 0.5,
                 ..Clump::default()
             },
             frizz: Frizz {
@@ -356,12 +444,109 @@ impl StylingParams {
             },
             wave: Wave {
                 amplitude_m: 0.01,
+                clump_coherence: 0.5,
                 ..Wave::default()
             },
             length: LengthVariation { fraction: 0.3 },
+            stray: Stray {
+                fraction: 0.2,
+                ..Stray::default()
+            },
             twist: Twist { turns_per_m: 3.0 },
             ..StylingParams::default()
         }
+    }
+    /// Each op alone at [`Self::every_op`]'s setting, named (the rows of `bench switches`):
+    /// what each costs on its own against no styling. The second levels (sub-clumps,
+    /// ringlets, lock waves, strays) are their own rows, on top of the op they refine.
+    pub fn each_op() -> Vec<(&'static str, StylingParams)> {
+        let all = Self::every_op();
+        let none = Self::default();
+        let curl = StylingParams {
+            curl: Curl {
+                clump_coherence: 0.0,
+                radius_tip_scale: 1.0,
+                rate_tip_scale: 1.0,
+                ..all.curl.clone()
+            },
+            ..none.clone()
+        };
+        let clump = StylingParams {
+            clump: Clump {
+                sub_strength: 0.0,
+                ..all.clump.clone()
+            },
+            ..none.clone()
+        };
+        let wave = StylingParams {
+            wave: Wave {
+                clump_coherence: 0.0,
+                ..all.wave.clone()
+            },
+            ..none.clone()
+        };
+        vec![
+            ("curl", curl),
+            (
+                "curl: ringlets + tip scales",
+                StylingParams {
+                    curl: all.curl.clone(),
+                    ..none.clone()
+                },
+            ),
+            (
+                "twist",
+                StylingParams {
+                    twist: all.twist.clone(),
+                    ..none.clone()
+                },
+            ),
+            (
+                "noise",
+                StylingParams {
+                    noise: all.noise.clone(),
+                    ..none.clone()
+                },
+            ),
+            ("clump", clump),
+            (
+                "clump + sub-clumps",
+                StylingParams {
+                    clump: all.clump.clone(),
+                    ..none.clone()
+                },
+            ),
+            (
+                "frizz",
+                StylingParams {
+                    frizz: all.frizz.clone(),
+                    ..none.clone()
+                },
+            ),
+            ("wave", wave),
+            (
+                "wave: shared by locks",
+                StylingParams {
+                    wave: all.wave.clone(),
+                    ..none.clone()
+                },
+            ),
+            (
+                "length variation",
+                StylingParams {
+                    length: all.length.clone(),
+                    ..none.clone()
+                },
+            ),
+            (
+                "strays",
+                StylingParams {
+                    stray: all.stray.clone(),
+                    ..none.clone()
+                },
+            ),
+            ("every op", all),
+        ]
     }
 }
 

@@ -160,7 +160,18 @@ pub struct StylingGpu {
     pub wave_ramp_in_m: f32,
     pub variation_per_uv: f32,
     pub seed: u32,
-    pub _padding: u32,
+    pub curl_clump_coherence: f32,
+    pub curl_radius_tip_scale: f32,
+    pub curl_rate_tip_scale: f32,
+    pub clump_sub_strength: f32,
+    pub clump_sub_clumps_per_uv: f32,
+    pub clump_sub_radius_m: f32,
+    pub wave_clump_coherence: f32,
+    pub stray_fraction: f32,
+    pub stray_amplitude_m: f32,
+    pub stray_frequency_per_m: f32,
+    pub stray_length_min: f32,
+    pub _padding: [u32; 2],
 }
 
 impl From<&crate::model::styling::StylingParams> for StylingGpu {
@@ -189,7 +200,18 @@ impl From<&crate::model::styling::StylingParams> for StylingGpu {
             wave_ramp_in_m: p.wave.ramp_in_m as f32,
             variation_per_uv: p.variation_per_uv as f32,
             seed: p.seed,
-            _padding: 0,
+            curl_clump_coherence: p.curl.clump_coherence as f32,
+            curl_radius_tip_scale: p.curl.radius_tip_scale as f32,
+            curl_rate_tip_scale: p.curl.rate_tip_scale as f32,
+            clump_sub_strength: p.clump.sub_strength as f32,
+            clump_sub_clumps_per_uv: p.clump.sub_clumps_per_uv as f32,
+            clump_sub_radius_m: p.clump.sub_radius_m as f32,
+            wave_clump_coherence: p.wave.clump_coherence as f32,
+            stray_fraction: p.stray.fraction as f32,
+            stray_amplitude_m: p.stray.amplitude_m as f32,
+            stray_frequency_per_m: p.stray.frequency_per_m as f32,
+            stray_length_min: p.stray.length_min.clamp(0.0, 1.0) as f32,
+            _padding: [0; 2],
         }
     }
 }

@@ -99,6 +99,20 @@ pub enum RuntimeHairError {
 }
 
 impl RuntimeHair {
+    /// Vertices per strand (2^N + 1, as N) that draw this hair's styling as curves
+    /// ([`crate::strands::styling::strand_vertices_log2`] over the largest w stored).
+    pub fn strand_vertices_log2(&self) -> u32 {
+        let longest_w = self
+            .textures
+            .w
+            .texels
+            .iter()
+            .map(|t| t.x as f64)
+            .filter(|w| w.is_finite())
+            .fold(0.0, f64::max);
+        crate::strands::styling::strand_vertices_log2(&self.styling, longest_w)
+    }
+
     /// What exporting `document` with `options` produces.
     pub fn from_document(document: &Document, options: &RuntimeOptions) -> Self {
         let textures = RuntimeTextures::build(&document.hair_mesh, options.precision);

@@ -21,7 +21,9 @@ use crate::io::project::Project;
 use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::{HairMesh, VertexRef};
 use crate::model::scene::{HairMaterial, Pigment};
-use crate::model::styling::{Clump, Curl, Frizz, LengthVariation, Noise, StylingParams, Wave};
+use crate::model::styling::{
+    Clump, Curl, Frizz, LengthVariation, Noise, Stray, StylingParams, Wave,
+};
 
 /// The sample every tool opens when none is named (the editor embeds the same file).
 pub const DEFAULT_SAMPLE: &str = "head_long_wavy.hairloom";
@@ -551,8 +553,21 @@ pub(crate) fn head_style(name: &str) -> StylingParams {
             clumps_per_uv: 60.0,
             radius_m: 0.006,
             tightening: 1.5,
+            sub_strength: 0.5,
+            sub_clumps_per_uv: 240.0,
+            sub_radius_m: 0.002,
         },
-        length: LengthVariation { fraction: 0.15 },
+        // Soft ends: strands end anywhere in the last quarter of their bundle.
+        length: LengthVariation { fraction: 0.25 },
+        // A few flyaways leave the mass.
+        stray: Stray {
+            fraction: 0.04,
+            // Drifts are symmetric in (û, v̂): more than 8 mm reaches under the skin where
+            // the hair lies on it (the temples).
+            amplitude_m: 0.008,
+            frequency_per_m: 6.0,
+            length_min: 0.4,
+        },
         ..StylingParams::default()
     };
     match name {
@@ -568,37 +583,55 @@ pub(crate) fn head_style(name: &str) -> StylingParams {
                 clumps_per_uv: 70.0,
                 radius_m: 0.005,
                 tightening: 2.0,
+                sub_strength: 0.5,
+                sub_clumps_per_uv: 280.0,
+                sub_radius_m: 0.0015,
             },
-            length: LengthVariation { fraction: 0.08 },
+            length: LengthVariation { fraction: 0.15 },
             ..base
         },
         "head_long_wavy" => StylingParams {
             wave: Wave {
-                amplitude_m: 0.008,
-                frequency_per_m: 9.0,
+                amplitude_m: 0.013,
+                frequency_per_m: 7.0,
                 direction_rad: 0.0,
                 phase_spread: 0.1,
                 ramp_in_m: 0.05,
+                // Each lock waves as one, neighbouring locks apart.
+                clump_coherence: 0.9,
             },
             ..base
         },
         "head_curly" => StylingParams {
+            // Ringlets: the strands of a lock share its helix and gather early (a clump
+            // cell is about 9 mm on the scalp: 0.55 m per uv).
             curl: Curl {
                 radius_m: 0.006,
                 turns_per_m: 45.0,
                 ramp_in_m: 0.01,
-                radius_jitter: 0.35,
+                radius_jitter: 0.15,
+                clump_coherence: 1.0,
+                radius_tip_scale: 0.8,
+                rate_tip_scale: 1.2,
+            },
+            noise: Noise {
+                amplitude_m: 0.0008,
+                frequency_per_m: 12.0,
+                octaves: 2,
             },
             frizz: Frizz {
-                amplitude_m: 0.0015,
+                amplitude_m: 0.0008,
                 frequency_per_m: 150.0,
-                fraction: 0.25,
+                fraction: 0.1,
             },
             clump: Clump {
-                strength: 0.5,
-                clumps_per_uv: 80.0,
-                radius_m: 0.005,
-                tightening: 1.0,
+                strength: 0.85,
+                clumps_per_uv: 60.0,
+                radius_m: 0.009,
+                tightening: 0.5,
+                sub_strength: 0.3,
+                sub_clumps_per_uv: 240.0,
+                sub_radius_m: 0.0023,
             },
             ..base
         },

@@ -31,6 +31,24 @@ const OPS: &[(&str, &[SliderSpec])] = &[
                 (0.0, 1.0),
                 "",
             ),
+            (
+                "Ringlets (curl shared by a clump)",
+                |p| &mut p.curl.clump_coherence,
+                (0.0, 1.0),
+                "",
+            ),
+            (
+                "Curl radius at the tip",
+                |p| &mut p.curl.radius_tip_scale,
+                (0.0, 2.0),
+                "×",
+            ),
+            (
+                "Curl turns at the tip",
+                |p| &mut p.curl.rate_tip_scale,
+                (0.0, 2.0),
+                "×",
+            ),
         ],
     ),
     (
@@ -76,6 +94,24 @@ const OPS: &[(&str, &[SliderSpec])] = &[
                 (0.0, 5.0),
                 "",
             ),
+            (
+                "Sub-clump strength",
+                |p| &mut p.clump.sub_strength,
+                (0.0, 1.0),
+                "",
+            ),
+            (
+                "Sub-clumps per uv",
+                |p| &mut p.clump.sub_clumps_per_uv,
+                (1.0, 800.0),
+                "",
+            ),
+            (
+                "Sub-clump radius",
+                |p| &mut p.clump.sub_radius_m,
+                (0.0, 0.02),
+                " m",
+            ),
         ],
     ),
     (
@@ -120,6 +156,36 @@ const OPS: &[(&str, &[SliderSpec])] = &[
             (
                 "Wave phase spread",
                 |p| &mut p.wave.phase_spread,
+                (0.0, 1.0),
+                "",
+            ),
+            (
+                "Wave shared by a clump",
+                |p| &mut p.wave.clump_coherence,
+                (0.0, 1.0),
+                "",
+            ),
+        ],
+    ),
+    (
+        "Strays",
+        &[
+            ("Stray share", |p| &mut p.stray.fraction, (0.0, 0.3), ""),
+            (
+                "Stray drift",
+                |p| &mut p.stray.amplitude_m,
+                (0.0, 0.05),
+                " m",
+            ),
+            (
+                "Stray drift frequency",
+                |p| &mut p.stray.frequency_per_m,
+                (0.0, 40.0),
+                " /m",
+            ),
+            (
+                "Stray shortest length",
+                |p| &mut p.stray.length_min,
                 (0.0, 1.0),
                 "",
             ),

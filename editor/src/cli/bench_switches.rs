@@ -1,6 +1,6 @@
 //! `hairloom bench switches`: what the method's switches cost, measured side by side in one
 //! run (seed 000 §5): styling on against every styling op off (the paper: 10-20 % of the
-//! render time), MSAA 1× / 4× / 8×, and exact against hardware (8-bit) texture filtering
+//! render time), each op alone against none (its generation cost), MSAA 1× / 4× / 8×, and exact against hardware (8-bit) texture filtering
 //! with the hardware weights' error beside their time — the measure the game runtime takes
 //! on its own adapter to choose its default filtering ([`GameHair::filtering_measure`]).
 //!
@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use hairloom_core::model::styling::StylingSet;
+use hairloom_core::model::styling::{StylingParams, StylingSet};
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
@@ -176,6 +176,28 @@ pub fn run(settings: &SwitchSettings) -> anyhow::Result<()> {
                 100.0 * (1.0 - plain_frame.0 / styled_frame.0)
             ),
         );
+
+        // Each op alone (at the every-op setting) against none: generation, where styling
+        // is paid.
+        for (name, params) in StylingParams::each_op() {
+            let alone = hairloom_core::model::document::Document {
+                styling: StylingSet {
+                    global: params,
+                    groups: Vec::new(),
+                },
+                ..document.clone()
+            };
+            let hair = generator.upload(&context, &runtime_of(&alone)?)?;
+            let t = generate(&hair, Filtering::Exact)?;
+            row(
+                "op alone",
+                name,
+                Some(t),
+                None,
+                Some(t.0 / plain_generate.0),
+                "",
+            );
+        }
 
         // MSAA, the styled hair.
         let mut first = None;

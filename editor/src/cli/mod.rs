@@ -138,9 +138,10 @@ enum Command {
         /// the head at a tenth of the size (far hair, LOD).
         #[arg(long, default_value_t = 1.0)]
         distance: f32,
-        /// Strands have 2^N + 1 vertices.
-        #[arg(long, default_value_t = render::PREVIEW_VERTICES_LOG2)]
-        vertices_log2: u32,
+        /// Strands have 2^N + 1 vertices (default: what the styling's curls and waves need,
+        /// 8 segments per turn, 4 to 7).
+        #[arg(long)]
+        vertices_log2: Option<u32>,
         /// Texture precision of a project render (a runtime bundle has its own).
         #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
         precision: PrecisionArg,
@@ -307,8 +308,10 @@ pub fn main() -> ExitCode {
                 );
                 return ExitCode::from(2);
             }
-            if vertices_log2 > 8 {
-                eprintln!("error: --vertices-log2 {vertices_log2} is more than 8");
+            if let Some(n) = vertices_log2
+                && n > 8
+            {
+                eprintln!("error: --vertices-log2 {n} is more than 8");
                 return ExitCode::from(2);
             }
             let settings = render::RenderSettings {

@@ -38,7 +38,10 @@ pub struct RenderSettings {
     pub effects: Option<String>,
     /// Camera distance as a multiple of the framing distance.
     pub distance: f32,
-    pub vertices_log2: u32,
+    /// `None`: what the hair's styling needs ([`RuntimeHair::strand_vertices_log2`]).
+    ///
+    /// [`RuntimeHair::strand_vertices_log2`]: hairloom_core::runtime::hair::RuntimeHair::strand_vertices_log2
+    pub vertices_log2: Option<u32>,
     /// Texture precision of a project render (a runtime bundle has its own).
     pub precision: Precision,
     pub filtering: Filtering,
@@ -57,7 +60,7 @@ impl Default for RenderSettings {
             view: "three-quarter".into(),
             effects: None,
             distance: 1.0,
-            vertices_log2: PREVIEW_VERTICES_LOG2,
+            vertices_log2: None,
             precision: Precision::F32,
             filtering: Filtering::Exact,
             generation: GenerationPath::default(),
@@ -208,7 +211,10 @@ impl HeadlessRenderer {
         };
         let asset = self.asset.as_ref().context("nothing to render")?;
         let hair = asset.hair();
-        let vertex_count = (1u32 << settings.vertices_log2.min(8)) + 1;
+        let vertices_log2 = settings
+            .vertices_log2
+            .unwrap_or_else(|| hair.strand_vertices_log2());
+        let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
         let mut camera = Camera::framing(frame.0, frame.1, direction);
         camera.eye = camera.target + (camera.eye - camera.target) * settings.distance;
         let scene = default_scene(

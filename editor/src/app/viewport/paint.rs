@@ -113,10 +113,12 @@ impl ViewportGpu {
             report.upload_error = Some(format!("cannot draw fur: {error}"));
         }
         let hair = &*hair;
+        // As many vertices as the styling's curls and waves need (vertex LOD thins far ones).
+        let vertex_count = (1u32 << hair.hair().strand_vertices_log2()) + 1;
         let scene = default_scene(
             hair.body(),
             hair.source(&self.generator, frame.filtering, frame.lod),
-            17,
+            vertex_count,
             hair.bounds(),
             frame.camera,
             &frame.lighting,
