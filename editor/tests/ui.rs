@@ -73,6 +73,42 @@ fn a_styling_slider_change_is_one_undo_step() {
     );
 }
 
+/// Issue 32's ops have their sliders in the Styling panel: each sets its own field, one
+/// undo step each, and undo takes it back.
+#[test]
+fn the_styling_structure_ops_have_sliders() {
+    let mut harness = harness();
+    type Read = fn(&hairloom_core::model::styling::StylingParams) -> f64;
+    let sliders: [(&str, f64, Read); 4] = [
+        ("Ringlets (curl shared by a clump)", 0.7, |p| {
+            p.curl.clump_coherence
+        }),
+        ("Sub-clump strength", 0.45, |p| p.clump.sub_strength),
+        ("Stray share", 0.12, |p| p.stray.fraction),
+        ("Wave shared by a clump", 0.35, |p| p.wave.clump_coherence),
+    ];
+    for (i, (label, value, read)) in sliders.into_iter().enumerate() {
+        harness
+            .get_by_role_and_label(Role::Slider, label)
+            .set_value_accesskit(value);
+        harness.run();
+        let state = &harness.state().state;
+        assert!(
+            (read(&state.document().styling.global) - value).abs() < 1e-9,
+            "{label}"
+        );
+        assert_eq!(state.project.history.undo.len(), i + 1, "{label}: one step");
+    }
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    let global = &harness.state().state.document().styling.global;
+    assert_ne!(
+        global.wave.clump_coherence, 0.35,
+        "undo takes the last one back"
+    );
+    assert_eq!(global.stray.fraction, 0.12);
+}
+
 #[test]
 fn a_typed_styling_value_is_one_undo_step() {
     // Issue 35's bug: one typed noise value made two identical history steps (the value
