@@ -27,6 +27,13 @@ pub const STRAND_WIDTH_M: f32 = 8e-5;
 /// detail unless asked otherwise.
 pub const EXPORT_VERTICES_LOG2: u32 = hairloom_core::runtime::hair::DEFAULT_MAX_VERTICES_LOG2;
 
+/// What an export takes by default: [`EXPORT_VERTICES_LOG2`], or more where the styling's
+/// curls and waves need it (8 segments a turn: the curly sample's ringlets 65 vertices), so
+/// a game or another tool gets the curls the viewport shows.
+pub fn export_vertices_log2(document: &Document) -> u32 {
+    EXPORT_VERTICES_LOG2.max(document.strand_vertices_log2())
+}
+
 /// The strand file formats, by extension.
 pub const STRAND_EXTENSIONS: [&str; 4] = ["hair", "usda", "glb", "abc"];
 
@@ -230,7 +237,8 @@ pub fn write_strand_file(
 #[derive(Clone, Copy, Debug)]
 pub struct ExportOptions {
     pub strands_per_bundle: u32,
-    pub vertices_log2: u32,
+    /// `None`: [`export_vertices_log2`] of the project.
+    pub vertices_log2: Option<u32>,
     pub precision: Precision,
     pub curve: StrandCurve,
     /// The application `.abc` files are written for (axes and units).
@@ -257,12 +265,15 @@ pub fn run(
             "nothing to export: give --runtime DIR, --strands FILE.{{hair,usda,glb,abc}} and/or --cards DIR"
         );
     }
-    check_vertices_log2(vertices_log2)?;
+    if let Some(n) = vertices_log2 {
+        check_vertices_log2(n)?;
+    }
     for file in strand_files {
         check_strand_file(file)?;
     }
     let project = hairloom_core::io::project::load(project_path)?;
     let document = &project.document;
+    let vertices_log2 = vertices_log2.unwrap_or_else(|| export_vertices_log2(document));
     if let Some(dir) = runtime {
         let summary =
             write_runtime_bundle(document, dir, precision, strands_per_bundle, vertices_log2)

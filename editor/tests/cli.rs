@@ -653,4 +653,12 @@ fn renders_give_curly_styles_the_vertices_their_turns_need() {
     assert_eq!(log2("head_curly"), 6);
     assert_eq!(log2("head_long_straight"), 4);
     assert!(log2("head_long_wavy") >= 5, "7 cycles/m over 30 cm");
+    // Exports give games and other tools the curls too (never fewer than 33 vertices).
+    let export = |name: &str| {
+        let project = hairloom_core::io::project::load(&dir.join(format!("{name}.hairloom")))
+            .expect("sample loads");
+        hairloom_editor::files::export_vertices_log2(&project.document)
+    };
+    assert_eq!(export("head_curly"), 6);
+    assert_eq!(export("head_long_straight"), 5);
 }

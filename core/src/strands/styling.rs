@@ -181,7 +181,9 @@ impl StrandStyling {
             });
         }
         // A stray cell's strands drift as one wisp: direction and key are constant over
-        // the cell (and so the same in f32 and f64: no amplified rounding).
+        // the cell, so f32 and f64 agree on them (no amplified rounding) except for a root
+        // within one f32 step of a cell border, where the cell itself (and whether the
+        // strand strays at all) may differ: a step by design, like frizz's selection.
         if strand.stray && stray.amplitude_m != 0.0 {
             strand.stray_direction = unit_phase(TAU * strand_cell_random(params, root_uv, 11));
             strand.stray_key = NOISE_KEY_SPAN * strand_cell_random(params, root_uv, 12);
@@ -558,8 +560,15 @@ mod tests {
             assert!(phase.distance(last) < 0.02, "jump at {x}");
             assert!(phase.length() < 1.0);
             last = phase;
-            let blended = blend_phase(DVec2::X, 0.7, || phase);
-            assert!(blended.length() <= 1.0 + 1e-12, "{blended}");
+        }
+        // The blend is continuous too, shrinking only where own and lock phases cancel.
+        let blend = |x: DVec2| blend_phase(DVec2::X, 0.7, || lock_phase(x, 1, 44));
+        let mut last = blend(DVec2::new(3.0, 5.0));
+        for i in 1..=4000 {
+            let x = DVec2::new(3.0 + i as f64 * 0.001, 5.0 + i as f64 * 0.0007);
+            let blended = blend(x);
+            assert!(blended.distance(last) < 0.05, "jump at {x}");
+            last = blended;
         }
         assert_eq!(blend_phase(DVec2::Y, 0.0, || unreachable!()), DVec2::Y);
     }
@@ -603,9 +612,14 @@ mod tests {
         let mut params = StylingParams::every_op();
         params.stray.fraction = 0.1;
         params.length.fraction = 0.0;
-        let n = 20_000;
+        // One root in each of 20,164 distinct random-value cells (a 142 × 142 grid over uv,
+        // 200 cells per uv): the share's standard deviation is 0.002.
+        let side = 142;
+        let n = side * side;
         let mut strays = 0;
-        for root in roots(n, 0.000_043) {
+        let grid = (0..n)
+            .map(|i| DVec2::new((i % side) as f64 + 0.5, (i / side) as f64 + 0.5) / side as f64);
+        for root in grid {
             let strand = StrandStyling::new(&params, root);
             let length = strand_length_fraction(&params, root);
             if strand.stray {
@@ -619,12 +633,13 @@ mod tests {
                     "{length}"
                 );
             } else {
-                assert_ne!(strand.clump_pull, DVec2::ZERO);
+                let lattice = root * params.clump.clumps_per_uv;
+                assert_eq!(strand.clump_pull, clump_pull(lattice, params.seed));
                 assert_eq!(length, 1.0);
             }
         }
         let share = strays as f64 / n as f64;
-        assert!((share - 0.1).abs() < 0.015, "{share}");
+        assert!((share - 0.1).abs() < 0.01, "{share}");
         // Off: nobody strays, lengths untouched.
         params.stray.fraction = 0.0;
         assert!(

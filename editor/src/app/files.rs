@@ -334,7 +334,7 @@ impl ExportJob {
                 &dir,
                 precision,
                 strands_per_bundle,
-                crate::files::EXPORT_VERTICES_LOG2,
+                crate::files::export_vertices_log2(&document),
             )
             .map_err(|e| format!("{e:#}")),
             ExportTarget::Strands {

@@ -512,7 +512,7 @@ impl HairloomApp {
             }),
             FileRequest::ExportStrands => self.start_export(ExportTarget::Strands {
                 file: path,
-                vertices_log2: crate::files::EXPORT_VERTICES_LOG2,
+                vertices_log2: crate::files::export_vertices_log2(self.state.document()),
                 alembic: self.alembic_target,
             }),
         }

@@ -89,9 +89,10 @@ enum Command {
         /// Strands per bundle (at most 4096, the runtime bundle's cap).
         #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
         strands_per_bundle: u32,
-        /// Strands have 2^N + 1 vertices.
-        #[arg(long, default_value_t = files::EXPORT_VERTICES_LOG2)]
-        vertices_log2: u32,
+        /// Strands have 2^N + 1 vertices (default: 5, or more where the styling's curls and
+        /// waves need 8 segments a turn).
+        #[arg(long)]
+        vertices_log2: Option<u32>,
         /// Runtime texture precision (also of `--curve runtime` strands).
         #[arg(long, value_enum, default_value_t = PrecisionArg::F32)]
         precision: PrecisionArg,
@@ -272,6 +273,8 @@ pub fn main() -> ExitCode {
             }
             if let Some(dir) = cards {
                 let document = hairloom_core::io::project::load(&project)?.document;
+                let vertices_log2 =
+                    vertices_log2.unwrap_or_else(|| files::export_vertices_log2(&document));
                 println!(
                     "{}",
                     files::write_cards(&document, &dir, strands_per_bundle, vertices_log2)?
