@@ -99,6 +99,10 @@ pub struct HairAsset {
     gpu: GpuHair,
     body: GpuBody,
     bounds: (Vec3, Vec3),
+    /// Vertices per strand the styling's curls and waves need
+    /// ([`RuntimeHair::strand_vertices_log2`]): it scans the w texture, so it is kept here,
+    /// made again when the styling or the shape changes, not per frame.
+    vertices_log2: u32,
     /// Far hair's hierarchy (seed 001), once a scene asked for it or a bundle carried it.
     /// Kept through a restyle or a reshape (its thick hairs are generated from the textures
     /// every frame, so they follow); made again after a rebuild.
@@ -121,6 +125,7 @@ impl HairAsset {
         let gpu = generator.upload(context, &hair)?;
         Ok(Self {
             body: GpuBody::upload(context, &hair.body),
+            vertices_log2: hair.strand_vertices_log2(),
             hair,
             gpu,
             bounds,
@@ -157,6 +162,7 @@ impl HairAsset {
             AssetChange::Restyle(styling) => {
                 self.hair.set_styling(&styling);
                 generator.update_styling(context, &mut self.gpu, &self.hair);
+                self.vertices_log2 = self.hair.strand_vertices_log2();
                 Ok(ChangeKind::Restyle)
             }
             AssetChange::Hair { hair, kind } => {
@@ -170,6 +176,7 @@ impl HairAsset {
                     }
                     self.hair = *hair;
                     self.bounds = bounds;
+                    self.vertices_log2 = self.hair.strand_vertices_log2();
                     return Ok(ChangeKind::Reshape);
                 }
                 *self = HairAsset::upload(context, generator, *hair)?;
@@ -204,6 +211,11 @@ impl HairAsset {
 
     pub fn hair(&self) -> &RuntimeHair {
         &self.hair
+    }
+
+    /// Vertices per strand (2^N + 1, as N) this hair's styling needs.
+    pub fn strand_vertices_log2(&self) -> u32 {
+        self.vertices_log2
     }
 
     /// Far hair's hierarchy as a bundle carries it (`LoadedBundle::far_hair`).

@@ -213,7 +213,7 @@ impl HeadlessRenderer {
         let hair = asset.hair();
         let vertices_log2 = settings
             .vertices_log2
-            .unwrap_or_else(|| hair.strand_vertices_log2());
+            .unwrap_or_else(|| asset.strand_vertices_log2());
         let vertex_count = (1u32 << vertices_log2.min(8)) + 1;
         let mut camera = Camera::framing(frame.0, frame.1, direction);
         camera.eye = camera.target + (camera.eye - camera.target) * settings.distance;

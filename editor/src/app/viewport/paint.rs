@@ -114,7 +114,7 @@ impl ViewportGpu {
         }
         let hair = &*hair;
         // As many vertices as the styling's curls and waves need (vertex LOD thins far ones).
-        let vertex_count = (1u32 << hair.hair().strand_vertices_log2()) + 1;
+        let vertex_count = (1u32 << hair.strand_vertices_log2()) + 1;
         let scene = default_scene(
             hair.body(),
             hair.source(&self.generator, frame.filtering, frame.lod),
