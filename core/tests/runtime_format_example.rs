@@ -21,7 +21,7 @@ use hairloom_core::io::runtime_bundle::{Manifest, bundle_files};
 use hairloom_core::model::mesh::HairMesh;
 use hairloom_core::model::styling::StylingParams;
 use hairloom_core::runtime::atlas::{Atlas, BundleBlock};
-use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions, strand_root};
+use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions, sample_rank, strand_root};
 use hairloom_core::runtime::strand_gen::{Filtering, StrandGen, fetch};
 use hairloom_core::runtime::textures::Precision;
 use hairloom_core::strands::lod::{morph_odd_vertices, strand_count, thickness_factor, vertex_lod};
@@ -300,7 +300,12 @@ fn example_tables() -> Vec<Table> {
 
     // The root and its random values.
     let sample = hair.samples.quad[0];
-    let root = strand_root(block, sample, 0);
+    let root = strand_root(
+        block,
+        sample,
+        0,
+        sample_rank(0, hair.strands_per_bundle as usize),
+    );
     let (s, t_coord) =
         Atlas::sample_block_coords(block, DVec2::new(sample[0] as f64, sample[1] as f64));
     let weights = Atlas::corner_weights(block, s, t_coord);
@@ -987,11 +992,12 @@ mod from_the_document {
         first + (second - first) * q + t.position_offset
     }
 
-    /// The strand of `sample` (a manifest sample) in `bundle`, `n` vertices.
+    /// The strand `j` of `per_bundle` at `sample` (a manifest sample) in `bundle`, `n`
+    /// vertices.
     pub fn strand(
         t: &Textures<'_>,
         bundle: &Bundle,
-        sample: [f32; 2],
+        (j, per_bundle, sample): (usize, usize, [f32; 2]),
         params: &StylingParams,
         n: usize,
     ) -> Vec<Vec3> {
@@ -1029,6 +1035,19 @@ mod from_the_document {
             let shortest = params.stray.length_min.clamp(0.0, 1.0) as f32;
             length *= shortest + (1.0 - shortest) * cell_random(10);
         }
+        let hairline = &params.hairline;
+        if hairline.width_m > 0.0 {
+            let distance = fetch(t.hair_mesh, p.extend(0.5)).w;
+            let rank = (j as f32 + 0.5) / per_bundle as f32;
+            let x = (distance.max(0.0) / hairline.width_m as f32).clamp(0.0, 1.0);
+            let s_h = x * x * (3.0 - 2.0 * x);
+            let grows = rank < 1.0 - (1.0 - hairline.edge_density as f32) * (1.0 - s_h);
+            length *= if grows {
+                1.0 - (1.0 - hairline.edge_length as f32) * (1.0 - s_h)
+            } else {
+                0.0
+            };
+        }
         let x_c = root_uv * params.clump.clumps_per_uv.max(1.0) as f32;
         let layers = bundle.layers;
         (0..n)
@@ -1036,7 +1055,7 @@ mod from_the_document {
                 let along = k as f32 / (n - 1) as f32;
                 let tau = layers as f32 * length * along;
                 let mut x = position(t, p, layers, tau);
-                if k == 0 {
+                if k == 0 || length <= 0.0 {
                     return x;
                 }
                 let z = p.extend(tau + 0.5);
@@ -1174,18 +1193,72 @@ fn an_implementation_of_the_document_matches_the_cpu_mirror() {
         corner_of_block: entry.corner_of_block,
         layers: entry.layers,
     };
-    let mut worst = 0.0f32;
-    for (j, root) in hair.strand_roots().iter().enumerate() {
-        for n in [2, VERTICES, 33] {
-            let expected = mirror.styled_strand(root, n, &params);
-            let got =
-                from_the_document::strand(&ours, &bundle, manifest.quad_samples[j], &params, n);
-            for (a, b) in got.iter().zip(&expected) {
-                worst = worst.max(a.distance(*b));
+    let per_bundle = hair.strands_per_bundle as usize;
+    let compare = |textures: &_, ours: &from_the_document::Textures<'_>, params: &_| {
+        let mirror = StrandGen {
+            textures,
+            filtering: Filtering::Exact,
+        };
+        let mut worst = 0.0f32;
+        for (j, root) in hair.strand_roots().iter().enumerate() {
+            for n in [2, VERTICES, 33] {
+                let expected = mirror.styled_strand(root, n, params);
+                let sample = (j, per_bundle, manifest.quad_samples[j]);
+                let got = from_the_document::strand(ours, &bundle, sample, params, n);
+                for (a, b) in got.iter().zip(&expected) {
+                    worst = worst.max(a.distance(*b));
+                }
             }
         }
-    }
+        worst
+    };
+    let worst = compare(textures, &ours, &params);
     eprintln!("from the document vs the CPU mirror: {worst:.3e} m (size {size:.3} m)");
+    assert!(worst <= 1e-5 * size, "{worst} m");
+    // The hairline op, from the root slice's fourth channel. The example's one bundle is all
+    // border (every corner at distance 0), so the test writes distances of its own there.
+    let mut hairline_textures = textures.clone();
+    let texture = &mut hairline_textures.hair_mesh;
+    for (corner, distance) in [(0, 0.0), (1, 0.003), (2, 0.02), (3, 0.007)] {
+        let [x, y] = [[0, 0], [1, 0], [1, 1], [0, 1]][corner];
+        let origin = hair.textures.atlas.blocks[0].origin;
+        let i = texture.index(origin[0] + x, origin[1] + y, 0);
+        texture.texels[i].w = distance;
+    }
+    let mut hairline_params = params.clone();
+    hairline_params.hairline = hairloom_core::model::styling::Hairline {
+        width_m: 0.012,
+        edge_density: 0.4,
+        edge_length: 0.5,
+    };
+    let hairline_mirror = StrandGen {
+        textures: &hairline_textures,
+        filtering: Filtering::Exact,
+    };
+    let lengths: Vec<f64> = hair
+        .strand_roots()
+        .iter()
+        .map(|root| {
+            hairline_mirror
+                .strand_input(root, &hairline_params)
+                .length_fraction
+        })
+        .collect();
+    let plain: Vec<f64> = hair
+        .strand_roots()
+        .iter()
+        .map(|root| hairline_mirror.strand_input(root, &params).length_fraction)
+        .collect();
+    assert!(
+        lengths.contains(&0.0) && lengths.iter().zip(&plain).any(|(&l, &p)| l > 0.0 && l < p),
+        "the example's strands include thinned and shortened ones: {lengths:?}"
+    );
+    let ours = from_the_document::Textures {
+        hair_mesh: &hairline_textures.hair_mesh,
+        ..ours
+    };
+    let worst = compare(&hairline_textures, &ours, &hairline_params);
+    eprintln!("with the hairline: {worst:.3e} m");
     assert!(worst <= 1e-5 * size, "{worst} m");
     // The strands compared include strays and clumped strands both.
     let strays: Vec<bool> = hair

@@ -115,11 +115,10 @@ fn runtime_curve_strands(
         document,
         &runtime_options(precision, strands_per_bundle, vertices_log2),
     );
-    Ok(runtime_strands(
-        &hair,
-        (1usize << vertices_log2) + 1,
-        Filtering::Exact,
-    ))
+    let mut strands = runtime_strands(&hair, (1usize << vertices_log2) + 1, Filtering::Exact);
+    // Strands the hairline op does not grow lie at their root: nothing for another tool.
+    strands.retain(|strand| strand.length_fraction > 0.0);
+    Ok(strands)
 }
 
 /// How a runtime bundle is exported: `2^vertices_log2 + 1` vertices per strand at full detail.

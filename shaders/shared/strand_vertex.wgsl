@@ -36,7 +36,10 @@ struct StrandRoot {
     centre_texel: vec2<f32>,
     layers: u32,
     styling: u32,
-    _padding: vec2<u32>,
+    // (j + ½) / N: the root's place in its bundle's progressive sample set (the hairline
+    // op thins by it).
+    rank: f32,
+    _padding: u32,
 }
 
 struct Styling {
@@ -74,8 +77,12 @@ struct Styling {
     stray_amplitude_m: f32,
     stray_frequency_per_m: f32,
     stray_length_min: f32,
+    hairline_width_m: f32,
+    hairline_edge_density: f32,
+    hairline_edge_length: f32,
     _padding0: u32,
     _padding1: u32,
+    _padding2: u32,
 }
 
 // Mirror: SLICES_PER_SEGMENT in core/src/runtime/textures.rs (p_k, q0, q1 per segment).
@@ -364,6 +371,19 @@ fn strand_length_fraction(s: Styling, root_uv: vec2<f32>) -> f32 {
     return fraction;
 }
 
+// Mirror: styling::hairline_length_scale (0: the strand does not grow).
+fn hairline_length_scale(s: Styling, distance: f32, rank: f32) -> f32 {
+    if !(s.hairline_width_m > 0.0) {
+        return 1.0;
+    }
+    let x = ramp(s.hairline_width_m, max(distance, 0.0));
+    let density = 1.0 - (1.0 - s.hairline_edge_density) * (1.0 - x);
+    if !(rank < density) {
+        return 0.0;
+    }
+    return 1.0 - (1.0 - s.hairline_edge_length) * (1.0 - x);
+}
+
 // Mirror: styling::styling_offset_of (without twist).
 fn styling_offset(
     s: Styling,
@@ -478,6 +498,7 @@ fn strand_root(root_index: u32) -> StrandRoot {
     root.centre_texel = bundle.origin_texel + centre;
     root.layers = bundle.layers;
     root.styling = bundle.styling;
+    root.rank = (f32(sample_index) + 0.5) / f32(params.per_bundle);
     return root;
 }
 
@@ -501,7 +522,11 @@ fn strand_input(root_index: u32) -> StrandInput {
     input.style = styling[style_index];
     // Root uv: always exact (it seeds every per-strand random value).
     input.root_uv = fetch_exact(uv_texture, vec3<f32>(root.texel, 0.5)).xy;
-    input.length_fraction = strand_length_fraction(input.style, input.root_uv);
+    // The root slice's fourth channel: the root's distance to the border of the hair
+    // (always exact: it decides whether the strand grows).
+    let hairline_distance = fetch_exact(hair_mesh, vec3<f32>(root.texel, 0.5)).w;
+    input.length_fraction = strand_length_fraction(input.style, input.root_uv)
+        * hairline_length_scale(input.style, hairline_distance, root.rank);
     input.constants = strand_constants(input.style, input.root_uv);
     return input;
 }
@@ -513,7 +538,8 @@ fn styled_vertex(input: StrandInput, k: u32, n: u32) -> vec3<f32> {
     let along = f32(k) / f32(n - 1u);
     let tau = f32(root.layers) * input.length_fraction * along;
     var p = strand_position(root.texel, root.layers, tau);
-    if k == 0u {
+    // A strand that does not grow (hairline) lies at its root: nothing is drawn.
+    if k == 0u || input.length_fraction <= 0.0 {
         return p;
     }
     let layer_coord = vec3<f32>(root.texel, tau + 0.5);

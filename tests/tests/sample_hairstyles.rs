@@ -139,41 +139,27 @@ fn hair_rests_on_the_crown() {
     }
 }
 
-/// Hair thins out over the hairline instead of ending in a hard edge: the bundles on the
-/// scalp's rim grow about a third of their strands, the next ring about two thirds, and the
-/// rest all of them; the generated strands follow.
+/// Hair thins out and grows shorter over the hairline instead of ending in a hard edge (the
+/// hairline styling op): the bundles on the border of the hair grow under 60 % of their
+/// strands in all (about half; each under three quarters), shorter than the same bundles' strands without the op, while most bundles grow
+/// every strand at full length.
 #[test]
 fn strand_density_falls_off_over_the_hairline() {
     for (name, document) in head_samples() {
         let mesh = &document.hair_mesh;
-        let mut edge_uses = std::collections::HashMap::<(u32, u32), u32>::new();
-        for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
-            let n = bundle.vertices.len();
-            for i in 0..n {
-                let (a, b) = (bundle.vertices[i], bundle.vertices[(i + 1) % n]);
-                *edge_uses.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
-        let on_rim = |b: usize| {
+        let border = hairloom_core::geometry::hairline::border_edges(mesh);
+        let on_border = |b: usize| {
             let vertices = &mesh.bundles[b].vertices;
             (0..vertices.len()).any(|i| {
                 let (a, c) = (vertices[i], vertices[(i + 1) % vertices.len()]);
-                edge_uses[&(a.min(c), a.max(c))] == 1
+                border.binary_search(&[a.min(c), a.max(c)]).is_ok()
             })
         };
-        let rim: Vec<usize> = (0..mesh.bundles.len()).filter(|&b| on_rim(b)).collect();
+        let rim: Vec<usize> = (0..mesh.bundles.len()).filter(|&b| on_border(b)).collect();
         assert!(rim.len() > 20, "{name}: {} rim bundles", rim.len());
-        for &b in &rim {
-            assert!(
-                mesh.bundles[b].density < 0.5,
-                "{name}: rim bundle {b} has density {}",
-                mesh.bundles[b].density
-            );
-        }
-        let full = mesh.bundles.iter().filter(|b| b.density == 1.0).count();
         assert!(
-            full * 2 > mesh.bundles.len(),
-            "{name}: only {full} bundles at full density"
+            document.styling.global.hairline.width_m > 0.0,
+            "{name}: the sample uses the hairline op"
         );
         let options = StrandOptions {
             strands_per_bundle: 32,
@@ -181,19 +167,43 @@ fn strand_density_falls_off_over_the_hairline() {
             ..StrandOptions::default()
         };
         let strands = generate(&document, &options);
+        let mut without = document.clone();
+        without.styling.global.hairline = Default::default();
+        let full = generate(&without, &options);
         let mut per_bundle = vec![0usize; mesh.bundles.len()];
+        let mut length = vec![0.0f64; mesh.bundles.len()];
         for strand in &strands {
             per_bundle[strand.bundle as usize] += 1;
+            length[strand.bundle as usize] += strand.length_fraction;
         }
+        let mut full_length = vec![0.0f64; mesh.bundles.len()];
+        for strand in &full {
+            full_length[strand.bundle as usize] += strand.length_fraction;
+        }
+        let rim_grown: usize = rim.iter().map(|&b| per_bundle[b]).sum();
+        assert!(
+            rim_grown * 10 < rim.len() * 32 * 6,
+            "{name}: the rim bundles grow {rim_grown} of {} strands",
+            rim.len() * 32
+        );
         for &b in &rim {
             assert!(
-                per_bundle[b] < 16,
+                per_bundle[b] < 24,
                 "{name}: rim bundle {b}: {}",
                 per_bundle[b]
             );
+            let mean = length[b] / per_bundle[b].max(1) as f64;
+            let mean_full = full_length[b] / 32.0;
+            assert!(
+                mean < 0.9 * mean_full,
+                "{name}: rim bundle {b}: mean length {mean:.3} against {mean_full:.3}"
+            );
         }
-        let densest = per_bundle.iter().max().copied().unwrap_or(0);
-        assert_eq!(densest, 32, "{name}: full bundles grow every strand");
+        let untouched = per_bundle.iter().filter(|&&n| n == 32).count();
+        assert!(
+            untouched * 2 > mesh.bundles.len(),
+            "{name}: only {untouched} bundles grow every strand"
+        );
     }
 }
 
@@ -374,8 +384,8 @@ fn scalp_coverage(
 /// scalp the camera sees (root faces of growing bundles, not hidden by the face or ears),
 /// at least 97% lies under a strand in front of it, and the largest bare region is under
 /// 0.5 cm² (a bald patch a viewer notices is several cm²). 32 strands per bundle. Measured
-/// (2026-12-04): 97.8-100% covered, largest bare region 0.32 cm² (short straight, side);
-/// the rim bundles' thinning is most of what stays bare. A control proves the measurement
+/// (2026-12-07): 97.5-100% covered, largest bare region 0.36 cm² (ponytail, side); the
+/// hairline op's thinning and shortening at the border is most of what stays bare. A control proves the measurement
 /// sees a bald patch: without the strands of the short cut's bundles rooted within 4 cm of
 /// the scalp point nearest the side camera, the side view shows one.
 #[test]

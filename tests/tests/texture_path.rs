@@ -47,9 +47,14 @@ fn styled_texture_path_matches_the_reference_generator() {
                         s: sample.x,
                         t: sample.y,
                     };
-                    let reference = context
-                        .strand(block.bundle as usize, coord, 17, &options)
-                        .expect("strand");
+                    let Some(reference) =
+                        context.strand(block.bundle as usize, coord, 17, &options)
+                    else {
+                        // Not grown (the hairline op at the border): the mirror's strand
+                        // lies at its root.
+                        assert!(gpu_like.iter().all(|p| *p == gpu_like[0]));
+                        continue;
+                    };
                     for (a, b) in gpu_like.iter().zip(&reference.points) {
                         worst = worst.max(a.as_dvec3().distance(*b));
                     }
@@ -80,7 +85,7 @@ fn styled_texture_path_matches_the_reference_generator() {
 /// generator's two-quadratic strand at that root within the f32 bound above.
 #[test]
 fn runtime_strands_are_the_texture_path_strands_of_each_sample() {
-    use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+    use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions, sample_rank};
     use hairloom_core::runtime::strand_gen::runtime_strands;
     let path = sample_paths()
         .into_iter()
@@ -95,26 +100,40 @@ fn runtime_strands_are_the_texture_path_strands_of_each_sample() {
     };
     let hair = RuntimeHair::from_document(&document, &options);
     let strands = runtime_strands(&hair, 9, Filtering::Exact);
-    // Each block grows its share of 3 (hairline bundles are thinned: `Bundle::density`).
+    // Each block grows its share of 3 (`Bundle::density`); the hairline op's strands that
+    // do not grow are kept, at their root, as the GPU draws them.
     let grown: usize = (0..hair.textures.atlas.blocks.len())
         .map(|block| hair.block_strand_count(block) as usize)
         .sum();
+    assert_eq!(strands.len(), grown);
     assert!(
-        grown < hair.textures.atlas.blocks.len() * 3,
+        strands.iter().any(|s| s.length_fraction == 0.0),
         "the sample's hairline is thinned"
     );
-    assert_eq!(strands.len(), grown);
     let context = StrandContext::new(&document);
     let reference_options = StrandOptions {
         form: SegmentForm::TwoQuadratics,
         ..StrandOptions::default()
     };
     let bound = 1e-5 * document.hair_mesh.size();
+    let mut compared = 0;
     for strand in strands.iter().step_by(5) {
         assert_eq!(strand.points.len(), 9);
-        let reference = context
-            .strand(strand.bundle as usize, strand.coord, 9, &reference_options)
-            .expect("strand");
+        let rank = sample_rank(strand.root as usize % 3, 3) as f64;
+        let reference = context.strand_ranked(
+            strand.bundle as usize,
+            strand.coord,
+            rank,
+            9,
+            &reference_options,
+        );
+        let Some(reference) = reference else {
+            // The hairline op does not grow it: the runtime draws it at its root.
+            assert_eq!(strand.length_fraction, 0.0);
+            assert!(strand.points.iter().all(|p| *p == strand.points[0]));
+            continue;
+        };
+        compared += 1;
         for (a, b) in strand.points.iter().zip(&reference.points) {
             assert!(
                 a.distance(*b) < bound,
@@ -123,4 +142,5 @@ fn runtime_strands_are_the_texture_path_strands_of_each_sample() {
             );
         }
     }
+    assert!(compared * 2 > strands.len() / 5, "most strands grow");
 }

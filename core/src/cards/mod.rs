@@ -27,7 +27,6 @@ use crate::geometry::curve::{CurveDefinition, FaceCoord, ReferenceStrand, Segmen
 use crate::light::material::Fibre;
 use crate::strands::random::{hash_to_unit, pcg_hash};
 use crate::strands::reference::Strand;
-use crate::strands::styling::strand_length_fraction;
 
 /// How cards are made and baked.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -262,8 +261,7 @@ pub fn hair_cards(document: &Document, strands: &[Strand], options: &CardOptions
             continue;
         };
         let card = &mut cards[c];
-        let params = document.styling.params_for(strand.bundle);
-        let tau_max = card.layers * strand_length_fraction(params, strand.root_uv);
+        let tau_max = card.layers * strand.length_fraction;
         let n = strand.points.len().max(2);
         let mut points = Vec::with_capacity(strand.points.len());
         for (k, p) in strand.points.iter().enumerate() {

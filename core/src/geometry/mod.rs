@@ -3,5 +3,6 @@
 
 pub mod curve;
 pub mod frames;
+pub mod hairline;
 pub mod interior;
 pub mod uv;

@@ -15,15 +15,17 @@ pub use crate::runtime::hair::LodEntry;
 use crate::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 
-/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 5
-/// adds styling ops (sub-clumps, strays, ringlet and lock-wave phases, curl tip scales): a
+/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 6
+/// adds the hairline op: the `hairline` styling keys and each root's distance to the border
+/// of the hair in the hair-mesh root slice's fourth channel (0 before); a version 5 reader
+/// would grow every strand at full length. Version 5 adds styling ops (sub-clumps, strays, ringlet and lock-wave phases, curl tip scales): a
 /// version 4 reader would skip their keys and grow other strands, so it must refuse the
 /// bundle; their defaults leave older bundles' strands unchanged. Version 4 adds what a game needs to rebuild the textures from a moving hair mesh (each bundle's
 /// `columns`, `column_layers`, `bare_faces`); version 3 adds far hair's hierarchy (`manifest.far_hair`); version 2 stores 3 hair-mesh slices per
 /// segment (`p_k, q0, q1`); version 1 stored the quadratics' joint `m` too (4 slices). All
 /// are read (version 1's `m` slices are dropped on load: `m` is exactly `(q0 + q1) / 2`;
 /// bundles before version 3 have no far hair).
-pub const RUNTIME_FORMAT_VERSION: u32 = 5;
+pub const RUNTIME_FORMAT_VERSION: u32 = 6;
 /// Hair-mesh slices per segment in format version 1 bundles.
 const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
@@ -1603,7 +1605,7 @@ mod tests {
                         .expect("a bundle")
                         .remove("columns");
                 }),
-                "bundles[0] has no columns (format_version 5 needs them)",
+                "bundles[0] has no columns (format_version 6 needs them)",
             ),
             (
                 Box::new(|m| {

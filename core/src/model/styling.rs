@@ -192,6 +192,35 @@ impl Default for Stray {
     }
 }
 
+/// Hairlines: hair thins out, and grows shorter, over the last `width_m` before the border
+/// of the hair (where bundles end: the hairline, the nape, around the ears, a bald patch).
+/// With `d` a root's distance to that border (object units, straight-line, bilinear over
+/// its face from the root corners') and `s = smoothstep(0, width_m, d)`, the strand grows
+/// when its place in its bundle's progressive sample set, `(j + ½) / N`, is below
+/// `edge_density + (1 − edge_density) s` — an even, sparser cover toward the border — and
+/// keeps `edge_length + (1 − edge_length) s` of its length: short, fine-looking vellus at
+/// the edge instead of a comb line of full-length roots.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Hairline {
+    /// How far in from the border the falloff reaches; 0 turns the op off.
+    pub width_m: f64,
+    /// The share of strands that grow right at the border.
+    pub edge_density: f64,
+    /// The share of their length strands keep right at the border.
+    pub edge_length: f64,
+}
+
+impl Default for Hairline {
+    fn default() -> Self {
+        Self {
+            width_m: 0.0,
+            edge_density: 0.1,
+            edge_length: 0.3,
+        }
+    }
+}
+
 /// Length variation: a strand ends at `1 − fraction · ξ₅` of its bundle's length.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -211,6 +240,7 @@ pub struct StylingParams {
     pub wave: Wave,
     pub length: LengthVariation,
     pub stray: Stray,
+    pub hairline: Hairline,
     /// Cells per uv unit of the per-strand random fields ξ.
     pub variation_per_uv: f64,
     pub seed: u32,
@@ -227,6 +257,7 @@ impl Default for StylingParams {
             wave: Wave::default(),
             length: LengthVariation::default(),
             stray: Stray::default(),
+            hairline: Hairline::default(),
             variation_per_uv: 200.0,
             seed: 1,
         }
@@ -339,6 +370,9 @@ impl StylingSet {
                 ("stray.amplitude_m", p.stray.amplitude_m),
                 ("stray.frequency_per_m", p.stray.frequency_per_m),
                 ("stray.length_min", p.stray.length_min),
+                ("hairline.width_m", p.hairline.width_m),
+                ("hairline.edge_density", p.hairline.edge_density),
+                ("hairline.edge_length", p.hairline.edge_length),
                 ("variation_per_uv", p.variation_per_uv),
             ];
             for (name, value) in values {
@@ -413,6 +447,10 @@ pub const HARD_RANGES: &[(&str, f64, f64)] = &[
     ("stray.amplitude_m", 0.0, 0.5),
     ("stray.frequency_per_m", 0.0, 1000.0),
     ("stray.length_min", 0.0, 1.0),
+    // A metre of falloff is already a whole head of thinning hair.
+    ("hairline.width_m", 0.0, 1.0),
+    ("hairline.edge_density", 0.0, 1.0),
+    ("hairline.edge_length", 0.0, 1.0),
     ("variation_per_uv", 1.0, 10_000.0),
 ];
 
@@ -451,6 +489,10 @@ impl StylingParams {
             stray: Stray {
                 fraction: 0.2,
                 ..Stray::default()
+            },
+            hairline: Hairline {
+                width_m: 0.008,
+                ..Hairline::default()
             },
             twist: Twist { turns_per_m: 3.0 },
             ..StylingParams::default()
@@ -542,6 +584,13 @@ impl StylingParams {
                 "strays",
                 StylingParams {
                     stray: all.stray.clone(),
+                    ..none.clone()
+                },
+            ),
+            (
+                "hairline",
+                StylingParams {
+                    hairline: all.hairline.clone(),
                     ..none.clone()
                 },
             ),

@@ -129,7 +129,10 @@ pub struct StrandRoot {
     pub layers: u32,
     /// Index into the styling-parameter array: 0 = global, `g + 1` = styling group `g`.
     pub styling: u32,
-    pub _padding: [u32; 2],
+    /// `(j + ½) / N`: sample `j`'s place among the bundle's `N` (strands per bundle), what
+    /// the hairline op thins by (computed in f32 on both sides, so they agree exactly).
+    pub rank: f32,
+    pub _padding: u32,
 }
 
 /// One set of styling parameters in f32 (`crate::model::styling::StylingParams`), flattened.
@@ -171,7 +174,10 @@ pub struct StylingGpu {
     pub stray_amplitude_m: f32,
     pub stray_frequency_per_m: f32,
     pub stray_length_min: f32,
-    pub _padding: [u32; 2],
+    pub hairline_width_m: f32,
+    pub hairline_edge_density: f32,
+    pub hairline_edge_length: f32,
+    pub _padding: [u32; 3],
 }
 
 impl From<&crate::model::styling::StylingParams> for StylingGpu {
@@ -211,7 +217,10 @@ impl From<&crate::model::styling::StylingParams> for StylingGpu {
             stray_amplitude_m: p.stray.amplitude_m as f32,
             stray_frequency_per_m: p.stray.frequency_per_m as f32,
             stray_length_min: p.stray.length_min.clamp(0.0, 1.0) as f32,
-            _padding: [0; 2],
+            hairline_width_m: p.hairline.width_m.max(0.0) as f32,
+            hairline_edge_density: p.hairline.edge_density.clamp(0.0, 1.0) as f32,
+            hairline_edge_length: p.hairline.edge_length.clamp(0.0, 1.0) as f32,
+            _padding: [0; 3],
         }
     }
 }

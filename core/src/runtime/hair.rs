@@ -218,8 +218,9 @@ pub fn block_styling(textures: &RuntimeTextures, styling: &StylingSet) -> Vec<u3
 }
 
 /// The root of the strand at `sample` (a manifest sample) of `block`, with the texel of the
-/// bundle's centre strand (block centre, or the triangle's centroid) for twist.
-pub fn strand_root(block: &BundleBlock, sample: [f32; 2], styling: u32) -> StrandRoot {
+/// bundle's centre strand (block centre, or the triangle's centroid) for twist, and `rank`,
+/// the sample's place in the bundle ([`sample_rank`]).
+pub fn strand_root(block: &BundleBlock, sample: [f32; 2], styling: u32, rank: f32) -> StrandRoot {
     let origin = Vec2::new(block.origin[0] as f32, block.origin[1] as f32) + 0.5;
     let centre = if Atlas::is_triangle(block) {
         Vec2::new(0.5, 1.0 / 3.0)
@@ -233,8 +234,15 @@ pub fn strand_root(block: &BundleBlock, sample: [f32; 2], styling: u32) -> Stran
         centre_texel: (origin + centre).to_array(),
         layers: block.layers,
         styling,
-        _padding: [0; 2],
+        rank,
+        _padding: 0,
     }
+}
+
+/// `(j + ½) / N`, sample `j`'s place among a bundle's `N`, in f32 as the shader computes
+/// it (`strand_root` in `shared/strand_vertex.wgsl`), so both sides agree exactly.
+pub fn sample_rank(sample_index: usize, per_bundle: usize) -> f32 {
+    (sample_index as f32 + 0.5) / per_bundle.max(1) as f32
 }
 
 /// Progressive root samples as a runtime bundle stores them (f32, seed 000 §3.3): quads in

@@ -14,7 +14,8 @@ use crate::runtime::gpu_types::{StrandRoot, StrandRun, ThickHairGpu};
 use crate::runtime::hair::strand_root;
 use crate::runtime::textures::{RuntimeTextures, Texture3d, curve_fetch_slices};
 use crate::strands::styling::{
-    StrandStyling, StylingInput, strand_length_fraction, styling_offset_of, twist,
+    StrandStyling, StylingInput, hairline_length_scale, strand_length_fraction, styling_offset_of,
+    twist,
 };
 
 /// The per-strand values `strand_gen.wgsl` computes once before a strand's vertices.
@@ -23,7 +24,8 @@ pub struct StrandInput<'p> {
     pub root: StrandRoot,
     pub params: &'p StylingParams,
     pub root_uv: glam::DVec2,
-    /// Fraction of the bundle's length this strand keeps (length variation).
+    /// Fraction of the bundle's length this strand keeps (length variation, strays, the
+    /// hairline); 0 for a strand that does not grow.
     pub length_fraction: f64,
     /// The styling ops' per-strand values (random phases and keys, clump pull).
     pub styling: StrandStyling,
@@ -152,7 +154,8 @@ impl StrandGen<'_> {
         params: &StylingParams,
     ) -> Vec<Vec3> {
         let block = &self.textures.atlas.blocks[block_index];
-        let root = strand_root(block, [sample.x as f32, sample.y as f32], 0);
+        // Rank 0: the first strand of its bundle, the last the hairline op thins away.
+        let root = strand_root(block, [sample.x as f32, sample.y as f32], 0, 0.0);
         self.styled_strand(&root, vertex_count, params)
     }
 
@@ -171,11 +174,20 @@ impl StrandGen<'_> {
             .truncate()
             .truncate()
             .as_dvec2();
+        // The root slice's fourth channel: the root's distance to the border of the hair,
+        // always exact (it decides whether the strand grows).
+        let hairline_distance = fetch(
+            &self.textures.hair_mesh,
+            texel.extend(0.5),
+            Filtering::Exact,
+        )
+        .w as f64;
         StrandInput {
             root: *root,
             params,
             root_uv,
-            length_fraction: strand_length_fraction(params, root_uv),
+            length_fraction: strand_length_fraction(params, root_uv)
+                * hairline_length_scale(params, hairline_distance, root.rank as f64),
             styling: StrandStyling::new(params, root_uv),
         }
     }
@@ -190,7 +202,8 @@ impl StrandGen<'_> {
         let along = k as f64 / (n.max(2) - 1) as f64;
         let tau = (root.layers as f64 * input.length_fraction * along) as f32;
         let p = self.strand_position(texel, root.layers, tau);
-        if k == 0 {
+        // A strand that does not grow (hairline) lies at its root: nothing is drawn.
+        if k == 0 || input.length_fraction <= 0.0 {
             return p;
         }
         let layer_fetch =
@@ -333,7 +346,9 @@ fn params_of<'p>(
 /// piecewise quadratics of the textures at their precision, filtered by `filtering`, styled
 /// (what `hairloom export --curve runtime` writes, so a game can compare its own loader).
 /// Strands come in the GPU's order: bundle-major over the atlas blocks, `coord` holding the
-/// manifest sample each was drawn from.
+/// manifest sample each was drawn from. A strand the hairline op does not grow is kept, every
+/// vertex at its root and `length_fraction` 0, as the GPU draws it (far hair's hierarchy
+/// numbers strands by their place in the bundle); exports leave such strands out.
 pub fn runtime_strands(
     hair: &crate::runtime::hair::RuntimeHair,
     vertex_count: usize,
@@ -374,6 +389,7 @@ pub fn runtime_strands(
                     t: sample[1] as f64,
                 },
                 root_uv: input.root_uv,
+                length_fraction: input.length_fraction,
                 points: (0..n)
                     .map(|k| generator.styled_vertex(&input, k, n).as_dvec3())
                     .collect(),

@@ -14,6 +14,10 @@
 //! and `3k+2`, so a quadratic at parameter `q` is still two filtered fetches and one lerp (de
 //! Casteljau; see [`curve_fetch_slices`]) and the texture takes 3 slices per segment, not 4.
 //!
+//! The root slice's fourth channel holds each root's distance to the border of the hair
+//! ([`crate::geometry::hairline`], what the hairline styling op thins by); every other
+//! slice's is 0.
+//!
 //! Texels are stored as RGBA (3D textures have no 3-channel formats). The `f16` variant stores
 //! positions relative to [`RuntimeTextures::position_offset`] (the bounding-box centre) so that
 //! half precision is spent on the hair, not on the distance from the origin.
@@ -24,7 +28,7 @@ use crate::geometry::curve::{cubic_to_quadratics, curve_segments};
 use crate::geometry::frames::layer_frames;
 use crate::model::mesh::HairMesh;
 use crate::runtime::atlas::{Atlas, BundleBlock, build_atlas};
-use crate::runtime::hair::{RootSamples, strand_root};
+use crate::runtime::hair::{RootSamples, sample_rank, strand_root};
 use crate::runtime::half::round_to_f16;
 
 /// Slices of the hair-mesh texture per segment (2 control points + 1 layer).
@@ -211,6 +215,9 @@ impl RuntimeTextures {
             .map(|c| curve_segments(&c.positions))
             .collect();
         let position = |p: DVec3| quantize((p - offset).as_vec3().extend(0.0), precision);
+        // The root slice's fourth channel: each root's distance to the border of the hair
+        // (the hairline op's input; object units, not offset).
+        let hairline = crate::geometry::hairline::column_distances(mesh);
         for y in 0..height {
             for x in 0..width {
                 let Some(source) = atlas.texels[(y * width + x) as usize] else {
@@ -228,12 +235,11 @@ impl RuntimeTextures {
                 for k in 0..=max_layers as usize {
                     // Slices past the column's tip repeat the tip (never sampled by a bundle).
                     let layer = k.min(last);
-                    hair_mesh.set(
-                        x,
-                        y,
-                        SLICES_PER_SEGMENT * k as u32,
-                        position(column.positions[layer]),
-                    );
+                    let mut point = position(column.positions[layer]);
+                    if k == 0 {
+                        point.w = quantize(Vec4::splat(hairline[c] as f32), precision).w;
+                    }
+                    hair_mesh.set(x, y, SLICES_PER_SEGMENT * k as u32, point);
                     w.set(
                         x,
                         y,
@@ -300,11 +306,9 @@ impl RuntimeTextures {
                 &samples.quad
             };
             let styling = styling_of_block(index, block);
-            roots.extend(
-                set[..per_bundle]
-                    .iter()
-                    .map(|sample| strand_root(block, *sample, styling)),
-            );
+            roots.extend(set[..per_bundle].iter().enumerate().map(|(j, sample)| {
+                strand_root(block, *sample, styling, sample_rank(j, per_bundle))
+            }));
         }
         roots
     }

@@ -120,12 +120,27 @@ pub struct BundleHierarchy {
 /// Groups one bundle's `strands` (control points root first, the same count each) into
 /// levels and fits every thick hair's cross-sections.
 pub fn build_bundle_hierarchy(strands: &[Vec<DVec3>]) -> Result<BundleHierarchy, ThickHairError> {
+    let all: Vec<u32> = (0..strands.len() as u32).collect();
+    build_bundle_hierarchy_of(strands, &all)
+}
+
+/// [`build_bundle_hierarchy`] over the strands `grown` names (sorted, in range) only: a
+/// strand the hairline op does not grow lies at its root and joins no thick hair (as a
+/// corner it would pull the hair's centre onto the scalp). Indices still count every strand.
+pub fn build_bundle_hierarchy_of(
+    strands: &[Vec<DVec3>],
+    grown: &[u32],
+) -> Result<BundleHierarchy, ThickHairError> {
     check_strands(strands)?;
-    if strands.is_empty() {
+    let all: Vec<u32> = grown
+        .iter()
+        .copied()
+        .filter(|&i| (i as usize) < strands.len())
+        .collect();
+    if all.is_empty() {
         return Ok(BundleHierarchy { levels: Vec::new() });
     }
     let tangents: Vec<Vec<DVec3>> = strands.iter().map(|s| strand_tangents(s)).collect();
-    let all: Vec<u32> = (0..strands.len() as u32).collect();
     let mut levels = Vec::new();
     let mut most = 1usize;
     loop {
@@ -158,20 +173,25 @@ pub fn build_hierarchy(
         vertex_count,
         crate::runtime::strand_gen::Filtering::Exact,
     );
-    let mut by_block: Vec<Vec<Vec<DVec3>>> = Vec::new();
+    // Per block: its strands' points, and which of them grow (the hairline op leaves some at
+    // their root).
+    let mut by_block: Vec<(Vec<Vec<DVec3>>, Vec<u32>)> = Vec::new();
     let mut last_bundle = None;
     for strand in strands {
         if last_bundle != Some(strand.bundle) {
-            by_block.push(Vec::new());
+            by_block.push((Vec::new(), Vec::new()));
             last_bundle = Some(strand.bundle);
         }
-        if let Some(block) = by_block.last_mut() {
-            block.push(strand.points);
+        if let Some((points, grown)) = by_block.last_mut() {
+            if strand.length_fraction > 0.0 {
+                grown.push(points.len() as u32);
+            }
+            points.push(strand.points);
         }
     }
     by_block
         .iter()
-        .map(|strands| build_bundle_hierarchy(strands))
+        .map(|(strands, grown)| build_bundle_hierarchy_of(strands, grown))
         .collect()
 }
 
@@ -704,6 +724,30 @@ mod tests {
                     .collect()
             })
             .collect()
+    }
+
+    #[test]
+    fn strands_that_do_not_grow_join_no_thick_hair() {
+        // 24 strands; every third lies at its root (the hairline op does not grow it).
+        let mut strands = elliptic_bundle(24, 5);
+        for strand in strands.iter_mut().step_by(3) {
+            let root = strand[0];
+            strand.iter_mut().for_each(|p| *p = root);
+        }
+        let grown: Vec<u32> = (0..24).filter(|i| i % 3 != 0).collect();
+        let hierarchy = build_bundle_hierarchy_of(&strands, &grown).expect("builds");
+        for level in &hierarchy.levels {
+            let mut members: Vec<u32> = level.iter().flat_map(|h| h.members.clone()).collect();
+            members.sort_unstable();
+            assert_eq!(members, grown, "each level holds the grown strands once");
+            for hair in level {
+                assert!(hair.corners.iter().all(|c| grown.contains(c)));
+            }
+        }
+        assert_eq!(hierarchy.levels.last().map(Vec::len), Some(1));
+        // None grown: no levels, as for an empty bundle.
+        let none = build_bundle_hierarchy_of(&strands, &[]).expect("builds");
+        assert!(none.levels.is_empty());
     }
 
     #[test]

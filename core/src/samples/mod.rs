@@ -22,7 +22,7 @@ use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::{HairMesh, VertexRef};
 use crate::model::scene::{HairMaterial, Pigment};
 use crate::model::styling::{
-    Clump, Curl, Frizz, LengthVariation, Noise, Stray, StylingParams, Wave,
+    Clump, Curl, Frizz, Hairline, LengthVariation, Noise, Stray, StylingParams, Wave,
 };
 
 /// The sample every tool opens when none is named (the editor embeds the same file).
@@ -437,35 +437,6 @@ fn lift_curves_out_of_body(
     }
 }
 
-/// Strand density of the bundles along the hairline, from the edge in: hair thins out over a
-/// couple of centimetres instead of ending in a hard line.
-pub const HAIRLINE_DENSITY: [f64; 2] = [0.35, 0.7];
-
-/// Sets the density of the bundles on the scalp's rim to `densities[0]`, of those touching
-/// them to `densities[1]`, and so on inward (rings of bundles sharing a corner).
-pub(crate) fn thin_hairline(mesh: &mut HairMesh, densities: &[f64]) {
-    // Columns of the current ring's outer side: the rim (root boundary) first.
-    let topology = crate::model::mesh::Topology::build(mesh);
-    let mut front: std::collections::HashSet<u32> = (0..mesh.columns.len() as u32)
-        .filter(|&c| topology.root_boundary[c as usize])
-        .collect();
-    let mut ring = vec![usize::MAX; mesh.bundles.len()];
-    for (r, &density) in densities.iter().enumerate() {
-        let mut next = std::collections::HashSet::new();
-        for (b, bundle) in mesh.bundles.iter_mut().enumerate() {
-            if bundle.removed || ring[b] != usize::MAX {
-                continue;
-            }
-            if bundle.vertices.iter().any(|v| front.contains(v)) {
-                ring[b] = r;
-                bundle.density = density.clamp(0.0, 1.0);
-                next.extend(bundle.vertices.iter().copied());
-            }
-        }
-        front = next;
-    }
-}
-
 /// Area-weighted root-layer vertex normals.
 fn root_normals(mesh: &HairMesh) -> Vec<DVec3> {
     let mut normals = vec![DVec3::ZERO; mesh.columns.len()];
@@ -567,6 +538,13 @@ pub(crate) fn head_style(name: &str) -> StylingParams {
             amplitude_m: 0.008,
             frequency_per_m: 6.0,
             length_min: 0.4,
+        },
+        // Hair thins out and grows short over the last 1.5 cm before the border (the
+        // hairline, the nape, around the ears) instead of ending in a hard comb line.
+        hairline: Hairline {
+            width_m: 0.015,
+            edge_density: 0.3,
+            edge_length: 0.5,
         },
         ..StylingParams::default()
     };
@@ -860,8 +838,7 @@ pub fn head_projects(glb: &[u8]) -> Result<Vec<(String, Project)>, ImportError> 
     meshes.push((name, mesh));
     Ok(meshes
         .into_iter()
-        .map(|(name, mut mesh)| {
-            thin_hairline(&mut mesh, &HAIRLINE_DENSITY);
+        .map(|(name, mesh)| {
             let mut document = Document::new(name, mesh);
             document.styling.global = head_style(name);
             document.scene.material = head_material(name);

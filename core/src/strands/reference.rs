@@ -18,7 +18,8 @@ use crate::model::document::Document;
 use crate::model::styling::StylingParams;
 use crate::strands::roots::{SampleDomain, progressive_samples};
 use crate::strands::styling::{
-    StrandStyling, StylingInput, strand_length_fraction, styling_offset_of, twist,
+    StrandStyling, StylingInput, hairline_length_scale, strand_length_fraction, styling_offset_of,
+    twist,
 };
 
 /// What to generate.
@@ -58,6 +59,9 @@ pub struct Strand {
     /// Root position on the face: bilinear `(s, t)` for quads, barycentric for triangles.
     pub coord: FaceCoord,
     pub root_uv: DVec2,
+    /// The share of its bundle's length the strand spans (length variation, strays, the
+    /// hairline); 0 for a strand that does not grow (only the runtime mirror keeps those).
+    pub length_fraction: f64,
     pub points: Vec<DVec3>,
 }
 
@@ -69,6 +73,9 @@ pub struct StrandContext<'a> {
     /// Each bundle's place among the bundles that grow hair: its block in the runtime
     /// atlas, which blocks sort by bundle (`runtime::atlas::build_atlas`).
     blocks: Vec<u32>,
+    /// Each column's root distance to the border of the hair (`geometry::hairline`); empty
+    /// when no styling uses the hairline op.
+    hairline: Vec<f64>,
 }
 
 impl<'a> StrandContext<'a> {
@@ -86,10 +93,20 @@ impl<'a> StrandContext<'a> {
                 Some(block)
             })
             .collect();
+        let styling = &document.styling;
+        let uses_hairline = std::iter::once(&styling.global)
+            .chain(styling.groups.iter().map(|g| &g.params))
+            .any(|p| p.hairline.width_m > 0.0);
+        let hairline = if uses_hairline {
+            crate::geometry::hairline::column_distances(mesh)
+        } else {
+            Vec::new()
+        };
         Self {
             document,
             frames,
             blocks,
+            hairline,
         }
     }
 
@@ -121,12 +138,27 @@ impl<'a> StrandContext<'a> {
         (u, v, w_axis, w)
     }
 
-    /// The styled strand of `bundle` rooted at `coord`, with `vertex_count ≥ 2` vertices.
-    /// `None` for a bundle that does not exist or grows no hair.
+    /// The styled strand of `bundle` rooted at `coord`, with `vertex_count ≥ 2` vertices, as
+    /// its bundle's first strand (rank 0, the last the hairline op thins away). `None` for a
+    /// bundle that does not exist or grows no hair.
     pub fn strand(
         &self,
         bundle: usize,
         coord: FaceCoord,
+        vertex_count: usize,
+        options: &StrandOptions,
+    ) -> Option<Strand> {
+        self.strand_ranked(bundle, coord, 0.0, vertex_count, options)
+    }
+
+    /// [`Self::strand`] for the root whose place in its bundle's progressive sample set is
+    /// `rank = (j + ½) / N` ([`crate::runtime::hair::sample_rank`]); `None` also where the
+    /// hairline op does not grow it.
+    pub fn strand_ranked(
+        &self,
+        bundle: usize,
+        coord: FaceCoord,
+        rank: f64,
         vertex_count: usize,
         options: &StrandOptions,
     ) -> Option<Strand> {
@@ -149,7 +181,21 @@ impl<'a> StrandContext<'a> {
         let centre = (params.twist.turns_per_m != 0.0)
             .then(|| ReferenceStrand::new(mesh, bundle, centre_coord))
             .flatten();
-        let tau_max = b.layers as f64 * strand_length_fraction(params, reference.root_uv);
+        let hairline_distance = if self.hairline.is_empty() {
+            crate::geometry::hairline::NO_BORDER_DISTANCE
+        } else {
+            b.vertices
+                .iter()
+                .zip(weights)
+                .map(|(&c, weight)| weight * self.hairline.get(c as usize).copied().unwrap_or(0.0))
+                .sum()
+        };
+        let length_fraction = strand_length_fraction(params, reference.root_uv)
+            * hairline_length_scale(params, hairline_distance, rank);
+        if length_fraction <= 0.0 {
+            return None;
+        }
+        let tau_max = b.layers as f64 * length_fraction;
         // What styling needs of this strand at every vertex, computed once.
         let strand_styling = StrandStyling::new(params, reference.root_uv);
         let vertex_count = vertex_count.max(2);
@@ -182,6 +228,7 @@ impl<'a> StrandContext<'a> {
             root: 0,
             coord,
             root_uv: reference.root_uv,
+            length_fraction,
             points,
         })
     }
@@ -239,7 +286,9 @@ impl StrandPlan {
                     s: sample.x,
                     t: sample.y,
                 };
-                let mut strand = context.strand(index, coord, self.vertex_count, &self.options)?;
+                let rank = crate::runtime::hair::sample_rank(i, self.count) as f64;
+                let mut strand =
+                    context.strand_ranked(index, coord, rank, self.vertex_count, &self.options)?;
                 // The renderers number roots by atlas block, which skips bald bundles.
                 strand.root = context.blocks[index]
                     .wrapping_mul(self.count as u32)
@@ -300,10 +349,13 @@ mod tests {
         document
     }
 
-    /// The shared every-op set without twist (twist has its own test below).
+    /// The shared every-op set without twist and the hairline (each has its own test
+    /// below): the hairline thins the 3 × 2 grid's strands, all of which lie within its
+    /// falloff.
     fn everything_but_twist() -> StylingParams {
         StylingParams {
             twist: Twist::default(),
+            hairline: crate::model::styling::Hairline::default(),
             ..StylingParams::every_op()
         }
     }
@@ -488,5 +540,71 @@ mod tests {
                 .all(|&z| z <= full + 1e-15 && z >= 0.5 * full - 1e-15)
         );
         assert!(tips.iter().any(|&z| z < 0.8 * full));
+    }
+
+    #[test]
+    fn the_hairline_thins_and_shortens_only_near_the_border() {
+        use crate::model::styling::Hairline;
+        // 8 × 8 quads of 1 cm: the centre lies 4 cm from the border.
+        let mut document = Document::new("grid", grid(8, 8, 3, 1.0));
+        for column in &mut document.hair_mesh.columns {
+            for p in &mut column.positions {
+                *p *= 0.01;
+            }
+        }
+        document.hair_mesh.update_w();
+        let options = StrandOptions {
+            strands_per_bundle: 32,
+            vertices_log2: 3,
+            ..StrandOptions::default()
+        };
+        let plain = generate(&document, &options);
+        document.styling.global.hairline = Hairline {
+            width_m: 0.015,
+            edge_density: 0.2,
+            edge_length: 0.5,
+        };
+        let thinned = generate(&document, &options);
+        assert_eq!(plain.len(), 64 * 32);
+        // The rim bundles (distance 0 … 1 cm) grow fewer, shorter strands; the 4 × 4 in the
+        // middle (every corner ≥ 2 cm in) are untouched, bit for bit.
+        let of = |strands: &[Strand], bundle: u32| -> Vec<Strand> {
+            strands
+                .iter()
+                .filter(|s| s.bundle == bundle)
+                .cloned()
+                .collect()
+        };
+        let rim = |b: u32| matches!(b % 8, 0 | 7) || matches!(b / 8, 0 | 7);
+        let middle = |b: u32| (2..6).contains(&(b % 8)) && (2..6).contains(&(b / 8));
+        let (mut rim_plain, mut rim_thinned) = (0, 0);
+        for bundle in 0..64 {
+            let (a, b) = (of(&plain, bundle), of(&thinned, bundle));
+            if middle(bundle) {
+                assert_eq!(a, b, "bundle {bundle}");
+            }
+            if rim(bundle) {
+                rim_plain += a.len();
+                rim_thinned += b.len();
+                assert!(b.iter().all(|s| s.length_fraction < 1.0), "bundle {bundle}");
+            }
+            assert!(b.iter().all(|s| s.points.iter().all(|p| p.is_finite())));
+        }
+        let share = rim_thinned as f64 / rim_plain as f64;
+        assert!(
+            (0.2..0.75).contains(&share),
+            "rim keeps {share} of its strands"
+        );
+        // Tips come closer to the root than the plain strands' where shortened.
+        let reach = |s: &Strand| s.points[0].distance(*s.points.last().expect("tip"));
+        let mean = |strands: &[Strand]| {
+            let rim: Vec<f64> = strands
+                .iter()
+                .filter(|s| rim(s.bundle))
+                .map(reach)
+                .collect();
+            rim.iter().sum::<f64>() / rim.len() as f64
+        };
+        assert!(mean(&thinned) < 0.9 * mean(&plain));
     }
 }

@@ -83,6 +83,26 @@ pub fn strand_length_fraction(params: &StylingParams, root_uv: DVec2) -> f64 {
     fraction
 }
 
+/// The hairline op's share of its length a strand keeps (0: it does not grow at all), for a
+/// root `distance` (object units) from the border of the hair and `rank = (j + ½) / N`, its
+/// sample's place in its bundle's progressive set ([`crate::model::styling::Hairline`]).
+/// Written `1 − (1 − edge)(1 − s)` so that a root `width_m` or more inside keeps exactly 1.
+/// A NaN distance counts as 0 (on the border); runtime bundles refuse non-finite texels.
+pub fn hairline_length_scale(params: &StylingParams, distance: f64, rank: f64) -> f64 {
+    let hairline = &params.hairline;
+    // Off unless a positive width (NaN too).
+    if hairline.width_m.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return 1.0;
+    }
+    let s = smoothstep(hairline.width_m, distance.max(0.0));
+    let density = 1.0 - (1.0 - hairline.edge_density.clamp(0.0, 1.0)) * (1.0 - s);
+    // Grows only below the density (a NaN rank or density grows nothing).
+    if rank.partial_cmp(&density) != Some(std::cmp::Ordering::Less) {
+        return 0.0;
+    }
+    1.0 - (1.0 - hairline.edge_length.clamp(0.0, 1.0)) * (1.0 - s)
+}
+
 fn smoothstep(edge: f64, x: f64) -> f64 {
     if edge <= 0.0 {
         return if x > 0.0 { 1.0 } else { 0.0 };
@@ -646,6 +666,64 @@ mod tests {
             roots(2000, 0.0004).all(|r| !StrandStyling::new(&params, r).stray
                 && strand_length_fraction(&params, r) == 1.0)
         );
+    }
+
+    #[test]
+    fn the_hairline_thins_evenly_and_shortens_toward_the_border() {
+        use crate::model::styling::Hairline;
+        let mut params = StylingParams::default();
+        let n = 64;
+        let ranks: Vec<f64> = (0..n).map(|j| (j as f64 + 0.5) / n as f64).collect();
+        // Off: every strand, full length, wherever it is.
+        assert!(
+            ranks
+                .iter()
+                .all(|&r| hairline_length_scale(&params, 0.0, r) == 1.0)
+        );
+        params.hairline = Hairline {
+            width_m: 0.01,
+            edge_density: 0.25,
+            edge_length: 0.4,
+        };
+        let grown_with = |params: &StylingParams, distance: f64| {
+            ranks
+                .iter()
+                .filter(|&&r| hairline_length_scale(params, distance, r) > 0.0)
+                .count()
+        };
+        let grown = |distance: f64| grown_with(&params, distance);
+        // At the border: the asked share grows (the first samples: an even cover), at the
+        // edge length.
+        assert_eq!(grown(0.0), 16);
+        assert!(
+            ranks[..16]
+                .iter()
+                .all(|&r| (hairline_length_scale(&params, 0.0, r) - 0.4).abs() < 1e-15)
+        );
+        // A width or more inside: exactly as without the op.
+        for distance in [0.01, 0.0100001, 0.5, 65504.0] {
+            assert!(
+                ranks
+                    .iter()
+                    .all(|&r| hairline_length_scale(&params, distance, r) == 1.0)
+            );
+        }
+        // In between: more strands and longer ones the further in, never fewer.
+        let mut last = (0, 0.0);
+        for i in 0..=100 {
+            let distance = 0.01 * i as f64 / 100.0;
+            let length = hairline_length_scale(&params, distance, ranks[0]);
+            assert!(grown(distance) >= last.0 && length >= last.1, "{distance}");
+            last = (grown(distance), length);
+        }
+        assert_eq!(grown(0.005), 40, "half way: (0.25 + 0.75 · ½) of 64");
+        // Negative and NaN distances count as on the border; an edge density of 0 grows
+        // nothing there.
+        assert_eq!(grown(-1.0), 16);
+        assert_eq!(grown(f64::NAN), 16);
+        let mut bare_edge = params.clone();
+        bare_edge.hairline.edge_density = 0.0;
+        assert_eq!(grown_with(&bare_edge, 0.0), 0);
     }
 
     #[test]

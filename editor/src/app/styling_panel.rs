@@ -192,6 +192,29 @@ const OPS: &[(&str, &[SliderSpec])] = &[
         ],
     ),
     (
+        "Hairline",
+        &[
+            (
+                "Hairline falloff width",
+                |p| &mut p.hairline.width_m,
+                (0.0, 0.04),
+                " m",
+            ),
+            (
+                "Hairline edge density",
+                |p| &mut p.hairline.edge_density,
+                (0.0, 1.0),
+                "",
+            ),
+            (
+                "Hairline edge length",
+                |p| &mut p.hairline.edge_length,
+                (0.0, 1.0),
+                "",
+            ),
+        ],
+    ),
+    (
         "Length",
         &[(
             "Length variation",
