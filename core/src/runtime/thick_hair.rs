@@ -110,8 +110,8 @@ impl ThickHair {
     }
 }
 
-/// A bundle's levels: `levels[0]` holds every strand alone, each next level thick hairs of
-/// about [`AREA_RATIO_PER_LEVEL`] times the members, the last one thick hair.
+/// A bundle's levels: `levels[0]` holds every grown strand alone, each next level thick hairs
+/// of about [`AREA_RATIO_PER_LEVEL`] times the members, the last one thick hair.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BundleHierarchy {
     pub levels: Vec<Vec<ThickHair>>,
@@ -174,15 +174,13 @@ pub fn build_hierarchy(
         crate::runtime::strand_gen::Filtering::Exact,
     );
     // Per block: its strands' points, and which of them grow (the hairline op leaves some at
-    // their root).
-    let mut by_block: Vec<(Vec<Vec<DVec3>>, Vec<u32>)> = Vec::new();
-    let mut last_bundle = None;
+    // their root). Blocks by root number, so a block that grows none (density 0) keeps its
+    // place and every later block its own.
+    let per_bundle = hair.strands_per_bundle.max(1) as usize;
+    let mut by_block: Vec<(Vec<Vec<DVec3>>, Vec<u32>)> =
+        vec![(Vec::new(), Vec::new()); hair.textures.atlas.blocks.len()];
     for strand in strands {
-        if last_bundle != Some(strand.bundle) {
-            by_block.push((Vec::new(), Vec::new()));
-            last_bundle = Some(strand.bundle);
-        }
-        if let Some((points, grown)) = by_block.last_mut() {
+        if let Some((points, grown)) = by_block.get_mut(strand.root as usize / per_bundle) {
             if strand.length_fraction > 0.0 {
                 grown.push(points.len() as u32);
             }
@@ -952,6 +950,47 @@ mod tests {
             moved_m > 0.01,
             "the bend moved the strands by only {moved_m} m"
         );
+    }
+
+    /// A block that grows no strand (density 0, a painted bald patch) keeps its place: the
+    /// blocks after it keep their own hierarchies, and the file loads back.
+    #[test]
+    fn a_bald_block_keeps_every_later_blocks_hierarchy() {
+        use crate::model::document::Document;
+        use crate::runtime::hair::{RuntimeHair, RuntimeOptions};
+        use crate::samples::{grid_scalp, straight_layers};
+        let scalp = grid_scalp(3, 1, |x, y| DVec3::new(x * 0.03, y * 0.01, 0.0));
+        let mut document = Document::new("grid", straight_layers(scalp, 2, DVec3::Z * 0.02));
+        document.hair_mesh.bundles[1].density = 0.0;
+        let per_bundle = 16;
+        let hair = RuntimeHair::from_document(
+            &document,
+            &RuntimeOptions {
+                strands_per_bundle: per_bundle,
+                ..RuntimeOptions::default()
+            },
+        );
+        let hierarchies = build_hierarchy(&hair, 5).expect("builds");
+        assert_eq!(hierarchies.len(), hair.textures.atlas.blocks.len());
+        assert!(hierarchies[1].levels.is_empty(), "the bald block has none");
+        assert!(
+            !hierarchies[2].levels.is_empty(),
+            "the last block keeps its own"
+        );
+        let table = FarHair::new(&hierarchies, per_bundle);
+        let grown: Vec<u32> = (0..hierarchies.len())
+            .map(|b| hair.block_strand_count(b))
+            .collect();
+        let loaded = FarHair::from_bytes(&table.to_bytes(), &grown, per_bundle).expect("loads");
+        // The file holds widths in f32.
+        assert_eq!(loaded.thick_hairs, table.thick_hairs);
+        let counts = |far: &FarHair| -> Vec<Vec<(u32, u32)>> {
+            far.blocks
+                .iter()
+                .map(|levels| levels.iter().map(|l| (l.first, l.count)).collect())
+                .collect()
+        };
+        assert_eq!(counts(&loaded), counts(&table));
     }
 
     #[test]

@@ -138,8 +138,8 @@ impl<'a> StrandContext<'a> {
         (u, v, w_axis, w)
     }
 
-    /// The styled strand of `bundle` rooted at `coord`, with `vertex_count ≥ 2` vertices, as
-    /// its bundle's first strand (rank 0, the last the hairline op thins away). `None` for a
+    /// The styled strand of `bundle` rooted at `coord`, with `vertex_count ≥ 2` vertices, at
+    /// rank 0 (it grows wherever the hairline op grows any strand: `edge_density > 0`). `None` for a
     /// bundle that does not exist or grows no hair.
     pub fn strand(
         &self,
