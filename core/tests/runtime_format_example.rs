@@ -371,8 +371,8 @@ fn example_tables() -> Vec<Table> {
         "lock_phase(x_c, 44), lock_phase(x_c, 45)",
         vec![fixed(
             &[
-                lock_phase(x_clump, params.seed, 44).to_array(),
-                lock_phase(x_clump, params.seed, 45).to_array(),
+                lock_phase(x_clump, params.seed, 44, 1.0).to_array(),
+                lock_phase(x_clump, params.seed, 45, params.wave.lock_phase_spread).to_array(),
             ]
             .concat(),
             7,
@@ -939,10 +939,10 @@ mod from_the_document {
         weighted / (total + 0.25)
     }
 
-    fn lock_phase(x: Vec2, seed: u32, k: u32) -> Vec2 {
+    fn lock_phase(x: Vec2, seed: u32, k: u32, spread: f32) -> Vec2 {
         let (mut weighted, mut total) = (Vec2::ZERO, 0.0);
         for (cx, cy, _, weight) in centres(x, seed, 40) {
-            let beta = TAU * unit(hash(&[seed, k, cx, cy]));
+            let beta = spread * TAU * unit(hash(&[seed, k, cx, cy]));
             weighted += weight * Vec2::new(beta.cos(), beta.sin());
             total += weight;
         }
@@ -1081,7 +1081,7 @@ mod from_the_document {
                 if curl.radius_m != 0.0 {
                     let own = Vec2::new((TAU * xi(1)).cos(), (TAU * xi(1)).sin());
                     let e = blend(own, curl.clump_coherence as f32, || {
-                        lock_phase(x_c, seed, 44)
+                        lock_phase(x_c, seed, 44, 1.0)
                     });
                     let psi = TAU
                         * curl.turns_per_m as f32
@@ -1140,7 +1140,7 @@ mod from_the_document {
                     let e = blend(
                         Vec2::new(phi.cos(), phi.sin()),
                         wave.clump_coherence as f32,
-                        || lock_phase(x_c, seed, 45),
+                        || lock_phase(x_c, seed, 45, wave.lock_phase_spread as f32),
                     );
                     let psi = TAU * wave.frequency_per_m as f32 * w;
                     let s = e.x * psi.sin() + e.y * psi.cos();

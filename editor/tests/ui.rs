@@ -79,7 +79,7 @@ fn a_styling_slider_change_is_one_undo_step() {
 fn the_styling_structure_ops_have_sliders() {
     let mut harness = harness();
     type Read = fn(&hairloom_core::model::styling::StylingParams) -> f64;
-    let sliders: [(&str, f64, Read); 7] = [
+    let sliders: [(&str, f64, Read); 8] = [
         ("Ringlets (curl shared by a clump)", 0.7, |p| {
             p.curl.clump_coherence
         }),
@@ -88,6 +88,9 @@ fn the_styling_structure_ops_have_sliders() {
         ("Hairline falloff width", 0.012, |p| p.hairline.width_m),
         ("Hairline edge density", 0.2, |p| p.hairline.edge_density),
         ("Hairline edge length", 0.4, |p| p.hairline.edge_length),
+        ("Wave spread between clumps", 0.25, |p| {
+            p.wave.lock_phase_spread
+        }),
         ("Wave shared by a clump", 0.35, |p| p.wave.clump_coherence),
     ];
     for (i, (label, value, read)) in sliders.into_iter().enumerate() {

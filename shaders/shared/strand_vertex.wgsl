@@ -80,9 +80,9 @@ struct Styling {
     hairline_width_m: f32,
     hairline_edge_density: f32,
     hairline_edge_length: f32,
+    wave_lock_phase_spread: f32,
     _padding0: u32,
     _padding1: u32,
-    _padding2: u32,
 }
 
 // Mirror: SLICES_PER_SEGMENT in core/src/runtime/textures.rs (p_k, q0, q1 per segment).
@@ -260,7 +260,7 @@ fn clump_pull(x: vec2<f32>, seed: u32, channel: u32) -> vec2<f32> {
 }
 
 // Mirror: styling::lock_phase (the main clump lattice's centres).
-fn lock_phase(x: vec2<f32>, seed: u32, channel: u32) -> vec2<f32> {
+fn lock_phase(x: vec2<f32>, seed: u32, channel: u32, spread: f32) -> vec2<f32> {
     let cell = floor(x);
     var weighted = vec2<f32>(0.0);
     var total = 0.0;
@@ -270,7 +270,7 @@ fn lock_phase(x: vec2<f32>, seed: u32, channel: u32) -> vec2<f32> {
             let d = clump_centre(c, seed, CLUMP_CHANNEL) - x;
             let k = max(1.0 - dot(d, d), 0.0);
             let angle = hash_to_unit(hash4(seed, channel, cell_index(c.x), cell_index(c.y)));
-            weighted += k * k * unit_phase(TURN_RAD * angle);
+            weighted += k * k * unit_phase(spread * TURN_RAD * angle);
             total += k * k;
         }
     }
@@ -319,7 +319,7 @@ fn strand_constants(s: Styling, root_uv: vec2<f32>) -> StrandConstants {
             c.curl_phase = blend_phase(
                 c.curl_phase,
                 s.curl_clump_coherence,
-                lock_phase(lock_uv, s.seed, 44u),
+                lock_phase(lock_uv, s.seed, 44u, 1.0),
             );
         }
         c.curl_radius_m = s.curl_radius_m
@@ -347,7 +347,7 @@ fn strand_constants(s: Styling, root_uv: vec2<f32>) -> StrandConstants {
             c.wave_phase = blend_phase(
                 c.wave_phase,
                 s.wave_clump_coherence,
-                lock_phase(lock_uv, s.seed, 45u),
+                lock_phase(lock_uv, s.seed, 45u, s.wave_lock_phase_spread),
             );
         }
     }

@@ -15,7 +15,9 @@ pub use crate::runtime::hair::LodEntry;
 use crate::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 
-/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 6
+/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 7
+/// adds `wave.lock_phase_spread` (how far apart the locks' wave phases lie; absent means 1,
+/// the phases older bundles had; a version 6 reader would draw other waves). Version 6
 /// adds the hairline op: the `hairline` styling keys and each root's distance to the border
 /// of the hair in the hair-mesh root slice's fourth channel (0 before); a version 5 reader
 /// would grow every strand at full length. Version 5 adds styling ops (sub-clumps, strays, ringlet and lock-wave phases, curl tip scales): a
@@ -25,7 +27,7 @@ use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, T
 /// segment (`p_k, q0, q1`); version 1 stored the quadratics' joint `m` too (4 slices). All
 /// are read (version 1's `m` slices are dropped on load: `m` is exactly `(q0 + q1) / 2`;
 /// bundles before version 3 have no far hair).
-pub const RUNTIME_FORMAT_VERSION: u32 = 6;
+pub const RUNTIME_FORMAT_VERSION: u32 = 7;
 /// Hair-mesh slices per segment in format version 1 bundles.
 const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
@@ -1605,7 +1607,7 @@ mod tests {
                         .expect("a bundle")
                         .remove("columns");
                 }),
-                "bundles[0] has no columns (format_version 6 needs them)",
+                "bundles[0] has no columns (format_version 7 needs them)",
             ),
             (
                 Box::new(|m| {

@@ -137,7 +137,10 @@ impl Default for Frizz {
 /// `ramp(w) · amplitude_m · Im(e · exp(i 2π · frequency_per_m · w)) · d`, with
 /// `d = cos α û + sin α v̂` (`α` = `direction_rad`) and the phase `e` the unit vector of
 /// angle `phase_spread · 2π ξ₈`, blended toward its lock's phase by `clump_coherence` (the
-/// strands of a lock wave together, locks apart: waves that read from the front).
+/// strands of a lock wave together: waves that read from the front). The locks' own phases
+/// lie within `lock_phase_spread` of a cycle: at 1 every lock waves on its own (a patchwork
+/// of crests whose highlights break up into blotches), small values keep neighbouring locks
+/// nearly in step so the crests, and their highlights, run as bands across the head.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Wave {
@@ -149,6 +152,9 @@ pub struct Wave {
     pub ramp_in_m: f64,
     /// 0: the phase above; 1: every strand of a lock takes its lock's phase.
     pub clump_coherence: f64,
+    /// How far apart the locks' phases lie, as a share of a cycle: 0 all locks in step, 1
+    /// any phase (the default, which documents made before this field keep).
+    pub lock_phase_spread: f64,
 }
 
 impl Default for Wave {
@@ -160,6 +166,7 @@ impl Default for Wave {
             phase_spread: 0.15,
             ramp_in_m: 0.03,
             clump_coherence: 0.0,
+            lock_phase_spread: 1.0,
         }
     }
 }
@@ -365,6 +372,7 @@ impl StylingSet {
                 ("wave.phase_spread", p.wave.phase_spread),
                 ("wave.ramp_in_m", p.wave.ramp_in_m),
                 ("wave.clump_coherence", p.wave.clump_coherence),
+                ("wave.lock_phase_spread", p.wave.lock_phase_spread),
                 ("length.fraction", p.length.fraction),
                 ("stray.fraction", p.stray.fraction),
                 ("stray.amplitude_m", p.stray.amplitude_m),
@@ -442,6 +450,7 @@ pub const HARD_RANGES: &[(&str, f64, f64)] = &[
     ("wave.phase_spread", 0.0, 1.0),
     ("wave.ramp_in_m", 0.0, 10.0),
     ("wave.clump_coherence", 0.0, 1.0),
+    ("wave.lock_phase_spread", 0.0, 1.0),
     ("length.fraction", 0.0, 1.0),
     ("stray.fraction", 0.0, 1.0),
     ("stray.amplitude_m", 0.0, 0.5),

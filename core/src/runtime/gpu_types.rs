@@ -177,7 +177,8 @@ pub struct StylingGpu {
     pub hairline_width_m: f32,
     pub hairline_edge_density: f32,
     pub hairline_edge_length: f32,
-    pub _padding: [u32; 3],
+    pub wave_lock_phase_spread: f32,
+    pub _padding: [u32; 2],
 }
 
 impl From<&crate::model::styling::StylingParams> for StylingGpu {
@@ -220,7 +221,8 @@ impl From<&crate::model::styling::StylingParams> for StylingGpu {
             hairline_width_m: p.hairline.width_m.max(0.0) as f32,
             hairline_edge_density: p.hairline.edge_density.clamp(0.0, 1.0) as f32,
             hairline_edge_length: p.hairline.edge_length.clamp(0.0, 1.0) as f32,
-            _padding: [0; 3],
+            wave_lock_phase_spread: p.wave.lock_phase_spread.clamp(0.0, 1.0) as f32,
+            _padding: [0; 2],
         }
     }
 }

@@ -575,8 +575,11 @@ pub(crate) fn head_style(name: &str) -> StylingParams {
                 direction_rad: 0.0,
                 phase_spread: 0.1,
                 ramp_in_m: 0.05,
-                // Each lock waves as one, neighbouring locks apart.
+                // Each lock waves as one, a little out of step with its neighbours: the
+                // crests (and the highlights on them) run as bands across the head, broken
+                // at the locks. Locks at any phase drew a patchwork of pale blotches.
                 clump_coherence: 0.9,
+                lock_phase_spread: 0.2,
             },
             ..base
         },
@@ -628,6 +631,13 @@ pub(crate) fn head_material(name: &str) -> HairMaterial {
                 eumelanin: 0.2,
                 pheomelanin: 0.9,
             },
+            ..base
+        },
+        // Medium brown, smoother than the default: the waves tilt the fibres through the
+        // primary highlight's angle, and a narrow lobe keeps it on the crests as bands (at
+        // 0.3 it greyed most of the back).
+        "head_long_wavy" => HairMaterial {
+            longitudinal_roughness: 0.2,
             ..base
         },
         // Light brown.

@@ -169,7 +169,7 @@ impl StrandStyling {
         if curl.radius_m != 0.0 {
             let own = unit_phase(TAU * xi(1));
             strand.curl_phase = blend_phase(own, curl.clump_coherence, || {
-                lock_phase(lock_uv, params.seed, 44)
+                lock_phase(lock_uv, params.seed, 44, 1.0)
             });
             strand.curl_radius_m = curl.radius_m * (1.0 + curl.radius_jitter * (2.0 * xi(2) - 1.0));
         }
@@ -197,7 +197,7 @@ impl StrandStyling {
         if wave.amplitude_m != 0.0 {
             let own = unit_phase(wave.phase_spread * TAU * xi(8));
             strand.wave_phase = blend_phase(own, wave.clump_coherence, || {
-                lock_phase(lock_uv, params.seed, 45)
+                lock_phase(lock_uv, params.seed, 45, wave.lock_phase_spread)
             });
         }
         // A stray cell's strands drift as one wisp: direction and key are constant over
@@ -347,15 +347,16 @@ pub fn clump_pull_on(x: DVec2, seed: u32, channel: u32) -> DVec2 {
 }
 
 /// A lock's phase at `x` (clump-cell units of the main clump lattice): every clump centre
-/// draws an angle `2π unit(hash(seed, channel, cx, cy))` and the strand reads their
+/// draws an angle `spread · 2π unit(hash(seed, channel, cx, cy))` and the strand reads their
 /// kernel-weighted average `Σ K_i (cos, sin)_i / (Σ K_i + ¼)`, with the clump pull's weights
-/// — continuous, and near a centre close to that centre's own angle. Channels: 44 curl,
-/// 45 wave.
-pub fn lock_phase(x: DVec2, seed: u32, channel: u32) -> DVec2 {
+/// — continuous, and near a centre close to that centre's own angle. Channels: 44 curl
+/// (spread 1: every ringlet its own), 45 wave (`wave.lock_phase_spread`).
+pub fn lock_phase(x: DVec2, seed: u32, channel: u32, spread: f64) -> DVec2 {
     let mut weighted = DVec2::ZERO;
     let mut total = 0.0;
     for_each_centre(x, seed, CLUMP_CHANNEL, |(ix, iy), _, k| {
-        weighted += k * unit_phase(TAU * hash_to_unit(hash_values(&[seed, channel, ix, iy])));
+        let unit = hash_to_unit(hash_values(&[seed, channel, ix, iy]));
+        weighted += k * unit_phase(spread * TAU * unit);
         total += k;
     });
     weighted / (total + 0.25)
@@ -571,18 +572,53 @@ mod tests {
         assert!(far > 0.8, "locks apart share a phase: {far}");
     }
 
+    /// `wave.lock_phase_spread` decides how far apart locks wave: at 0 every lock is in step
+    /// (crests run as bands across the head), at 1 each lock has any phase; a document that
+    /// predates the field reads 1, the phases it had.
+    #[test]
+    fn wave_lock_phase_spread_keeps_locks_in_step() {
+        let mut params = StylingParams::default();
+        params.wave.amplitude_m = 0.005;
+        params.wave.phase_spread = 0.0;
+        params.wave.clump_coherence = 1.0;
+        params.clump.clumps_per_uv = 10.0;
+        let apart = |spread: f64| {
+            let mut params = params.clone();
+            params.wave.lock_phase_spread = spread;
+            roots(500, 0.0037)
+                .map(|root| {
+                    let a = StrandStyling::new(&params, root);
+                    let b = StrandStyling::new(&params, root + DVec2::new(0.3, 0.2));
+                    // Directions: the blend shrinks where the lock kernel is weak.
+                    let (a, b) = (a.wave_phase.normalize(), b.wave_phase.normalize());
+                    a.distance(b)
+                })
+                .sum::<f64>()
+                / 500.0
+        };
+        let (step, near, free) = (apart(0.0), apart(0.2), apart(1.0));
+        assert!(step < 1e-9, "in step: {step}");
+        // Angles within a fifth of a cycle: chords under 2 sin(π/5) ≈ 1.18, mostly far less.
+        assert!(near > 0.05 && near < 0.5, "a fifth of a cycle: {near}");
+        assert!(free > 0.8, "any phase: {free}");
+        let old: crate::model::styling::Wave =
+            serde_json::from_str(r#"{"amplitude_m": 0.01, "clump_coherence": 0.9}"#)
+                .expect("a wave without the field parses");
+        assert_eq!(old.lock_phase_spread, 1.0);
+    }
+
     #[test]
     fn lock_phase_is_continuous_and_blends_to_unit_length() {
-        let mut last = lock_phase(DVec2::new(3.0, 5.0), 1, 44);
+        let mut last = lock_phase(DVec2::new(3.0, 5.0), 1, 44, 1.0);
         for i in 1..=4000 {
             let x = DVec2::new(3.0 + i as f64 * 0.001, 5.0 + i as f64 * 0.0007);
-            let phase = lock_phase(x, 1, 44);
+            let phase = lock_phase(x, 1, 44, 1.0);
             assert!(phase.distance(last) < 0.02, "jump at {x}");
             assert!(phase.length() < 1.0);
             last = phase;
         }
         // The blend is continuous too, shrinking only where own and lock phases cancel.
-        let blend = |x: DVec2| blend_phase(DVec2::X, 0.7, || lock_phase(x, 1, 44));
+        let blend = |x: DVec2| blend_phase(DVec2::X, 0.7, || lock_phase(x, 1, 44, 1.0));
         let mut last = blend(DVec2::new(3.0, 5.0));
         for i in 1..=4000 {
             let x = DVec2::new(3.0 + i as f64 * 0.001, 5.0 + i as f64 * 0.0007);

@@ -165,6 +165,12 @@ const OPS: &[(&str, &[SliderSpec])] = &[
                 (0.0, 1.0),
                 "",
             ),
+            (
+                "Wave spread between clumps",
+                |p| &mut p.wave.lock_phase_spread,
+                (0.0, 1.0),
+                "",
+            ),
         ],
     ),
     (
