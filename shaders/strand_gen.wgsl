@@ -50,7 +50,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = max(run.vertex_count, 2u);
     let local = strand - run_start(run, RUN_BY_STRAND);
     let base = run.vertex_offset + local * n;
-    let input = strand_input(run.first_root + local, run.thickness);
+    let input = strand_input(run.first_root + local);
     var previous = styled_vertex(input, 0u, n);
     positions[base] = vec4<f32>(previous, 0.0);
     for (var k = 1u; k < n; k += 2u) {
@@ -82,7 +82,7 @@ fn main_per_vertex(@builtin(global_invocation_id) id: vec3<u32>) {
     let local = vertex - run.vertex_offset;
     let strand = local / n;
     let k = local % n;
-    let input = strand_input(run.first_root + strand, run.thickness);
+    let input = strand_input(run.first_root + strand);
     let p = morphed_vertex(input, k, n, run.gamma);
     positions[vertex] = vec4<f32>(p, along_of(k, n));
 }
@@ -113,10 +113,10 @@ fn thick_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let hair = thick_hairs[thick.first + t];
     let n = max(thick.vertex_count, 2u);
     let base = thick.output_offset + t * n;
-    let a = strand_input(hair.corners.x, 1.0);
-    let b = strand_input(hair.corners.y, 1.0);
-    let c = strand_input(hair.corners.z, 1.0);
-    let d = strand_input(hair.corners.w, 1.0);
+    let a = strand_input(hair.corners.x);
+    let b = strand_input(hair.corners.y);
+    let c = strand_input(hair.corners.z);
+    let d = strand_input(hair.corners.w);
     for (var k = 0u; k < n; k++) {
         let pa = styled_vertex(a, k, n);
         let pb = styled_vertex(b, k, n);

@@ -169,7 +169,7 @@ fn ms_main(
         mesh_out.primitive_count = 2u * strands * (chunk - 1u);
     }
     if in_group && j == 0u {
-        mesh_inputs[slot] = strand_input(run.first_root + strand, run.thickness);
+        mesh_inputs[slot] = strand_input(run.first_root + strand);
     }
     workgroupBarrier();
     if in_group {

@@ -15,32 +15,13 @@ use hairloom_render::renderer::strand_gen::{GpuHair, StrandGenRenderer, full_det
 
 const VERTICES: u32 = 33;
 
-/// The long sample without its hairline op (see [`without_hairline`]).
-fn sample_document() -> hairloom_core::model::document::Document {
-    without_hairline(common::sample("head_long_wavy"))
-}
-
-/// LHS skins strands bound once at full detail, so a LOD run draws its first share with
-/// their full-detail hairline ranks; generation ranks a LOD run's strands among those it
-/// draws (`strand_input`'s thickness), so the hairline keeps its thinning from afar. That is
-/// a property of generation, not of the baseline: the pictures are compared without it.
-fn without_hairline(
-    mut document: hairloom_core::model::document::Document,
-) -> hairloom_core::model::document::Document {
-    document.styling.global.hairline.width_m = 0.0;
-    for group in &mut document.styling.groups {
-        group.params.hairline.width_m = 0.0;
-    }
-    document
-}
-
 /// The long sample's runtime hair at `per_bundle` strands a bundle, uploaded, and its
 /// strands generated on the GPU at full detail, bound to 2 % of them as guides.
 fn skinned_sample(
     context: &GpuContext,
     per_bundle: u32,
 ) -> (RuntimeHair, StrandGenRenderer, GpuHair, SkinnedHair) {
-    let document = sample_document();
+    let document = common::sample("head_long_wavy");
     let runtime = RuntimeHair::from_document(
         &document,
         &RuntimeOptions {
@@ -161,7 +142,7 @@ fn a_skinned_frame_at_rest_draws_the_generated_picture() {
     let (runtime, generator, hair, skinned) = skinned_sample(&context, 12);
     let skinner = LinearHairSkinningRenderer::new(&context);
     let gpu = skinner.upload(&context, &skinned).expect("upload");
-    let document = sample_document();
+    let document = common::sample("head_long_wavy");
     let body = GpuBody::upload(&context, &document.body);
     let (lo, hi) = runtime.textures.hair_bounds().expect("hair");
     let preview = PreviewRenderer::new(&context);

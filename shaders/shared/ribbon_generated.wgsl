@@ -26,7 +26,7 @@ fn ribbon_centre(vertex_index: u32, instance_index: u32) -> RibbonCentre {
     let n = max(run.vertex_count, 2u);
     let strand = instance_index - run_start(run, RUN_BY_STRAND);
     let k = min(vertex_index / 2u, n - 1u);
-    let input = strand_input(run.first_root + strand, run.thickness);
+    let input = strand_input(run.first_root + strand);
     var out: RibbonCentre;
     if n == 2u {
         let a = styled_vertex(input, 0u, n);

@@ -510,10 +510,8 @@ struct StrandInput {
     constants: StrandConstants,
 }
 
-// What every vertex of root `root_index`'s strand shares (mirror: StrandGen::strand_input_at).
-// `thickness` is its run's LOD thickness factor (min(1/L, N), 1 at full detail): the hairline
-// op ranks the strand among those LOD draws, so the drawn share keeps its thinning.
-fn strand_input(root_index: u32, thickness: f32) -> StrandInput {
+// What every vertex of root `root_index`'s strand shares (mirror: StrandGen::strand_input).
+fn strand_input(root_index: u32) -> StrandInput {
     let root = strand_root(root_index);
     var style_index = root.styling;
     if style_index >= arrayLength(&styling) {
@@ -528,7 +526,7 @@ fn strand_input(root_index: u32, thickness: f32) -> StrandInput {
     // (always exact: it decides whether the strand grows).
     let hairline_distance = fetch_exact(hair_mesh, vec3<f32>(root.texel, 0.5)).w;
     input.length_fraction = strand_length_fraction(input.style, input.root_uv)
-        * hairline_length_scale(input.style, hairline_distance, root.rank * max(thickness, 1.0));
+        * hairline_length_scale(input.style, hairline_distance, root.rank);
     input.constants = strand_constants(input.style, input.root_uv);
     return input;
 }

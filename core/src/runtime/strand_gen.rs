@@ -169,19 +169,6 @@ impl StrandGen<'_> {
         root: &StrandRoot,
         params: &'p StylingParams,
     ) -> StrandInput<'p> {
-        self.strand_input_at(root, params, 1.0)
-    }
-
-    /// [`Self::strand_input`] in a run drawn with LOD thickness factor `thickness`
-    /// (`min(1/L, N)`, 1 at full detail; mirror: `strand_input`'s second argument): the
-    /// hairline op ranks the strand among the strands LOD draws, `rank · thickness` in f32,
-    /// so the drawn share keeps the hairline's thinning.
-    pub fn strand_input_at<'p>(
-        &self,
-        root: &StrandRoot,
-        params: &'p StylingParams,
-        thickness: f32,
-    ) -> StrandInput<'p> {
         let texel = Vec2::from_array(root.texel);
         let root_uv = fetch(&self.textures.uv, texel.extend(0.5), Filtering::Exact)
             .truncate()
@@ -200,11 +187,7 @@ impl StrandGen<'_> {
             params,
             root_uv,
             length_fraction: strand_length_fraction(params, root_uv)
-                * hairline_length_scale(
-                    params,
-                    hairline_distance,
-                    (root.rank * thickness.max(1.0)) as f64,
-                ),
+                * hairline_length_scale(params, hairline_distance, root.rank as f64),
             styling: StrandStyling::new(params, root_uv),
         }
     }
@@ -285,11 +268,8 @@ impl StrandGen<'_> {
             for strand in 0..run.strand_count {
                 let root = &roots[(run.first_root + strand) as usize];
                 let params = params_of(root, styling, &default);
-                let input = self.strand_input_at(root, params, run.thickness);
-                let n = (run.vertex_count as usize).max(2);
-                let mut points: Vec<DVec3> = (0..n)
-                    .map(|k| self.styled_vertex(&input, k, n).as_dvec3())
-                    .collect();
+                let points = self.styled_strand(root, run.vertex_count as usize, params);
+                let mut points: Vec<DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
                 crate::strands::lod::morph_odd_vertices(&mut points, run.gamma as f64);
                 out.extend(points.iter().map(|p| p.as_vec3()));
             }
@@ -521,60 +501,6 @@ mod tests {
                     assert!(worst < 3.0 * 1.6 / 512.0, "hardware: {worst}");
                 }
             }
-        }
-    }
-
-    /// LOD keeps the hairline: a run that draws a share `L` of a bundle's strands (thickness
-    /// `1/L`) grows the same share of them near the border as full detail grows of all.
-    #[test]
-    fn lod_runs_keep_the_hairline_thinning() {
-        use crate::model::document::Document;
-        use crate::model::styling::Hairline;
-        use crate::runtime::hair::{RuntimeHair, RuntimeOptions};
-        use crate::samples::{grid_scalp, straight_layers};
-        // One row of quads: every root lies on the border (the edge density grows).
-        let scalp = grid_scalp(6, 1, |x, y| DVec3::new(x * 0.06, y * 0.01, 0.0));
-        let mut document = Document::new("row", straight_layers(scalp, 2, DVec3::Z * 0.02));
-        document.styling.global.hairline = Hairline {
-            width_m: 0.02,
-            edge_density: 0.2,
-            edge_length: 0.5,
-        };
-        let per_bundle = 256;
-        let hair = RuntimeHair::from_document(
-            &document,
-            &RuntimeOptions {
-                strands_per_bundle: per_bundle,
-                ..RuntimeOptions::default()
-            },
-        );
-        let generator = StrandGen {
-            textures: &hair.textures,
-            filtering: Filtering::Exact,
-        };
-        let params = &document.styling.global;
-        let roots = hair.strand_roots();
-        let share = |drawn: usize, thickness: f32| {
-            let grown = roots
-                .chunks(per_bundle as usize)
-                .flat_map(|bundle| &bundle[..drawn])
-                .filter(|root| {
-                    generator
-                        .strand_input_at(root, params, thickness)
-                        .length_fraction
-                        > 0.0
-                })
-                .count();
-            grown as f64 / (drawn * roots.len() / per_bundle as usize) as f64
-        };
-        let full = share(per_bundle as usize, 1.0);
-        assert!((0.15..0.25).contains(&full), "{full}");
-        for level in [0.5f32, 0.25, 0.125] {
-            let drawn = (level * per_bundle as f32) as usize;
-            let lod = share(drawn, 1.0 / level);
-            assert!((lod - full).abs() < 0.1, "L {level}: {lod} against {full}");
-            // Without the thickness, the drawn prefix would nearly all grow.
-            assert!(share(drawn, 1.0) > full + 0.1 || level == 0.5);
         }
     }
 }
