@@ -19,7 +19,91 @@ pub fn seeds(target: Target) -> Vec<(String, Vec<u8>)> {
         Target::RuntimeBundle => bundle_seeds(),
         Target::Ktx2 => ktx2_seeds(),
         Target::StrandExport => strand_export_seeds(),
+        Target::GroomIn => groom_seeds(),
     }
+}
+
+/// Issue 36: grooms as other tools hand them over — our own exports of the grid project in
+/// every groom format (Alembic for Blender and Unreal, USD, cyHair) — and crafted files that
+/// claim more than they hold, reach outside their folder or break the formats' structure.
+fn groom_seeds() -> Vec<(String, Vec<u8>)> {
+    use crate::targets::groom_input;
+    use hairloom_core::io::alembic::{AlembicTarget, groom::Groom, groom_file};
+    use hairloom_core::io::strand_files::{ScalpMesh, StrandLook, hair_file, usda_file};
+    use hairloom_core::strands::reference::{StrandOptions, generate};
+    let projects = project_seeds();
+    let project = hairloom_core::io::project::from_bytes(
+        &projects[0].1,
+        std::path::Path::new("grid.hairloom"),
+    )
+    .expect("the grid project loads");
+    let document = &project.document;
+    let strands = generate(
+        document,
+        &StrandOptions {
+            strands_per_bundle: 4,
+            vertices_log2: 2,
+            ..StrandOptions::default()
+        },
+    );
+    let look = StrandLook::new(&strands, 1e-4, &document.scene.material);
+    let hair = hair_file(&strands, &look);
+    let usda = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), &look);
+    let groom = Groom::new(document, &strands, 1e-4);
+    let abc = |target| groom_file(&groom, target).expect("the grid's groom writes");
+    let blender = abc(AlembicTarget::Blender);
+    let mut seeds = vec![
+        ("grid.hair".to_string(), groom_input("hair", &hair)),
+        ("grid_blender.abc".into(), groom_input("abc", &blender)),
+        (
+            "grid_unreal.abc".into(),
+            groom_input("abc", &abc(AlembicTarget::Unreal)),
+        ),
+        ("grid.usda".into(), groom_input("usda", usda.as_bytes())),
+    ];
+    // cyHair: a header that claims 2³¹ strands of 2¹⁶ points over an empty body.
+    let mut claims = hair[..128.min(hair.len())].to_vec();
+    claims[4..8].copy_from_slice(&(1u32 << 31).to_le_bytes());
+    claims[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+    seeds.push((
+        "crafted_hair_claims_2e31_strands.hair".into(),
+        groom_input("hair", &claims),
+    ));
+    // Alembic cut in half: offsets that point past the end.
+    seeds.push((
+        "crafted_abc_truncated.abc".into(),
+        groom_input("abc", &blender[..blender.len() / 2]),
+    ));
+    // USD: a stage whose only hair is a reference outside the groom's folder (the resolver
+    // refuses it: no curves), and curve counts past the caps.
+    let outside = "#usda 1.0\ndef \"Root\" (\n    references = @../../../etc/hair.usda@\n)\n{\n}\n";
+    seeds.push((
+        "crafted_usda_reference_outside_folder.usda".into(),
+        groom_input("usda", outside.as_bytes()),
+    ));
+    // What the target found: a prim name and a path with a brace (the library recursed
+    // without end on the one and looped on the other).
+    seeds.push((
+        "crafted_usda_prim_name_with_brace.usda".into(),
+        groom_input("usda", b"#usda 1.0\ndef \"}\nRoot\" (\n)\n{\n}\n"),
+    ));
+    seeds.push((
+        "crafted_usda_path_with_brace.usda".into(),
+        groom_input(
+            "usda",
+            b"#usda 1.0\ndef \"Root\" (\n    references = </}A>\n)\n{\n}\n",
+        ),
+    ));
+    let huge = usda.replacen(
+        "int[] curveVertexCounts = [",
+        "int[] curveVertexCounts = [2147483647, 2147483647, ",
+        1,
+    );
+    seeds.push((
+        "crafted_usda_counts_2e31.usda".into(),
+        groom_input("usda", huge.as_bytes()),
+    ));
+    seeds
 }
 
 /// Issue "Nothing lost, nothing blocked": exports at every documented maximum (4096

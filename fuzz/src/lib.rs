@@ -99,7 +99,13 @@ pub fn run(target: Target, seeds: &[Vec<u8>], budget: Budget, rng_seed: u64) -> 
             }
         }));
     }
+    // An abort (stack overflow, out of memory) cannot be caught: with this set, each input
+    // is written there before it runs, so the one that killed the process is left behind.
+    let current = std::env::var_os("HAIRLOOM_FUZZ_CURRENT").map(PathBuf::from);
     let one = |input: &[u8], report: &mut Report| {
+        if let Some(path) = &current {
+            let _ = std::fs::write(path, input);
+        }
         let start = Instant::now();
         let result = std::panic::catch_unwind(AssertUnwindSafe(|| target.run(input)));
         report.slowest = report.slowest.max(start.elapsed());

@@ -24,15 +24,21 @@ pub enum Target {
     /// bytes pick, up to and past the documented maxima (see [`strand_export_input`]):
     /// refused by the cap with its size, or generated and written in every format.
     StrandExport,
+    /// `io::groom_in`'s readers (cyHair `.hair`, Alembic, USD text and crate files) under
+    /// small caps: the first byte picks the format (see [`groom_input`]), the rest is the
+    /// file. A groom read without error must keep the readers' promises (see
+    /// [`check_groom`]): the fit indexes by them.
+    GroomIn,
 }
 
 impl Target {
-    pub const ALL: [Target; 5] = [
+    pub const ALL: [Target; 6] = [
         Target::ProjectLoad,
         Target::GltfImport,
         Target::RuntimeBundle,
         Target::Ktx2,
         Target::StrandExport,
+        Target::GroomIn,
     ];
 
     pub fn name(self) -> &'static str {
@@ -42,6 +48,7 @@ impl Target {
             Target::RuntimeBundle => "runtime_bundle",
             Target::Ktx2 => "ktx2",
             Target::StrandExport => "strand_export",
+            Target::GroomIn => "groom_in",
         }
     }
 
@@ -56,6 +63,7 @@ impl Target {
             Target::RuntimeBundle => runtime_bundle(input),
             Target::Ktx2 => ktx2(input),
             Target::StrandExport => strand_export(input),
+            Target::GroomIn => groom_in(input),
         }
     }
 }
@@ -190,6 +198,123 @@ fn strand_export(input: &[u8]) {
     let groom = Groom::new(document, &strands, 1e-4);
     for target in AlembicTarget::ALL {
         let _ = groom_file(&groom, target);
+    }
+}
+
+/// The groom formats a [`Target::GroomIn`] input's first byte picks (modulo their count),
+/// by the extension the reader is given.
+pub const GROOM_EXTENSIONS: [&str; 4] = ["hair", "abc", "usda", "usdc"];
+
+/// A groom fuzz input: the format (an extension of [`GROOM_EXTENSIONS`]) before the file.
+pub fn groom_input(extension: &str, file: &[u8]) -> Vec<u8> {
+    let pick = GROOM_EXTENSIONS
+        .iter()
+        .position(|&e| e == extension)
+        .expect("a groom extension the target knows");
+    let mut input = vec![pick as u8];
+    input.extend_from_slice(file);
+    input
+}
+
+/// Caps small enough that an input claiming the most a cap allows still runs in
+/// milliseconds; the checks are the same code as at the default caps.
+const FUZZ_GROOM_LIMITS: hairloom_core::io::groom_in::GroomLimits =
+    hairloom_core::io::groom_in::GroomLimits {
+        max_file_bytes: 1 << 20,
+        max_curves: 4096,
+        max_points: 1 << 16,
+        max_points_per_curve: 1024,
+    };
+
+fn groom_in(input: &[u8]) {
+    if let Some(Ok(groom)) = read_groom_input(input) {
+        check_groom(&groom, FUZZ_GROOM_LIMITS);
+    }
+}
+
+/// Reads a [`Target::GroomIn`] input with its format's reader under the fuzz caps (`None`
+/// for an empty input or a USD file that could not be written).
+pub fn read_groom_input(
+    input: &[u8],
+) -> Option<
+    Result<hairloom_core::io::groom_in::InputGroom, hairloom_core::io::groom_in::GroomReadError>,
+> {
+    use hairloom_core::io::groom_in::{alembic, hair, usd};
+    use std::ops::ControlFlow;
+    let (&pick, file) = input.split_first()?;
+    let extension = GROOM_EXTENSIONS[pick as usize % GROOM_EXTENSIONS.len()];
+    let name = std::path::PathBuf::from(format!("fuzz.{extension}"));
+    let mut progress = |_| ControlFlow::Continue(());
+    let read = match extension {
+        "hair" => hair::parse(&name, file, FUZZ_GROOM_LIMITS, &mut progress),
+        "abc" => alembic::parse(&name, file.to_vec(), FUZZ_GROOM_LIMITS, &mut progress),
+        _ => {
+            // The USD library opens files itself: the input goes into a folder of its own.
+            let folder = groom_folder();
+            let path = folder.join(&name);
+            std::fs::write(&path, file).ok()?;
+            usd::read(&path, FUZZ_GROOM_LIMITS, &mut progress)
+        }
+    };
+    Some(read)
+}
+
+/// This process's folder for USD inputs (one file at a time: runs are sequential).
+fn groom_folder() -> &'static std::path::Path {
+    static FOLDER: OnceLock<std::path::PathBuf> = OnceLock::new();
+    FOLDER.get_or_init(|| {
+        let folder =
+            std::env::temp_dir().join(format!("hairloom-fuzz-groom-{}", std::process::id()));
+        std::fs::create_dir_all(&folder).expect("a temporary folder for USD inputs");
+        folder
+    })
+}
+
+/// What every groom reader promises of a groom it returns, asserted (a failure is a
+/// finding): curves of 2 or more points within the caps, finite points, and per-point
+/// widths and per-curve uvs and groups that match the counts.
+pub fn check_groom(
+    groom: &hairloom_core::io::groom_in::InputGroom,
+    limits: hairloom_core::io::groom_in::GroomLimits,
+) {
+    let starts = &groom.starts;
+    assert_eq!(starts.first(), Some(&0), "curves start at point 0");
+    assert_eq!(
+        starts.last().map(|&s| s as usize),
+        Some(groom.points.len()),
+        "the last curve ends at the last point"
+    );
+    assert!(
+        starts
+            .windows(2)
+            .all(|w| w[1] >= w[0] + 2 && u64::from(w[1] - w[0]) <= limits.max_points_per_curve),
+        "every curve has 2 to max_points_per_curve points"
+    );
+    let curves = groom.curve_count();
+    assert!(
+        curves >= 1 && curves as u64 <= limits.max_curves,
+        "{curves} curves"
+    );
+    assert!(
+        groom.points.len() as u64 <= limits.max_points,
+        "points over the cap"
+    );
+    assert!(
+        groom.points.iter().flatten().all(|c| c.is_finite()),
+        "a point is not finite"
+    );
+    if let Some(widths) = &groom.widths_m {
+        assert_eq!(widths.len(), groom.points.len(), "a width per point");
+        assert!(
+            widths.iter().all(|w| w.is_finite() && *w >= 0.0),
+            "widths ≥ 0"
+        );
+    }
+    if let Some(uvs) = &groom.root_uvs {
+        assert_eq!(uvs.len(), curves, "a root uv per curve");
+    }
+    if let Some(groups) = &groom.groups {
+        assert_eq!(groups.len(), curves, "a group per curve");
     }
 }
 

@@ -68,3 +68,20 @@ fn crafted_cases_are_named_errors() {
         assert!(error.contains(&name), "{name}: {error}");
     }
 }
+
+#[test]
+fn groom_seeds_read_and_crafted_grooms_are_named_errors() {
+    // The valid grooms read (so the mutations start from files the readers take in, and
+    // the target's checks run), and every crafted one is refused with a message.
+    use hairloom_fuzz::targets::{check_groom, read_groom_input};
+    for (name, bytes) in corpus::seeds(Target::GroomIn) {
+        let read = read_groom_input(&bytes).expect(&name);
+        if name.starts_with("crafted_") {
+            let error = read.expect_err(&name).to_string();
+            assert!(error.contains("fuzz."), "{name}: {error}");
+        } else {
+            let groom = read.unwrap_or_else(|e| panic!("{name}: {e}"));
+            check_groom(&groom, hairloom_core::io::groom_in::GroomLimits::default());
+        }
+    }
+}

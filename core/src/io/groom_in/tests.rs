@@ -360,3 +360,57 @@ fn usd_counts_that_overflow_and_absurd_units_are_named() {
         other => panic!("{other:?}"),
     }
 }
+
+/// Found by the `groom_in` fuzz target: `openusd` 0.6 recursed without end (a stack overflow,
+/// which aborts the process) on a prim name with a brace or a line break, and looped forever
+/// on a path literal with a brace. Such files are named errors before the library composes
+/// them; a valid stage with a typed prim, comments, strings and asset paths still reads.
+#[test]
+fn usd_names_and_paths_the_library_cannot_compose_are_named_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let cases: [(&str, &str, &str); 5] = [
+        (
+            "brace_name.usda",
+            "#usda 1.0\ndef \"}Root\" (\n)\n{\n}\n",
+            "prim name",
+        ),
+        (
+            "newline_name.usda",
+            "#usda 1.0\ndef \"R\noot\"\n{\n}\n",
+            "prim name",
+        ),
+        (
+            "nested.usda",
+            "#usda 1.0\ndef Xform \"Root\"\n{\n    def \"x}y\"\n    {\n    }\n}\n",
+            "prim name",
+        ),
+        (
+            "reference_path.usda",
+            "#usda 1.0\ndef \"Root\" (\n    references = </}A>\n)\n{\n}\ndef \"A\"\n{\n}\n",
+            "path </}A>",
+        ),
+        (
+            "inherits_path.usda",
+            "#usda 1.0\nover \"Root\" (\n    inherits = </A}>\n)\n{\n}\n",
+            "path </A}>",
+        ),
+    ];
+    for (name, text, says) in cases {
+        let file = write(dir.path(), name, text.as_bytes());
+        let error = read_groom(&file, GroomLimits::default(), &mut no_progress())
+            .expect_err(name)
+            .to_string();
+        assert!(
+            error.contains(name) && error.contains(says),
+            "{name}: {error}"
+        );
+    }
+    let valid = "#usda 1.0\n(\n    doc = \"a } in a string, def \\\"x}\\\" too\"\n)\n\
+        # a comment with def \"}\" in it\n\
+        def BasisCurves \"Hair_1\" (\n    assetInfo = {asset identifier = @./a}b.usda@}\n)\n{\n\
+        int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0), (0,1,0)]\n}\n";
+    let file = write(dir.path(), "valid.usda", valid.as_bytes());
+    let groom = read_groom(&file, GroomLimits::default(), &mut no_progress())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(groom.curve_count(), 1);
+}

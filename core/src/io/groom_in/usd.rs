@@ -78,12 +78,127 @@ impl Resolver for FolderResolver {
                 format!("larger than the cap of {} bytes", self.cap_bytes),
             ));
         }
-        self.inner.open_asset(resolved_path)
+        let mut asset = self.inner.open_asset(resolved_path)?;
+        // Every layer of the stage comes through here (the root, references, sublayers,
+        // a package's text layers): check USD text before the library composes it.
+        let bytes = asset.read_all()?;
+        // Anything but a crate file or a package is parsed as text (the parser takes
+        // leading blank lines before `#usda`), so anything else is checked as text.
+        if !bytes.starts_with(b"PXR-USDC") && !bytes.starts_with(b"PK") {
+            check_usda_names(&bytes).map_err(|message| {
+                io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!("{}: {message}", resolved_path.display()),
+                )
+            })?;
+        }
+        Ok(Box::new(io::Cursor::new(bytes)))
     }
 
     fn identity(&self) -> String {
         format!("hairloom-folder:{}", self.folder.display())
     }
+}
+
+/// Refuses USD text whose prim names are not identifiers or whose path literals hold `{` or
+/// `}`: `openusd` 0.6's composition recurses without end on such a name (a stack overflow,
+/// which aborts the whole process, unsaved work and all) and loops forever on such a path
+/// (found by the `groom_in` fuzz target). Variant selections, the one valid use of braces in
+/// a path, are refused with them: grooms do not use them. Comments, strings and asset paths
+/// are skipped as the USD text grammar has them.
+pub(crate) fn check_usda_names(text: &[u8]) -> Result<(), String> {
+    let is_identifier = |name: &str| {
+        let mut chars = name.chars();
+        chars.next().is_some_and(|c| c.is_alphabetic() || c == '_')
+            && chars.all(|c| c.is_alphanumeric() || c == '_')
+    };
+    // The identifiers since the last punctuation: a string right after `def`, `over` or
+    // `class` (and an optional type name) is a prim name.
+    let mut words: Vec<&[u8]> = Vec::new();
+    let mut i = 0;
+    while i < text.len() {
+        let c = text[i];
+        match c {
+            b'#' => {
+                while i < text.len() && text[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            b'"' | b'\'' => {
+                let triple = text[i..].starts_with(&[c, c, c]);
+                let (open, close): (usize, &[u8]) = if triple {
+                    (3, &text[i..i + 3])
+                } else {
+                    (1, &text[i..i + 1])
+                };
+                let start = i + open;
+                let mut end = start;
+                while end < text.len() && !text[end..].starts_with(close) {
+                    end += if text[end] == b'\\' { 2 } else { 1 };
+                }
+                let content = &text[start.min(text.len())..end.min(text.len())];
+                let names_a_prim = matches!(
+                    words.as_slice(),
+                    [.., keyword] | [.., keyword, _] if matches!(*keyword, b"def" | b"over" | b"class")
+                );
+                if names_a_prim {
+                    let name = String::from_utf8_lossy(content);
+                    if !is_identifier(&name) {
+                        return Err(format!(
+                            "prim name {name:?} is not an identifier (letters, digits and _)"
+                        ));
+                    }
+                }
+                words.clear();
+                i = end + close.len();
+                continue;
+            }
+            b'@' => {
+                let close: &[u8] = if text[i..].starts_with(b"@@@") {
+                    b"@@@"
+                } else {
+                    b"@"
+                };
+                let mut end = i + close.len();
+                while end < text.len() && !text[end..].starts_with(close) {
+                    end += 1;
+                }
+                words.clear();
+                i = end + close.len();
+                continue;
+            }
+            b'<' => {
+                let end = text[i..]
+                    .iter()
+                    .position(|&b| b == b'>')
+                    .map_or(text.len(), |p| i + p);
+                let path = &text[i + 1..end];
+                if path.iter().any(|&b| b == b'{' || b == b'}') {
+                    return Err(format!(
+                        "path <{}> holds a brace (variant selections are not read)",
+                        String::from_utf8_lossy(path)
+                    ));
+                }
+                words.clear();
+                i = end + 1;
+                continue;
+            }
+            _ if c.is_ascii_alphabetic() || c == b'_' => {
+                let start = i;
+                while i < text.len()
+                    && (text[i].is_ascii_alphanumeric() || b"_:.".contains(&text[i]))
+                {
+                    i += 1;
+                }
+                words.push(&text[start..i]);
+                continue;
+            }
+            _ if c.is_ascii_whitespace() => {}
+            _ => words.clear(),
+        }
+        i += 1;
+    }
+    Ok(())
 }
 
 pub fn read(
