@@ -94,6 +94,26 @@ fn groom_seeds() -> Vec<(String, Vec<u8>)> {
             b"#usda 1.0\ndef \"Root\" (\n    references = </}A>\n)\n{\n}\n",
         ),
     ));
+    // A review's bypasses of the first check: a block comment before the name, a
+    // triple-quoted string ending in a backslash, a variant name with a brace.
+    seeds.push((
+        "crafted_usda_block_comment_before_name.usda".into(),
+        groom_input("usda", b"#usda 1.0\ndef /**/ \"}Root\"\n{\n}\n"),
+    ));
+    seeds.push((
+        "crafted_usda_triple_quoted_backslash.usda".into(),
+        groom_input(
+            "usda",
+            b"#usda 1.0\n(\n    doc = \"\"\"C:\\\"\"\"\n)\ndef \"}Root\"\n{\n}\n",
+        ),
+    ));
+    seeds.push((
+        "crafted_usda_variant_name_with_brace.usda".into(),
+        groom_input(
+            "usda",
+            b"#usda 1.0\ndef \"Root\" (\n    variantSets = \"v\"\n)\n{\n    variantSet \"v\" = {\n        \"a}\" {\n        }\n    }\n}\n",
+        ),
+    ));
     let huge = usda.replacen(
         "int[] curveVertexCounts = [",
         "int[] curveVertexCounts = [2147483647, 2147483647, ",

@@ -249,25 +249,27 @@ pub fn read_groom_input(
         "hair" => hair::parse(&name, file, FUZZ_GROOM_LIMITS, &mut progress),
         "abc" => alembic::parse(&name, file.to_vec(), FUZZ_GROOM_LIMITS, &mut progress),
         _ => {
-            // The USD library opens files itself: the input goes into a folder of its own.
+            // The USD library opens files itself: each input goes into a folder of its own
+            // (no file an earlier input left can be referenced; tests run in threads),
+            // removed after the read.
             let folder = groom_folder();
+            std::fs::create_dir_all(&folder).ok()?;
             let path = folder.join(&name);
-            std::fs::write(&path, file).ok()?;
-            usd::read(&path, FUZZ_GROOM_LIMITS, &mut progress)
+            let read = std::fs::write(&path, file)
+                .ok()
+                .map(|()| usd::read(&path, FUZZ_GROOM_LIMITS, &mut progress));
+            let _ = std::fs::remove_dir_all(&folder);
+            read?
         }
     };
     Some(read)
 }
 
-/// This process's folder for USD inputs (one file at a time: runs are sequential).
-fn groom_folder() -> &'static std::path::Path {
-    static FOLDER: OnceLock<std::path::PathBuf> = OnceLock::new();
-    FOLDER.get_or_init(|| {
-        let folder =
-            std::env::temp_dir().join(format!("hairloom-fuzz-groom-{}", std::process::id()));
-        std::fs::create_dir_all(&folder).expect("a temporary folder for USD inputs");
-        folder
-    })
+/// A new folder for one USD input: this process's and this call's own.
+fn groom_folder() -> std::path::PathBuf {
+    static CALLS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    std::env::temp_dir().join(format!("hairloom-fuzz-groom-{}-{call}", std::process::id()))
 }
 
 /// What every groom reader promises of a groom it returns, asserted (a failure is a

@@ -368,7 +368,7 @@ fn usd_counts_that_overflow_and_absurd_units_are_named() {
 #[test]
 fn usd_names_and_paths_the_library_cannot_compose_are_named_errors() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let cases: [(&str, &str, &str); 5] = [
+    let cases: [(&str, &str, &str); 8] = [
         (
             "brace_name.usda",
             "#usda 1.0\ndef \"}Root\" (\n)\n{\n}\n",
@@ -394,6 +394,23 @@ fn usd_names_and_paths_the_library_cannot_compose_are_named_errors() {
             "#usda 1.0\nover \"Root\" (\n    inherits = </A}>\n)\n{\n}\n",
             "path </A}>",
         ),
+        // A block comment between the keyword and the name does not hide it.
+        (
+            "block_comment.usda",
+            "#usda 1.0\ndef /**/ \"}\nRoot\"\n{\n}\n",
+            "prim name",
+        ),
+        // Triple-quoted strings have no escapes: a backslash before the closing quotes.
+        (
+            "triple_quoted.usda",
+            "#usda 1.0\n(\n    doc = \"\"\"C:\\\"\"\"\n)\ndef \"}Root\"\n{\n}\n",
+            "prim name",
+        ),
+        (
+            "variant_set.usda",
+            "#usda 1.0\ndef \"Root\" (\n    variantSets = \"v\"\n)\n{\n    variantSet \"v\" = {\n        \"a}\" {\n        }\n    }\n}\n",
+            "variant sets",
+        ),
     ];
     for (name, text, says) in cases {
         let file = write(dir.path(), name, text.as_bytes());
@@ -406,7 +423,7 @@ fn usd_names_and_paths_the_library_cannot_compose_are_named_errors() {
         );
     }
     let valid = "#usda 1.0\n(\n    doc = \"a } in a string, def \\\"x}\\\" too\"\n)\n\
-        # a comment with def \"}\" in it\n\
+        # a comment with def \"}\" in it\n/* and def \"{\" in a block */\n\
         def BasisCurves \"Hair_1\" (\n    assetInfo = {asset identifier = @./a}b.usda@}\n)\n{\n\
         int[] curveVertexCounts = [2]\n point3f[] points = [(0,0,0), (0,1,0)]\n}\n";
     let file = write(dir.path(), "valid.usda", valid.as_bytes());

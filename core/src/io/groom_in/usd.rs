@@ -100,105 +100,69 @@ impl Resolver for FolderResolver {
     }
 }
 
-/// Refuses USD text whose prim names are not identifiers or whose path literals hold `{` or
-/// `}`: `openusd` 0.6's composition recurses without end on such a name (a stack overflow,
-/// which aborts the whole process, unsaved work and all) and loops forever on such a path
-/// (found by the `groom_in` fuzz target). Variant selections, the one valid use of braces in
-/// a path, are refused with them: grooms do not use them. Comments, strings and asset paths
-/// are skipped as the USD text grammar has them.
-pub(crate) fn check_usda_names(text: &[u8]) -> Result<(), String> {
+/// Refuses USD text whose prim names are not identifiers, whose path literals hold `{` or
+/// `}`, or that has variant sets: `openusd` 0.6's composition recurses without end on such a
+/// name (a stack overflow, which aborts the whole process, unsaved work and all) and loops
+/// forever on such a path (found by the `groom_in` fuzz target); variant names become
+/// braced paths the same way. Grooms do not use variants. The text is read with the
+/// library's own tokenizer, so comments, strings and malformed quoting split exactly as
+/// its parser splits them. Crate files (`.usdc`) are not checked: their names sit in a
+/// compressed token table only the library decodes.
+pub(crate) fn check_usda_names(bytes: &[u8]) -> Result<(), String> {
+    use logos::Logos as _;
+    use openusd::usda::token::Token;
+    let text = std::str::from_utf8(bytes).map_err(|e| format!("not UTF-8 text ({e})"))?;
     let is_identifier = |name: &str| {
         let mut chars = name.chars();
         chars.next().is_some_and(|c| c.is_alphabetic() || c == '_')
             && chars.all(|c| c.is_alphanumeric() || c == '_')
     };
-    // The identifiers since the last punctuation: a string right after `def`, `over` or
-    // `class` (and an optional type name) is a prim name.
-    let mut words: Vec<&[u8]> = Vec::new();
-    let mut i = 0;
-    while i < text.len() {
-        let c = text[i];
-        match c {
-            b'#' => {
-                while i < text.len() && text[i] != b'\n' {
-                    i += 1;
-                }
+    let specifier = |t: &Option<Token>| matches!(t, Some(Token::Def | Token::Over | Token::Class));
+    let type_name = |t: &Option<Token>| {
+        matches!(
+            t,
+            Some(Token::Identifier(_) | Token::NamespacedIdentifier(_))
+        )
+    };
+    // The two tokens before this one (lexer errors included, as `None`).
+    let (mut before, mut last): (Option<Token>, Option<Token>) = (None, None);
+    for token in Token::lexer(text) {
+        let token = token.ok();
+        match &token {
+            Some(Token::VariantSet | Token::VariantSets | Token::Variants) => {
+                return Err("variant sets are not read".into());
             }
-            b'"' | b'\'' => {
-                let triple = text[i..].starts_with(&[c, c, c]);
-                let (open, close): (usize, &[u8]) = if triple {
-                    (3, &text[i..i + 3])
-                } else {
-                    (1, &text[i..i + 1])
-                };
-                let start = i + open;
-                let mut end = start;
-                while end < text.len() && !text[end..].starts_with(close) {
-                    end += if text[end] == b'\\' { 2 } else { 1 };
-                }
-                let content = &text[start.min(text.len())..end.min(text.len())];
-                let names_a_prim = matches!(
-                    words.as_slice(),
-                    [.., keyword] | [.., keyword, _] if matches!(*keyword, b"def" | b"over" | b"class")
-                );
-                if names_a_prim {
-                    let name = String::from_utf8_lossy(content);
-                    if !is_identifier(&name) {
-                        return Err(format!(
-                            "prim name {name:?} is not an identifier (letters, digits and _)"
-                        ));
-                    }
-                }
-                words.clear();
-                i = end + close.len();
-                continue;
+            Some(Token::PathRef(path)) if path.contains(['{', '}']) => {
+                return Err(format!(
+                    "path <{}> holds a brace (variant selections are not read)",
+                    shortened(path)
+                ));
             }
-            b'@' => {
-                let close: &[u8] = if text[i..].starts_with(b"@@@") {
-                    b"@@@"
-                } else {
-                    b"@"
-                };
-                let mut end = i + close.len();
-                while end < text.len() && !text[end..].starts_with(close) {
-                    end += 1;
-                }
-                words.clear();
-                i = end + close.len();
-                continue;
+            Some(Token::String(name))
+                if (specifier(&last) || (specifier(&before) && type_name(&last)))
+                    && !is_identifier(name) =>
+            {
+                return Err(format!(
+                    "prim name {:?} is not an identifier (letters, digits and _)",
+                    shortened(name)
+                ));
             }
-            b'<' => {
-                let end = text[i..]
-                    .iter()
-                    .position(|&b| b == b'>')
-                    .map_or(text.len(), |p| i + p);
-                let path = &text[i + 1..end];
-                if path.iter().any(|&b| b == b'{' || b == b'}') {
-                    return Err(format!(
-                        "path <{}> holds a brace (variant selections are not read)",
-                        String::from_utf8_lossy(path)
-                    ));
-                }
-                words.clear();
-                i = end + 1;
-                continue;
-            }
-            _ if c.is_ascii_alphabetic() || c == b'_' => {
-                let start = i;
-                while i < text.len()
-                    && (text[i].is_ascii_alphanumeric() || b"_:.".contains(&text[i]))
-                {
-                    i += 1;
-                }
-                words.push(&text[start..i]);
-                continue;
-            }
-            _ if c.is_ascii_whitespace() => {}
-            _ => words.clear(),
+            _ => {}
         }
-        i += 1;
+        before = last;
+        last = token;
     }
     Ok(())
+}
+
+/// At most 64 characters of `text` for an error message (a name left open runs to the end
+/// of the file).
+fn shortened(text: &str) -> String {
+    let mut short: String = text.chars().take(64).collect();
+    if short.len() < text.len() {
+        short.push('…');
+    }
+    short
 }
 
 pub fn read(
