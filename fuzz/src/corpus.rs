@@ -114,6 +114,24 @@ fn groom_seeds() -> Vec<(String, Vec<u8>)> {
             b"#usda 1.0\ndef \"Root\" (\n    variantSets = \"v\"\n)\n{\n    variantSet \"v\" = {\n        \"a}\" {\n        }\n    }\n}\n",
         ),
     ));
+    // The grid and the brace name in a binary crate file (`.usdc`), whose names sit in a
+    // token table the text check cannot see; the writer overflows on a brace itself, so the
+    // crafted name is patched into a name of the same length.
+    let crate_of = |text: &str| {
+        let data = openusd::usda::parse(text).expect("our USD text parses");
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        openusd::usdc::CrateWriter::write(&data, &mut bytes).expect("the crate writes");
+        bytes.into_inner()
+    };
+    seeds.push(("grid.usdc".into(), groom_input("usdc", &crate_of(&usda))));
+    let mut brace = crate_of("#usda 1.0\ndef \"Zq9Wk\"\n{\n}\n");
+    if let Some(at) = brace.windows(5).position(|w| w == b"Zq9Wk") {
+        brace[at] = b'}';
+    }
+    seeds.push((
+        "crafted_usdc_prim_name_with_brace.usdc".into(),
+        groom_input("usdc", &brace),
+    ));
     let huge = usda.replacen(
         "int[] curveVertexCounts = [",
         "int[] curveVertexCounts = [2147483647, 2147483647, ",

@@ -361,6 +361,18 @@ fn usd_counts_that_overflow_and_absurd_units_are_named() {
     }
 }
 
+/// Writes `bytes` as `name` and reads it: a named error that says `says`.
+fn assert_refused(dir: &Path, name: &str, bytes: &[u8], says: &str) {
+    let file = write(dir, name, bytes);
+    let error = read_groom(&file, GroomLimits::default(), &mut no_progress())
+        .expect_err(name)
+        .to_string();
+    assert!(
+        error.contains(name) && error.contains(says),
+        "{name}: {error}"
+    );
+}
+
 /// Found by the `groom_in` fuzz target: `openusd` 0.6 recursed without end (a stack overflow,
 /// which aborts the process) on a prim name with a brace or a line break, and looped forever
 /// on a path literal with a brace. Such files are named errors before the library composes
@@ -413,14 +425,7 @@ fn usd_names_and_paths_the_library_cannot_compose_are_named_errors() {
         ),
     ];
     for (name, text, says) in cases {
-        let file = write(dir.path(), name, text.as_bytes());
-        let error = read_groom(&file, GroomLimits::default(), &mut no_progress())
-            .expect_err(name)
-            .to_string();
-        assert!(
-            error.contains(name) && error.contains(says),
-            "{name}: {error}"
-        );
+        assert_refused(dir.path(), name, text.as_bytes(), says);
     }
     let valid = "#usda 1.0\n(\n    doc = \"a } in a string, def \\\"x}\\\" too\"\n)\n\
         # a comment with def \"}\" in it\n/* and def \"{\" in a block */\n\
@@ -430,4 +435,117 @@ fn usd_names_and_paths_the_library_cannot_compose_are_named_errors() {
     let groom = read_groom(&file, GroomLimits::default(), &mut no_progress())
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(groom.curve_count(), 1);
+}
+
+/// USD text as a crate file (`.usdc`), written by the library's own writer (what a tool that
+/// saves binary USD hands over), with the name `from` then changed to `to` in its token
+/// table: the writer itself overflows its stack on a name with a brace, so such a crate is
+/// made by patching a name of the same length (a lone token is stored as LZ4 literals).
+fn usdc_of(text: &str, from: &str, to: &str) -> Vec<u8> {
+    assert_eq!(from.len(), to.len(), "a patch keeps the token table's size");
+    let data = openusd::usda::parse(text).expect("the text parses");
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    openusd::usdc::CrateWriter::write(&data, &mut bytes).expect("the crate writes");
+    let mut bytes = bytes.into_inner();
+    if from != to {
+        let at: Vec<usize> = bytes
+            .windows(from.len())
+            .enumerate()
+            .filter(|(_, w)| *w == from.as_bytes())
+            .map(|(i, _)| i)
+            .collect();
+        assert_eq!(at.len(), 1, "{from:?} appears once in the crate");
+        bytes[at[0]..at[0] + to.len()].copy_from_slice(to.as_bytes());
+    }
+    bytes
+}
+
+/// The same names and paths in a binary crate file: its names sit in a token table the
+/// text check never sees, so the crate's paths, child lists and path-valued fields are
+/// checked too (without the check, the brace name aborted the process).
+#[test]
+fn usdc_names_and_paths_the_library_cannot_compose_are_named_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let cases: [(&str, &str, (&str, &str), &str); 5] = [
+        (
+            "brace_name.usdc",
+            "#usda 1.0\ndef \"Zq9Wk\"\n{\n}\n",
+            ("Zq9Wk", "}q9Wk"),
+            "prim name \"}q9Wk\"",
+        ),
+        (
+            "newline_name.usdc",
+            "#usda 1.0\ndef \"R\noot\"\n{\n}\n",
+            ("", ""),
+            "prim name \"R\\noot\"",
+        ),
+        (
+            "nested.usdc",
+            "#usda 1.0\ndef Xform \"Root\"\n{\n    def \"Zq9Wk\"\n    {\n    }\n}\n",
+            ("Zq9Wk", "x}9Wk"),
+            "prim name \"x}9Wk\"",
+        ),
+        (
+            "reference_path.usdc",
+            "#usda 1.0\ndef \"Root\" (\n    references = </Zq9Wk>\n)\n{\n}\n",
+            ("Zq9Wk", "}q9Wk"),
+            "path </}q9Wk> in references of </Root>",
+        ),
+        (
+            "inherits_path.usdc",
+            "#usda 1.0\nover \"Root\" (\n    inherits = </Zq9Wk>\n)\n{\n}\n",
+            ("Zq9Wk", "Zq9W}"),
+            "path </Zq9W}> in inheritPaths of </Root>",
+        ),
+    ];
+    for (name, text, (from, to), says) in cases {
+        assert_refused(dir.path(), name, &usdc_of(text, from, to), says);
+    }
+    // A crate groom of identifiers, namespaced properties and a reference reads.
+    let valid = "#usda 1.0\ndef Xform \"Root\"\n{\n    def BasisCurves \"Hair_1\"\n    {\n\
+        int[] curveVertexCounts = [2]\n        point3f[] points = [(0,0,0), (0,1,0)]\n\
+        float[] primvars:widths = [0.001, 0.001]\n    }\n}\n\
+        def \"Other\" (\n    references = </Root>\n)\n{\n}\n";
+    let file = write(dir.path(), "valid.usdc", &usdc_of(valid, "", ""));
+    let groom = read_groom(&file, GroomLimits::default(), &mut no_progress())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(groom.curve_count(), 2, "the curves and their reference");
+}
+
+/// Found by the `groom_in` fuzz target in the crate reader (`openusd` 0.6, patched in
+/// `vendor/openusd`): sizes and counts read from a `.usdc` were allocated before a byte of
+/// what they counted was read, and an allocation of exabytes aborts the process. Here every
+/// eight bytes of a valid crate groom in turn claim 2⁶⁰ (and then 2³²): each read ends in
+/// curves or a named error, and never in an abort.
+#[test]
+fn usdc_counts_that_claim_more_than_the_file_holds_are_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let text = "#usda 1.0\n(\n    customLayerData = {\n        dictionary nested = {\n\
+        string note = \"a\"\n        }\n    }\n)\ndef Xform \"Root\"\n{\n\
+        def BasisCurves \"Hair_1\" (\n        references = </Other>\n    )\n    {\n\
+        int[] curveVertexCounts = [4, 4]\n\
+        point3f[] points = [(0,0,0), (0,1,0), (0,2,0), (0,3,0), (1,0,0), (1,1,0), (1,2,0), (1,3,0)]\n\
+        float[] widths = [0.001, 0.001, 0.001, 0.001, 0.002, 0.002, 0.002, 0.002]\n    }\n}\n\
+        def \"Other\"\n{\n}\n";
+    let valid = usdc_of(text, "", "");
+    let file = write(dir.path(), "valid.usdc", &valid);
+    let groom = read_groom(&file, GroomLimits::default(), &mut no_progress())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(groom.curve_count(), 2);
+    let mut errors = 0;
+    for claim in [1u64 << 60, 1u64 << 32] {
+        for at in 8..valid.len().saturating_sub(8) {
+            let mut bytes = valid.clone();
+            bytes[at..at + 8].copy_from_slice(&claim.to_le_bytes());
+            let file = write(dir.path(), "claims.usdc", &bytes);
+            if let Err(error) = read_groom(&file, GroomLimits::default(), &mut no_progress()) {
+                assert!(error.to_string().contains("claims.usdc"), "{error}");
+                errors += 1;
+            }
+        }
+    }
+    assert!(
+        errors > valid.len() / 2,
+        "{errors} of the patched crates were refused"
+    );
 }

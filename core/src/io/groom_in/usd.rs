@@ -84,14 +84,20 @@ impl Resolver for FolderResolver {
         let bytes = asset.read_all()?;
         // Anything but a crate file or a package is parsed as text (the parser takes
         // leading blank lines before `#usda`), so anything else is checked as text.
-        if !bytes.starts_with(b"PXR-USDC") && !bytes.starts_with(b"PK") {
-            check_usda_names(&bytes).map_err(|message| {
-                io::Error::new(
-                    io::ErrorKind::InvalidData,
-                    format!("{}: {message}", resolved_path.display()),
-                )
-            })?;
-        }
+        let checked = if bytes.starts_with(b"PXR-USDC") {
+            check_usdc_names(&bytes)
+        } else if bytes.starts_with(b"PK") {
+            // A package's layers come through here one by one, each checked on its own.
+            Ok(())
+        } else {
+            check_usda_names(&bytes)
+        };
+        checked.map_err(|message| {
+            io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{}: {message}", resolved_path.display()),
+            )
+        })?;
         Ok(Box::new(io::Cursor::new(bytes)))
     }
 
@@ -106,17 +112,12 @@ impl Resolver for FolderResolver {
 /// forever on such a path (found by the `groom_in` fuzz target); variant names become
 /// braced paths the same way. Grooms do not use variants. The text is read with the
 /// library's own tokenizer, so comments, strings and malformed quoting split exactly as
-/// its parser splits them. Crate files (`.usdc`) are not checked: their names sit in a
-/// compressed token table only the library decodes.
+/// its parser splits them. Crate files (`.usdc`) hold the same names in a token table:
+/// [`check_usdc_names`] checks them.
 pub(crate) fn check_usda_names(bytes: &[u8]) -> Result<(), String> {
     use logos::Logos as _;
     use openusd::usda::token::Token;
     let text = std::str::from_utf8(bytes).map_err(|e| format!("not UTF-8 text ({e})"))?;
-    let is_identifier = |name: &str| {
-        let mut chars = name.chars();
-        chars.next().is_some_and(|c| c.is_alphabetic() || c == '_')
-            && chars.all(|c| c.is_alphanumeric() || c == '_')
-    };
     let specifier = |t: &Option<Token>| matches!(t, Some(Token::Def | Token::Over | Token::Class));
     let type_name = |t: &Option<Token>| {
         matches!(
@@ -153,6 +154,123 @@ pub(crate) fn check_usda_names(bytes: &[u8]) -> Result<(), String> {
         last = token;
     }
     Ok(())
+}
+
+/// What [`check_usda_names`] refuses, in a crate file (`.usdc`): found by writing the text
+/// cases with the library's own crate writer (the same stack overflow). The crate is opened
+/// with the library's reader and every spec's path, every child-name list and every
+/// path-valued field (references, payloads, inherits, specializes, relationship targets,
+/// connections, relocates) is checked: prim paths of identifiers, properties of namespaced
+/// identifiers, no variant selections, no variant sets. Attribute values (`default`,
+/// `timeSamples`: the bulk of a groom) are not decoded here.
+pub(crate) fn check_usdc_names(bytes: &[u8]) -> Result<(), String> {
+    use openusd::sdf::{AbstractData as _, SpecType, Value};
+    let data = openusd::usdc::CrateData::open(io::Cursor::new(bytes), true)
+        .map_err(|e| format!("not a readable USD crate file ({e})"))?;
+    let path_error = |path: &str, at: &str| {
+        format!(
+            "path <{}> in {at} is not a prim or property path of identifiers (braces, brackets \
+             and variant selections are not read)",
+            shortened(path)
+        )
+    };
+    for spec in data.spec_paths() {
+        let spec_text = spec.as_str();
+        if matches!(
+            data.spec_type(&spec),
+            Some(SpecType::Variant | SpecType::VariantSet)
+        ) {
+            return Err("variant sets are not read".into());
+        }
+        if !is_plain_path(spec_text) {
+            let name = spec_text.rsplit('/').next().unwrap_or(spec_text);
+            return Err(format!(
+                "prim name {:?} is not an identifier (letters, digits and _)",
+                shortened(name)
+            ));
+        }
+        for field in data.list_fields(&spec).unwrap_or_default() {
+            if field.starts_with("variant") {
+                return Err("variant sets are not read".into());
+            }
+            if matches!(field.as_str(), "default" | "timeSamples") {
+                continue;
+            }
+            // A field the library cannot decode is its own error, reported when it reads it.
+            let Ok(Some(value)) = data.try_field(&spec, &field) else {
+                continue;
+            };
+            let at = || format!("{field} of <{}>", shortened(spec_text));
+            let mut paths: Vec<&openusd::sdf::Path> = Vec::new();
+            match value.as_ref() {
+                Value::TokenVec(names) if field.ends_with("Children") => {
+                    // Prim names are identifiers, property names namespaced ones (`a:b`).
+                    let plain = |name: &str| name.split(':').all(is_identifier);
+                    if let Some(name) = names.iter().find(|n| !plain(n.as_str())) {
+                        let kind = if field == "primChildren" {
+                            "prim"
+                        } else {
+                            "child"
+                        };
+                        return Err(format!(
+                            "{kind} name {:?} in {} is not an identifier (letters, digits and _)",
+                            shortened(name.as_str()),
+                            at()
+                        ));
+                    }
+                }
+                Value::PathVec(list) => paths.extend(list),
+                Value::PathListOp(op) => paths.extend(all_items(op)),
+                Value::ReferenceListOp(op) => paths.extend(all_items(op).map(|r| &r.prim_path)),
+                Value::PayloadListOp(op) => paths.extend(all_items(op).map(|p| &p.prim_path)),
+                Value::Payload(payload) => paths.push(&payload.prim_path),
+                Value::Relocates(pairs) => paths.extend(pairs.iter().flat_map(|(s, t)| [s, t])),
+                _ => {}
+            }
+            if let Some(path) = paths.iter().find(|p| !is_plain_path(p.as_str())) {
+                return Err(path_error(path.as_str(), &at()));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every item of a list op, deleted and reordered ones too (the library composes those).
+fn all_items<T: Default + Clone + PartialEq>(
+    op: &openusd::sdf::ListOp<T>,
+) -> impl Iterator<Item = &T> {
+    op.iter().chain(&op.deleted_items).chain(&op.ordered_items)
+}
+
+/// A USD identifier: a letter or `_`, then letters, digits and `_`.
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars.next().is_some_and(|c| c.is_alphabetic() || c == '_')
+        && chars.all(|c| c.is_alphanumeric() || c == '_')
+}
+
+/// A prim path of identifiers (absolute or relative, `.` and `..` allowed), optionally
+/// ending in a property whose name is identifiers joined by `:`; an empty path too (a
+/// reference's "default prim"). No variant selection, target (`[…]`) or other character.
+fn is_plain_path(path: &str) -> bool {
+    let body = path.strip_prefix('/').unwrap_or(path);
+    if body.is_empty() {
+        return true;
+    }
+    let elements: Vec<&str> = body.split('/').collect();
+    elements.iter().enumerate().all(|(i, element)| {
+        if matches!(*element, "." | "..") {
+            return true;
+        }
+        match element.split_once('.') {
+            None => is_identifier(element),
+            Some((prim, property)) => {
+                i + 1 == elements.len()
+                    && (is_identifier(prim) || (prim.is_empty() && elements.len() == 1))
+                    && property.split(':').all(is_identifier)
+            }
+        }
+    })
 }
 
 /// At most 64 characters of `text` for an error message (a name left open runs to the end
