@@ -2196,3 +2196,97 @@ fn the_tools_and_history_panes_show_their_controls_at_the_default_size() {
         "{original:?} {history_tab:?}"
     );
 }
+
+/// Issue 35: with Drag ▸ Groom, a stroke of the comb over the hair moves it (both sides of
+/// the head with X-mirror), as one undo step that undo takes back exactly; the length
+/// brush makes the hair under it longer.
+#[test]
+fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
+    let mut harness = harness();
+    // A smaller window: the Tools panel is narrow, and the Groom button once sat past its
+    // edge, out of reach.
+    harness.set_size(egui::vec2(1100.0, 720.0));
+    harness.run();
+    let original = harness.state().state.document().clone();
+    harness.get_by_label("Groom").click();
+    harness.run();
+    let rect = viewport_rect(&harness);
+    // Find a point over the hair: the brush's circle says when it touches.
+    let mut start = None;
+    'search: for row in 2..12 {
+        for column in [5, 4, 6, 3, 7] {
+            let at = rect.left_top()
+                + egui::vec2(
+                    rect.width() * column as f32 / 10.0,
+                    rect.height() * row as f32 / 20.0,
+                );
+            harness.hover_at(at);
+            harness.run();
+            if harness
+                .state()
+                .viewport
+                .brush_cursor
+                .is_some_and(|c| c.touches_hair && c.radius_px > 2.0)
+            {
+                start = Some(at);
+                break 'search;
+            }
+        }
+    }
+    let start = start.expect("some point of the viewport shows hair under the brush");
+    drag(&mut harness, start, start + egui::vec2(70.0, 30.0));
+    let combed = harness.state().state.document().clone();
+    assert!(
+        combed.hair_mesh != original.hair_mesh,
+        "{}",
+        harness.state().state.message
+    );
+    let history = &harness.state().state.project.history;
+    assert_eq!(history.undo.len(), 1, "{}", harness.state().state.message);
+    assert_eq!(history.undo[0].label(), "Comb brush");
+    // X-mirror: columns on both sides of the head's plane moved.
+    let plane = original.mirror_plane_x();
+    let moved_side = |left: bool| {
+        original
+            .hair_mesh
+            .columns
+            .iter()
+            .zip(&combed.hair_mesh.columns)
+            .filter(|(a, _)| (a.positions[0].x < plane) == left)
+            .filter(|(a, b)| a.positions != b.positions)
+            .count()
+    };
+    assert!(moved_side(true) > 0 && moved_side(false) > 0);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().hair_mesh,
+        original.hair_mesh
+    );
+
+    // The length brush grows what it strokes.
+    harness.get_by_label("Grow / cut").click();
+    harness.run();
+    drag(&mut harness, start, start + egui::vec2(40.0, 0.0));
+    let grown = harness.state().state.document().clone();
+    let length = |mesh: &hairloom_core::HairMesh| -> f64 {
+        mesh.columns
+            .iter()
+            .map(|c| {
+                c.positions
+                    .windows(2)
+                    .map(|s| s[0].distance(s[1]))
+                    .sum::<f64>()
+            })
+            .sum()
+    };
+    assert!(
+        length(&grown.hair_mesh) > length(&original.hair_mesh),
+        "{}",
+        harness.state().state.message
+    );
+    assert_eq!(
+        harness.state().state.project.history.undo[0].label(),
+        "Grow / cut brush"
+    );
+}

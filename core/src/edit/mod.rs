@@ -12,6 +12,7 @@
 //! the edited layer ([`layer_closure`]); the returned [`EditOutcome`] says which bundles were
 //! affected.
 
+pub mod brush;
 pub mod coordinates;
 pub mod pick;
 pub mod select;
@@ -27,6 +28,7 @@ use crate::geometry::interior::place_interior;
 use crate::model::mesh::{HairMesh, VertexRef};
 
 // The edit API in one place: callers write `edit::extrude`, whichever file it lives in.
+pub use brush::{BrushDab, BrushKind, apply_brush, turned_layers};
 pub use coordinates::{set_corner_uvs, set_w, set_w_mode};
 pub use split_merge::{merge_bundles, split_bundles};
 pub use topology::{

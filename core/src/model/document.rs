@@ -144,6 +144,20 @@ pub struct InvalidDocument {
 }
 
 impl Document {
+    /// The head's plane of symmetry, `x = plane_x`: the middle of the body's x extent (a
+    /// head is symmetric; its hair need not be yet), or of the hair mesh's without a body.
+    /// Wisp mirroring and the brushes' X-mirror reflect across it.
+    pub fn mirror_plane_x(&self) -> f64 {
+        let body_x = self.body.positions.iter().map(|p| p[0] as f64);
+        match (body_x.clone().reduce(f64::min), body_x.reduce(f64::max)) {
+            (Some(lo), Some(hi)) if lo.is_finite() && hi.is_finite() => 0.5 * (lo + hi),
+            _ => self
+                .hair_mesh
+                .bounds()
+                .map_or(0.0, |(lo, hi)| 0.5 * (lo.x + hi.x)),
+        }
+    }
+
     /// Vertices per strand (2^N + 1, as N) that draw this project's styling as curves
     /// ([`crate::strands::styling::strand_vertices_log2`] over its longest column's w).
     pub fn strand_vertices_log2(&self) -> u32 {

@@ -40,6 +40,35 @@ pub enum DragTool {
     Box,
     Lasso,
     Paint,
+    /// Stroke the hair with the grooming brush (`ToolSettings::brush`) instead of selecting.
+    Groom,
+}
+
+/// The grooming brush a left drag strokes with under [`DragTool::Groom`] (view state: the
+/// strokes themselves are edits of the document).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BrushSettings {
+    pub kind: hairloom_core::edit::BrushKind,
+    /// In model units (metres for the bundled samples).
+    pub radius_m: f64,
+    /// 0 … 1.
+    pub strength: f64,
+    /// Also stroke the mirror image across the head's plane.
+    pub mirror_x: bool,
+    /// Leave hair whose scalp faces away from the view (never brush through the head).
+    pub front_only: bool,
+}
+
+impl Default for BrushSettings {
+    fn default() -> Self {
+        Self {
+            kind: hairloom_core::edit::BrushKind::Comb,
+            radius_m: 0.03,
+            strength: 0.5,
+            mirror_x: true,
+            front_only: true,
+        }
+    }
 }
 
 /// Selection and transform settings shared by the tools panel and the viewport (view state).
@@ -57,6 +86,7 @@ pub struct ToolSettings {
     pub z_up: bool,
     /// Pick and region-select through the body (and see hidden bundles' outlines).
     pub xray: bool,
+    pub brush: BrushSettings,
 }
 
 impl Default for ToolSettings {
@@ -69,6 +99,7 @@ impl Default for ToolSettings {
             gizmo: super::gizmo::GizmoKind::Move,
             z_up: true,
             xray: false,
+            brush: BrushSettings::default(),
         }
     }
 }

@@ -5,7 +5,8 @@ use hairloom_core::edit::{self, ExtrudeDirection};
 use hairloom_core::model::change::ChangeKind;
 
 use super::gizmo::GizmoKind;
-use super::state::{DragTool, EditorState, SelectMode};
+use super::state::{BrushSettings, DragTool, EditorState, SelectMode};
+use hairloom_core::edit::BrushKind;
 
 pub struct ToolsPanel {
     /// Extrusion distance along the top layer's normals (model units).
@@ -29,6 +30,51 @@ impl Default for ToolsPanel {
     }
 }
 
+/// The grooming brush's settings: which brush, its size and strength, X-mirror and
+/// front-facing only.
+fn brush_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Brush:");
+        for kind in BrushKind::ALL {
+            ui.selectable_value(&mut brush.kind, kind, kind.label())
+                .on_hover_text(match kind {
+                    BrushKind::Comb => "Drag hair along the stroke; lengths stay",
+                    BrushKind::Length => "Grow the hair under the brush (Ctrl: cut)",
+                    BrushKind::Puff => "Lift hair off the scalp (Ctrl: flatten)",
+                    BrushKind::Smooth => "Relax kinks along and across the hair",
+                    BrushKind::Clump => "Gather the hair under the brush (Ctrl: spread)",
+                });
+        }
+    });
+    // Label first, a short slider after: the Tools panel is narrow, and a slider's own text
+    // (drawn after it) is the first thing cut off.
+    let labelled_slider = |ui: &mut egui::Ui, name: &str, slider: egui::Slider| {
+        ui.horizontal(|ui| {
+            ui.spacing_mut().slider_width = 56.0;
+            let label = ui.label(name);
+            ui.add(slider).labelled_by(label.id);
+        });
+    };
+    labelled_slider(
+        ui,
+        "Brush size",
+        egui::Slider::new(&mut brush.radius_m, 0.002..=0.2)
+            .logarithmic(true)
+            .suffix(" m"),
+    );
+    labelled_slider(
+        ui,
+        "Strength",
+        egui::Slider::new(&mut brush.strength, 0.0..=1.0),
+    );
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut brush.mirror_x, "X mirror")
+            .on_hover_text("Stroke both sides of the head at once (across its centre, x)");
+        ui.checkbox(&mut brush.front_only, "Front only")
+            .on_hover_text("Leave the hair on the far side of the head alone");
+    });
+}
+
 impl ToolsPanel {
     pub fn extrude(&self, state: &mut EditorState) {
         let distance = self.extrude_distance_m;
@@ -45,11 +91,19 @@ impl ToolsPanel {
             ui.selectable_value(&mut state.tool.mode, SelectMode::Vertices, "Vertices")
                 .on_hover_text("Tab switches");
         });
-        ui.horizontal(|ui| {
-            ui.label("Drag:");
-            ui.selectable_value(&mut state.tool.drag, DragTool::Box, "Box");
-            ui.selectable_value(&mut state.tool.drag, DragTool::Lasso, "Lasso");
-            ui.selectable_value(&mut state.tool.drag, DragTool::Paint, "Paint");
+        // What a left drag does, on one line with no heading (the Tools pane is narrow and
+        // full: a second line pushes its last buttons out of view); wrapped rather than cut
+        // where the pane is narrower still.
+        ui.horizontal_wrapped(|ui| {
+            ui.spacing_mut().item_spacing.x = 4.0;
+            ui.selectable_value(&mut state.tool.drag, DragTool::Box, "Box")
+                .on_hover_text("A left drag selects in a box");
+            ui.selectable_value(&mut state.tool.drag, DragTool::Lasso, "Lasso")
+                .on_hover_text("A left drag selects in a lasso");
+            ui.selectable_value(&mut state.tool.drag, DragTool::Paint, "Paint")
+                .on_hover_text("A left drag paints the selection");
+            ui.selectable_value(&mut state.tool.drag, DragTool::Groom, "Groom")
+                .on_hover_text("A left drag strokes the hair with the grooming brush");
         });
         if state.tool.drag == DragTool::Paint {
             ui.add(
@@ -57,6 +111,9 @@ impl ToolsPanel {
                     .text("Brush radius")
                     .suffix(" px"),
             );
+        }
+        if state.tool.drag == DragTool::Groom {
+            brush_ui(ui, &mut state.tool.brush);
         }
         ui.horizontal(|ui| {
             if ui.button("Grow").on_hover_text("Ctrl +").clicked() {
@@ -286,16 +343,8 @@ impl ToolsPanel {
                 )
                 .clicked()
             {
-                // The body's centre (a head is symmetric; its hair need not be yet).
                 let document = state.document();
-                let body_x = document.body.positions.iter().map(|p| p[0] as f64);
-                let plane_x = match (body_x.clone().reduce(f64::min), body_x.reduce(f64::max)) {
-                    (Some(lo), Some(hi)) => 0.5 * (lo + hi),
-                    _ => document
-                        .hair_mesh
-                        .bounds()
-                        .map_or(0.0, |(lo, hi)| 0.5 * (lo.x + hi.x)),
-                };
+                let plane_x = document.mirror_plane_x();
                 // Shape and styling groups in one undo step.
                 state.commit_edit();
                 state.stop_playback_for_editing();

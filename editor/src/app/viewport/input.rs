@@ -116,6 +116,8 @@ impl Viewport {
                     points,
                     radius_px: state.tool.paint_radius_px as f64,
                 },
+                // A groom drag strokes the hair (`groom_brush.rs`); it never reaches here.
+                DragTool::Groom => return,
             };
             let project = project_seen;
             let replace = !modifiers.shift && !modifiers.command;

@@ -14,6 +14,10 @@
 //! Styling directions (View ▸ Styling-direction gizmo, `styling_gizmo.rs`): at the selected
 //! bundles' roots, drag the wave arrow, the twist ring or the curl ring; one undo step each.
 //!
+//! Grooming brushes (`groom_brush.rs`): with Drag ▸ Groom, a left drag combs, grows or cuts,
+//! puffs, smooths or clumps the hair under the brush, X-mirrored and front-facing by
+//! default; one undo step per stroke.
+//!
 //! Transform (modal, like Blender): G moves, R rotates, S scales the selection following
 //! the pointer, E extrudes the selected bundles with the pointer setting the distance; X / Y / Z lock an axis, the wheel changes the soft-selection radius; a click
 //! or Enter confirms (one undo step), Esc or a right-click cancels. Interior vertices follow
@@ -24,6 +28,8 @@ pub use budget::{FRAME_BUDGET_MS, FrameQuality, InteractiveEffort, SETTLE};
 mod camera;
 mod effect_costs;
 pub use effect_costs::EffectCostResult;
+mod groom_brush;
+pub use groom_brush::BrushCursor;
 mod input;
 mod overlay;
 mod paint;
@@ -234,6 +240,13 @@ pub struct Viewport {
     interior: Option<(u64, Vec<Vec<bool>>)>,
     /// The body's depth for the overlay, with what it was rasterised for.
     body_depth: Option<(BodyDepthKey, Arc<select::DepthMap>)>,
+    /// The grooming brush's stroke in progress.
+    stroke: Option<groom_brush::Stroke>,
+    /// The grooming brush under the pointer, as drawn last (tests aim with it).
+    pub brush_cursor: Option<BrushCursor>,
+    /// The body's distance field the brushes keep hair out of, for the body it was built
+    /// for (a fingerprint of its mesh).
+    body_field: Option<(u64, Arc<hairloom_core::simulate::BodySdf>)>,
     /// Styling frames per layer and column for the document revision they were computed at.
     frames: Option<(
         u64,
@@ -333,6 +346,9 @@ impl Viewport {
             framed_from_hair: false,
             interior: None,
             body_depth: None,
+            stroke: None,
+            brush_cursor: None,
+            body_field: None,
             frames: None,
         }
     }
@@ -380,7 +396,7 @@ impl Viewport {
                     self.styling_handles = None;
                     self.drive_gizmo(ui, state, &response, projector)
                 };
-                if !grabbed {
+                if !grabbed && !self.groom(ui, state, &response, projector) {
                     self.select(ui, state, &response, projector);
                 }
                 self.keys(ui, state, &response);

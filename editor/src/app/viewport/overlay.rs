@@ -208,6 +208,7 @@ impl Viewport {
                 DragTool::Lasso => {
                     painter.add(egui::Shape::closed_line(self.drag_path.clone(), stroke));
                 }
+                DragTool::Groom => {}
                 DragTool::Paint => {
                     painter.circle_stroke(last, state.tool.paint_radius_px, stroke);
                     painter.add(egui::Shape::line(
@@ -219,6 +220,24 @@ impl Viewport {
                     ));
                 }
             }
+        }
+        // The grooming brush: its circle at its size on the hair (fainter off the hair).dashed off the hair).
+        if state.tool.drag == DragTool::Groom
+            && let Some(cursor) = self.brush_cursor
+        {
+            let alpha = if cursor.touches_hair { 230 } else { 110 };
+            let colour = egui::Color32::from_rgba_unmultiplied(255, 200, 120, alpha);
+            painter.circle_stroke(
+                cursor.centre,
+                cursor.radius_px,
+                egui::Stroke::new(1.5, colour),
+            );
+            // Strength as an inner ring (a full-strength brush fills its circle).
+            painter.circle_stroke(
+                cursor.centre,
+                cursor.radius_px * state.tool.brush.strength as f32,
+                egui::Stroke::new(1.0, egui::Color32::from_white_alpha(alpha / 2)),
+            );
         }
         if let Some(active) = &self.transform {
             if let Some(pivot) = project(active.pivot) {

@@ -1,0 +1,722 @@
+//! Grooming brushes: comb, length, puff, smooth and clump dabs on the hair mesh's exterior
+//! vertices, as a groom artist strokes them over the head. Interior vertices follow by the
+//! existing rule ([`crate::geometry::interior`], through [`finish`]).
+//!
+//! Exterior vertices and locked interior ones (known values of their layers, as a drape
+//! leaves them) are brushed; the other interior vertices are placed.
+//!
+//! A stroke is a run of dabs; the editor applies each to the mesh the stroke has made so far
+//! and records the stroke as one undo step. Every dab keeps the mesh valid:
+//! - hair keeps its length (comb, puff, smooth and clump turn segments, never stretch them;
+//!   the length brush scales them within bounds), so no layer collapses onto the one below;
+//! - no bundle layer turns over (its corners' winding stays that of the root face): a dab
+//!   that would flip one is applied at a half, a quarter, … of its strength, or not at all;
+//! - hair stays outside the body: a vertex the dab moves into it is pushed back out along
+//!   the body's distance field.
+//!
+//! With `mirror_x` the dab also acts at its mirror image across the head's plane `x = c`,
+//! each vertex taking the nearer of the two (a dab on the plane does not act twice).
+
+use std::collections::BTreeSet;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use crate::edit::{EditError, EditOutcome, falloff_weight, finish};
+use crate::model::mesh::{HairMesh, Topology};
+use crate::simulate::BodySdf;
+
+/// What a dab does to the vertices under it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BrushKind {
+    /// Drag hair along the pointer's motion; segments turn, lengths stay.
+    #[default]
+    Comb,
+    /// Grow the hair under the brush (inverted: cut it), scaling its segments from the root.
+    Length,
+    /// Lift hair away from the scalp (inverted: flatten it onto the scalp).
+    Puff,
+    /// Relax kinks: each vertex toward the mean of its neighbours along and across the hair.
+    Smooth,
+    /// Gather the hair under the brush toward its centre, layer by layer (inverted: spread).
+    Clump,
+}
+
+impl BrushKind {
+    pub const ALL: [BrushKind; 5] = [
+        BrushKind::Comb,
+        BrushKind::Length,
+        BrushKind::Puff,
+        BrushKind::Smooth,
+        BrushKind::Clump,
+    ];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            BrushKind::Comb => "Comb",
+            BrushKind::Length => "Grow / cut",
+            BrushKind::Puff => "Puff",
+            BrushKind::Smooth => "Smooth",
+            BrushKind::Clump => "Clump",
+        }
+    }
+}
+
+/// One dab of a brush stroke, in model units.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BrushDab {
+    pub kind: BrushKind,
+    /// Where the brush touches the hair.
+    pub centre_m: [f64; 3],
+    pub radius_m: f64,
+    /// 0 … 1; a tablet's pressure multiplies into it.
+    pub strength: f64,
+    /// Ctrl: the brush's opposite (cut, flatten, spread).
+    pub invert: bool,
+    /// The pointer's motion over the hair since the last dab (the comb's direction).
+    pub motion_m: [f64; 3],
+    /// The view direction (camera toward the scene): hair whose scalp faces away from the
+    /// viewer is left alone, so a stroke never reaches through the head. `None`: all hair.
+    pub view_direction: Option<[f64; 3]>,
+    /// Also act at the mirror image across `x = mirror_plane_x`.
+    pub mirror_x: bool,
+    pub mirror_plane_x: f64,
+}
+
+/// How far one dab at full strength moves hair, as a share of the brush radius (puff,
+/// smooth, clump) or of the segment length (length): small steps, so a stroke of many dabs
+/// builds a shape the artist can follow.
+const STEP_SHARE: f64 = 0.25;
+/// The share by which one dab at full strength grows or cuts the hair under the brush.
+const LENGTH_STEP: f64 = 0.1;
+/// No brush leaves a segment shorter than this (unless it already was): the length brush
+/// cuts to it, and a dab that would crowd vertices closer is held back.
+const MIN_SEGMENT_M: f64 = 1e-4;
+/// Hair pushed out of the body lands this far outside it.
+const BODY_MARGIN_M: f64 = 1e-3;
+/// How deep inside the body's (sampled) distance field a hair vertex may sit before a dab
+/// that put it there is held back.
+const INSIDE_TOLERANCE_M: f64 = 2.5e-4;
+/// A scalp normal this far toward the view direction counts as facing away.
+const FACING_AWAY: f64 = 0.2;
+
+impl BrushDab {
+    fn check(&self) -> Result<(), EditError> {
+        let mut values: Vec<(&'static str, f64)> = vec![
+            ("brush radius", self.radius_m),
+            ("brush strength", self.strength),
+            ("mirror plane", self.mirror_plane_x),
+        ];
+        values.extend(self.centre_m.map(|v| ("brush centre", v)));
+        values.extend(self.motion_m.map(|v| ("brush motion", v)));
+        if let Some(view) = self.view_direction {
+            values.extend(view.map(|v| ("view direction", v)));
+        }
+        if let Some((what, value)) = values.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(EditError::NotFinite {
+                what,
+                value: value.to_string(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The brush's centres with their motion and view direction (the mirror image second).
+    fn centres(&self) -> Vec<(DVec3, DVec3, Option<DVec3>)> {
+        let view = self.view_direction.map(DVec3::from);
+        let mut centres = vec![(DVec3::from(self.centre_m), DVec3::from(self.motion_m), view)];
+        if self.mirror_x {
+            let mirror = |v: DVec3| DVec3::new(-v.x, v.y, v.z);
+            let c = DVec3::from(self.centre_m);
+            centres.push((
+                DVec3::new(2.0 * self.mirror_plane_x - c.x, c.y, c.z),
+                mirror(DVec3::from(self.motion_m)),
+                view.map(mirror),
+            ));
+        }
+        centres
+    }
+}
+
+/// The unit normal of each column's root vertex: the mean of the root faces around it
+/// (Newell's normal, so quads need not be planar). Zero for a column with no root face.
+pub fn root_normals(mesh: &HairMesh) -> Vec<DVec3> {
+    let mut sums = vec![DVec3::ZERO; mesh.columns.len()];
+    for bundle in &mesh.bundles {
+        let corners: Vec<DVec3> = bundle
+            .vertices
+            .iter()
+            .filter_map(|&c| mesh.columns.get(c as usize)?.positions.first().copied())
+            .collect();
+        if corners.len() != bundle.vertices.len() {
+            continue;
+        }
+        let normal = newell(&corners);
+        for &c in &bundle.vertices {
+            sums[c as usize] += normal;
+        }
+    }
+    sums.iter()
+        .map(|n| n.try_normalize().unwrap_or(DVec3::ZERO))
+        .collect()
+}
+
+/// Newell's polygon normal, its length twice the area.
+fn newell(corners: &[DVec3]) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    for (i, a) in corners.iter().enumerate() {
+        let b = corners[(i + 1) % corners.len()];
+        n += DVec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    n
+}
+
+/// A layer of a bundle that turned over or collapsed: its corners wind against the root
+/// face (or span no area), which no brush, transform or drape should leave behind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TurnedLayer {
+    pub bundle: u32,
+    pub layer: u32,
+}
+
+/// Every layer of every active bundle whose corners wind against its root face, or whose
+/// area falls below a millionth of the root face's. A dab never adds one (a mesh that came
+/// in with one keeps it).
+pub fn turned_layers(mesh: &HairMesh) -> Vec<TurnedLayer> {
+    turned_layers_of(mesh, 0..mesh.bundles.len())
+}
+
+fn turned_layers_of(mesh: &HairMesh, bundles: impl Iterator<Item = usize>) -> Vec<TurnedLayer> {
+    let mut turned = Vec::new();
+    for b in bundles {
+        let bundle = &mesh.bundles[b];
+        if bundle.removed {
+            continue;
+        }
+        let layer_normal = |k: usize| {
+            let corners: Option<Vec<DVec3>> = bundle
+                .vertices
+                .iter()
+                .map(|&c| mesh.columns.get(c as usize)?.positions.get(k).copied())
+                .collect();
+            corners.map(|corners| newell(&corners))
+        };
+        let Some(root) = layer_normal(0) else {
+            continue;
+        };
+        let root_area = root.length();
+        if root_area <= 0.0 {
+            continue;
+        }
+        for k in 1..=bundle.layers as usize {
+            let Some(normal) = layer_normal(k) else {
+                continue;
+            };
+            if normal.dot(root) <= 1e-6 * root_area * root_area {
+                turned.push(TurnedLayer {
+                    bundle: b as u32,
+                    layer: k as u32,
+                });
+            }
+        }
+    }
+    turned
+}
+
+/// One dab on `mesh` (see the module documentation). `body` keeps hair outside the head;
+/// [`BodySdf::empty`] when there is none. The outcome's `affected_bundles` is empty when the
+/// dab touched nothing (or could not act without turning a layer over).
+pub fn apply_brush(
+    mesh: &HairMesh,
+    body: &BodySdf,
+    dab: &BrushDab,
+) -> Result<EditOutcome, EditError> {
+    dab.check()?;
+    let unchanged = || EditOutcome {
+        mesh: mesh.clone(),
+        affected_bundles: Vec::new(),
+    };
+    let strength = dab.strength.clamp(0.0, 1.0);
+    if dab.radius_m <= 0.0 || strength == 0.0 {
+        return Ok(unchanged());
+    }
+    let topology = Topology::build(mesh);
+    let normals = root_normals(mesh);
+    let centres = dab.centres();
+    // Each exterior hair vertex under the brush: its weight and the centre that acts on it.
+    let mut weights: Vec<Vec<(f64, usize)>> = mesh
+        .columns
+        .iter()
+        .map(|c| vec![(0.0, 0); c.positions.len()])
+        .collect();
+    let mut touched_columns: BTreeSet<usize> = BTreeSet::new();
+    for (c, column) in mesh.columns.iter().enumerate() {
+        if topology.bundles_of_column[c].is_empty() {
+            continue;
+        }
+        for (k, &p) in column.positions.iter().enumerate().skip(1) {
+            // A locked interior vertex is a known value of its layer (placed by the artist
+            // or a drape), so the brush moves it like an exterior one.
+            if mesh.is_interior(&topology, c, k) && !mesh.is_locked(c, k) {
+                continue;
+            }
+            for (i, (centre, _, view)) in centres.iter().enumerate() {
+                if view.is_some_and(|view| normals[c].dot(view) > FACING_AWAY) {
+                    continue;
+                }
+                let w = falloff_weight(p.distance(*centre), dab.radius_m) * strength;
+                if w > weights[c][k].0 {
+                    weights[c][k] = (w, i);
+                    touched_columns.insert(c);
+                }
+            }
+        }
+    }
+    if touched_columns.is_empty() {
+        return Ok(unchanged());
+    }
+    let moved = stroke_positions(mesh, &normals, dab, &centres, &weights);
+    // The strongest share of the dab (1, ½, ¼, ⅛) that turns no layer over.
+    let affected: BTreeSet<u32> = touched_columns
+        .iter()
+        .flat_map(|&c| topology.bundles_of_column[c].iter().copied())
+        .collect();
+    let turned_before = turned_layers_of(mesh, affected.iter().map(|&b| b as usize));
+    let inside_before = inside_body(mesh, body);
+    let short_before = short_segments(mesh);
+    for share in [1.0, 0.5, 0.25, 0.125] {
+        let mut out = mesh.clone();
+        for &c in &touched_columns {
+            for (k, p) in out.columns[c].positions.iter_mut().enumerate().skip(1) {
+                *p = p.lerp(moved[c][k], share);
+            }
+        }
+        keep_outside(&mut out, body, &touched_columns);
+        let outcome = finish(out, affected.clone(), None)?;
+        let turned = turned_layers_of(&outcome.mesh, affected.iter().map(|&b| b as usize));
+        // Interior vertices are placed after the push out of the body, so they are checked.
+        let inside = inside_body(&outcome.mesh, body);
+        let held = turned.iter().all(|t| turned_before.contains(t))
+            && inside.is_subset(&inside_before)
+            && short_segments(&outcome.mesh).is_subset(&short_before);
+        if held {
+            return Ok(outcome);
+        }
+    }
+    Ok(unchanged())
+}
+
+/// Where the dab at full strength puts each vertex of the touched columns (the others keep
+/// theirs): the brush's displacement, then every column walked from the root so each
+/// segment keeps its length (or, for the length brush, its scaled length).
+fn stroke_positions(
+    mesh: &HairMesh,
+    normals: &[DVec3],
+    dab: &BrushDab,
+    centres: &[(DVec3, DVec3, Option<DVec3>)],
+    weights: &[Vec<(f64, usize)>],
+) -> Vec<Vec<DVec3>> {
+    let sign = if dab.invert { -1.0 } else { 1.0 };
+    let step = STEP_SHARE * dab.radius_m;
+    let mut target: Vec<Vec<DVec3>> = mesh.columns.iter().map(|c| c.positions.clone()).collect();
+    // Clump: the weighted centre of the hair under each centre, layer by layer.
+    let longest = mesh.columns.iter().map(|c| c.positions.len()).max();
+    let mut clump_centres: Vec<Vec<(DVec3, f64)>> =
+        vec![vec![(DVec3::ZERO, 0.0); longest.unwrap_or(0)]; centres.len()];
+    if dab.kind == BrushKind::Clump {
+        for (c, column) in mesh.columns.iter().enumerate() {
+            for (k, &p) in column.positions.iter().enumerate() {
+                let (w, i) = weights[c][k];
+                if w > 0.0 {
+                    let slot = &mut clump_centres[i][k];
+                    slot.0 += p * w;
+                    slot.1 += w;
+                }
+            }
+        }
+    }
+    let neighbours = column_neighbours(mesh);
+    for (c, column) in mesh.columns.iter().enumerate() {
+        for (k, &p) in column.positions.iter().enumerate().skip(1) {
+            let (w, i) = weights[c][k];
+            if w <= 0.0 {
+                continue;
+            }
+            let root = column.positions[0];
+            target[c][k] = match dab.kind {
+                BrushKind::Comb => p + centres[i].1 * w,
+                // Toward (or onto) the scalp's normal, by a share of the vertex's height.
+                BrushKind::Puff => p + normals[c] * (sign * w * STEP_SHARE * p.distance(root)),
+                BrushKind::Smooth => {
+                    let mut sum = column.positions[k - 1];
+                    let mut count = 1.0;
+                    if let Some(&above) = column.positions.get(k + 1) {
+                        sum += above;
+                        count += 1.0;
+                    }
+                    for &n in &neighbours[c] {
+                        if let Some(&q) = mesh.columns[n].positions.get(k) {
+                            sum += q;
+                            count += 1.0;
+                        }
+                    }
+                    p.lerp(sum / count, 0.5 * w)
+                }
+                BrushKind::Clump => {
+                    let (sum, total) = clump_centres[i][k];
+                    let toward = sum / total - p;
+                    let pull = (sign * w * 0.5).max(-step / toward.length().max(1e-12));
+                    p + toward * pull
+                }
+                BrushKind::Length => p,
+            };
+        }
+    }
+    // Walk each touched column from the root, segment lengths kept (or scaled).
+    for (c, column) in mesh.columns.iter().enumerate() {
+        let column_weight = weights[c].iter().map(|&(w, _)| w).fold(0.0, f64::max);
+        if column_weight <= 0.0 {
+            continue;
+        }
+        let scale = match dab.kind {
+            BrushKind::Length => 1.0 + sign * column_weight * LENGTH_STEP,
+            _ => 1.0,
+        };
+        for k in 1..column.positions.len() {
+            let before = column.positions[k] - column.positions[k - 1];
+            let length = (before.length() * scale).max(MIN_SEGMENT_M.min(before.length()));
+            let direction = (target[c][k] - target[c][k - 1])
+                .try_normalize()
+                .or_else(|| before.try_normalize())
+                .unwrap_or(DVec3::Y);
+            target[c][k] = target[c][k - 1] + direction * length;
+        }
+    }
+    target
+}
+
+/// For each column, the columns it shares a bundle edge with.
+fn column_neighbours(mesh: &HairMesh) -> Vec<Vec<usize>> {
+    let mut neighbours: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); mesh.columns.len()];
+    for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
+        let n = bundle.vertices.len();
+        for i in 0..n {
+            let (a, b) = (
+                bundle.vertices[i] as usize,
+                bundle.vertices[(i + 1) % n] as usize,
+            );
+            neighbours[a].insert(b);
+            neighbours[b].insert(a);
+        }
+    }
+    neighbours
+        .into_iter()
+        .map(|s| s.into_iter().collect())
+        .collect()
+}
+
+/// The segments `(column, upper layer)` shorter than [`MIN_SEGMENT_M`]: a layer collapsing
+/// onto the one below (hair cut to nothing, or vertices crowded against the body).
+fn short_segments(mesh: &HairMesh) -> BTreeSet<(usize, usize)> {
+    let mut short = BTreeSet::new();
+    for (c, column) in mesh.columns.iter().enumerate() {
+        for (k, s) in column.positions.windows(2).enumerate() {
+            if s[0].distance(s[1]) < MIN_SEGMENT_M {
+                short.insert((c, k + 1));
+            }
+        }
+    }
+    short
+}
+
+/// The hair vertices (layer ≥ 1) deeper inside the body than [`INSIDE_TOLERANCE_M`].
+fn inside_body(mesh: &HairMesh, body: &BodySdf) -> BTreeSet<(usize, usize)> {
+    if body.is_empty() {
+        return BTreeSet::new();
+    }
+    let mut inside = BTreeSet::new();
+    for (c, column) in mesh.columns.iter().enumerate() {
+        for (k, &p) in column.positions.iter().enumerate().skip(1) {
+            if body.distance_m(p) < -INSIDE_TOLERANCE_M {
+                inside.insert((c, k));
+            }
+        }
+    }
+    inside
+}
+
+/// Pushes each non-root vertex of `columns` that lies inside the body (or within the
+/// margin of its surface) back out along the distance field's gradient.
+fn keep_outside(mesh: &mut HairMesh, body: &BodySdf, columns: &BTreeSet<usize>) {
+    if body.is_empty() {
+        return;
+    }
+    for &c in columns {
+        for p in mesh.columns[c].positions.iter_mut().skip(1) {
+            let (distance, gradient) = body.distance_and_gradient(*p);
+            if distance < BODY_MARGIN_M
+                && let Some(out) = gradient.try_normalize()
+            {
+                *p += out * (BODY_MARGIN_M - distance);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::samples::{grid_scalp, sphere_body, sphere_cap, straight_layers};
+    use crate::strands::random::SplitMix64;
+
+    const RADIUS_M: f64 = 0.1;
+
+    /// A cap of hair on a sphere head, symmetric across x = 0, and the head's field.
+    fn head() -> (HairMesh, BodySdf) {
+        let body = sphere_body(RADIUS_M, 24, 48);
+        let mesh = sphere_cap(RADIUS_M, 0.9, 6, 4, 0.02);
+        let sdf = BodySdf::for_hair(&body, &mesh);
+        (mesh, sdf)
+    }
+
+    fn dab(kind: BrushKind, centre: DVec3, radius_m: f64) -> BrushDab {
+        BrushDab {
+            kind,
+            centre_m: centre.to_array(),
+            radius_m,
+            strength: 1.0,
+            invert: false,
+            motion_m: [0.0; 3],
+            view_direction: None,
+            mirror_x: false,
+            mirror_plane_x: 0.0,
+        }
+    }
+
+    fn column_length(mesh: &HairMesh, c: usize) -> f64 {
+        let p = &mesh.columns[c].positions;
+        p.windows(2).map(|s| s[0].distance(s[1])).sum()
+    }
+
+    /// Random strokes of every brush, mirrored or not, strong and weak, from any side: the
+    /// mesh stays valid, no layer turns over or collapses, and no hair vertex goes inside
+    /// the head.
+    #[test]
+    fn random_strokes_keep_the_mesh_valid_unturned_and_outside_the_body() {
+        let (mut mesh, sdf) = head();
+        let mut random = SplitMix64::new(7);
+        let mut acted = 0;
+        for step in 0..300 {
+            let kind = BrushKind::ALL[(random.next_u64() % 5) as usize];
+            let c = (random.next_u64() as usize) % mesh.columns.len();
+            let column = &mesh.columns[c].positions;
+            let on = column[(random.next_u64() as usize) % column.len()];
+            let mut unit = || 2.0 * random.next_f64() - 1.0;
+            let d = BrushDab {
+                kind,
+                centre_m: (on + DVec3::new(unit(), unit(), unit()) * 0.01).to_array(),
+                radius_m: 0.01 + 0.05 * unit().abs(),
+                strength: unit().abs(),
+                invert: unit() < 0.0,
+                motion_m: (DVec3::new(unit(), unit(), unit()) * 0.03).to_array(),
+                view_direction: (unit() < 0.0)
+                    .then(|| DVec3::new(unit(), unit(), unit()).normalize().to_array()),
+                mirror_x: unit() < 0.0,
+                mirror_plane_x: 0.0,
+            };
+            let outcome = apply_brush(&mesh, &sdf, &d).unwrap_or_else(|e| panic!("{step}: {e}"));
+            if !outcome.affected_bundles.is_empty() {
+                acted += 1;
+            }
+            mesh = outcome.mesh;
+            mesh.validate().expect("valid");
+            assert_eq!(turned_layers(&mesh), Vec::new(), "dab {step} ({kind:?})");
+            assert_eq!(
+                short_segments(&mesh),
+                BTreeSet::new(),
+                "dab {step} ({kind:?})"
+            );
+            for (c, column) in mesh.columns.iter().enumerate() {
+                for (k, &p) in column.positions.iter().enumerate().skip(1) {
+                    let distance = sdf.distance_m(p);
+                    assert!(
+                        distance > -INSIDE_TOLERANCE_M,
+                        "dab {step} ({kind:?}): column {c} layer {k} is {distance} m inside the head"
+                    );
+                }
+            }
+        }
+        assert!(acted > 150, "only {acted} of 300 dabs acted");
+    }
+
+    /// Combing turns hair without stretching it: every strand keeps its length.
+    #[test]
+    fn comb_keeps_every_strand_length_and_follows_the_motion() {
+        let (mesh, _) = head();
+        let before: Vec<f64> = (0..mesh.columns.len())
+            .map(|c| column_length(&mesh, c))
+            .collect();
+        let top = mesh.columns[(mesh.columns.len() - 1) / 2].positions[4];
+        let mut d = dab(BrushKind::Comb, top, 0.05);
+        d.motion_m = [0.02, 0.0, 0.0];
+        let outcome = apply_brush(&mesh, &BodySdf::empty(), &d).expect("comb");
+        assert!(!outcome.affected_bundles.is_empty());
+        let mut moved_x = 0.0;
+        for (c, column) in outcome.mesh.columns.iter().enumerate() {
+            let length = column_length(&outcome.mesh, c);
+            assert!(
+                (length - before[c]).abs() < 1e-9 * before[c].max(1.0),
+                "column {c}: {length} after {}",
+                before[c]
+            );
+            moved_x += column.positions[4].x - mesh.columns[c].positions[4].x;
+        }
+        assert!(moved_x > 0.01, "the tips moved along the comb: {moved_x}");
+    }
+
+    /// With X-mirror, a dab on one side of the head acts the same on the other.
+    #[test]
+    fn a_mirrored_dab_acts_the_same_on_both_sides() {
+        let (mesh, sdf) = head();
+        for kind in BrushKind::ALL {
+            let tip = mesh.columns[1].positions[4];
+            let mut d = dab(kind, tip, 0.04);
+            d.motion_m = [0.01, -0.005, 0.004];
+            d.mirror_x = true;
+            d.strength = 0.7;
+            let out = apply_brush(&mesh, &sdf, &d).expect("dab").mesh;
+            assert_ne!(out, mesh, "{kind:?} acted");
+            for (c, column) in out.columns.iter().enumerate() {
+                let root = mesh.columns[c].positions[0];
+                let image = (0..mesh.columns.len())
+                    .min_by(|&a, &b| {
+                        let m = DVec3::new(-root.x, root.y, root.z);
+                        let da = mesh.columns[a].positions[0].distance(m);
+                        da.total_cmp(&mesh.columns[b].positions[0].distance(m))
+                    })
+                    .expect("a column");
+                for (k, p) in column.positions.iter().enumerate() {
+                    let q = out.columns[image].positions[k];
+                    let mirrored = DVec3::new(-q.x, q.y, q.z);
+                    assert!(
+                        p.distance(mirrored) < 1e-6,
+                        "{kind:?}: column {c} layer {k} at {p} and its image at {q}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Seen from the front, a brush as large as the head leaves the hair whose scalp faces
+    /// away alone (it never reaches through the head).
+    #[test]
+    fn a_front_facing_dab_leaves_the_far_side_alone() {
+        let (mesh, sdf) = head();
+        let mut d = dab(BrushKind::Comb, DVec3::new(0.0, 0.1, 0.0), 1.0);
+        d.motion_m = [0.0, 0.0, 0.02];
+        // Looking along −z: the front is +z.
+        d.view_direction = Some([0.0, 0.0, -1.0]);
+        let out = apply_brush(&mesh, &sdf, &d).expect("comb").mesh;
+        let normals = root_normals(&mesh);
+        let (mut front, mut back) = (0, 0);
+        let topology = Topology::build(&mesh);
+        for (c, column) in out.columns.iter().enumerate() {
+            // Interior vertices are placed from the whole layer, so only the exterior count.
+            let moved = (1..column.positions.len()).any(|k| {
+                !mesh.is_interior(&topology, c, k)
+                    && column.positions[k] != mesh.columns[c].positions[k]
+            });
+            if normals[c].z < -FACING_AWAY {
+                assert!(!moved, "column {c} faces away but moved");
+                back += 1;
+            } else if moved {
+                front += 1;
+            }
+        }
+        assert!(
+            front > 0 && back > 0,
+            "{front} moved in front, {back} held behind"
+        );
+    }
+
+    /// The length brush grows hair by a share per dab and cuts it down to a floor, never to
+    /// nothing; puff lifts the tips away from the scalp and flattening brings them back.
+    #[test]
+    fn length_grows_and_cuts_within_bounds_and_puff_lifts() {
+        let (mesh, sdf) = head();
+        let c = mesh.columns.len() / 2;
+        let tip = mesh.columns[c].positions[4];
+        let before = column_length(&mesh, c);
+        let grown = apply_brush(&mesh, &sdf, &dab(BrushKind::Length, tip, 0.01)).expect("grow");
+        let grown_length = column_length(&grown.mesh, c);
+        assert!(grown_length > before * 1.02, "{before} → {grown_length}");
+        let mut cut = mesh.clone();
+        let mut d = dab(BrushKind::Length, tip, 0.5);
+        d.invert = true;
+        for _ in 0..200 {
+            cut = apply_brush(&cut, &sdf, &d).expect("cut").mesh;
+        }
+        // The columns on the cap's rim are exterior all the way up: their segments.
+        let topology = Topology::build(&cut);
+        for (c, column) in cut.columns.iter().enumerate() {
+            if !topology.root_boundary[c] {
+                continue;
+            }
+            for s in column.positions.windows(2) {
+                assert!(
+                    s[0].distance(s[1]) >= MIN_SEGMENT_M * 0.999,
+                    "column {c}: {} {} {}",
+                    s[0].distance(s[1]),
+                    s[0],
+                    s[1]
+                );
+            }
+            assert!(
+                column_length(&cut, c) < 0.5 * column_length(&mesh, c),
+                "column {c} cut: {} of {}",
+                column_length(&cut, c),
+                column_length(&mesh, c)
+            );
+        }
+        let height = |m: &HairMesh| m.columns[c].positions[4].length();
+        let puffed = apply_brush(&mesh, &sdf, &dab(BrushKind::Puff, tip, 0.05)).expect("puff");
+        assert!(height(&puffed.mesh) >= height(&mesh) - 1e-9);
+        let mut flat = dab(BrushKind::Puff, tip, 0.05);
+        flat.invert = true;
+        let flattened = apply_brush(&mesh, &sdf, &flat).expect("flatten");
+        assert!(height(&flattened.mesh) < height(&mesh));
+    }
+
+    /// A comb that would drag one corner of a bundle's tip across the bundle (turning the
+    /// tip face over) acts only as far as the face stays the right way up.
+    #[test]
+    fn a_dab_that_would_turn_a_layer_over_is_held_back() {
+        let scalp = grid_scalp(1, 1, |s, t| DVec3::new(0.1 * s, 0.1 * t, 0.0));
+        let mesh = straight_layers(scalp, 1, DVec3::Z * 0.1);
+        let corner = mesh.columns[0].positions[1];
+        let mut d = dab(BrushKind::Comb, corner, 0.02);
+        d.motion_m = [0.5, 0.5, 0.0];
+        let outcome = apply_brush(&mesh, &BodySdf::empty(), &d).expect("comb");
+        assert_eq!(turned_layers(&outcome.mesh), Vec::new());
+        // Cleared for the half-way share or less: the corner moved, but not across.
+        let moved = outcome.mesh.columns[0].positions[1];
+        assert!(moved.x < 0.1 && moved.y < 0.1, "{moved}");
+    }
+
+    #[test]
+    fn a_dab_with_a_non_finite_value_is_a_named_error() {
+        let (mesh, sdf) = head();
+        let mut d = dab(BrushKind::Smooth, DVec3::ZERO, 0.1);
+        d.motion_m[1] = f64::NAN;
+        let error = apply_brush(&mesh, &sdf, &d).expect_err("NaN");
+        assert!(error.to_string().contains("brush motion"), "{error}");
+        let mut d = dab(BrushKind::Smooth, DVec3::ZERO, f64::INFINITY);
+        d.strength = 0.5;
+        assert!(apply_brush(&mesh, &sdf, &d).is_err());
+    }
+}
