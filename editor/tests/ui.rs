@@ -2213,8 +2213,9 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
     let rect = viewport_rect(&harness);
     // Find a point over the hair: the brush's circle says when it touches.
     let mut start = None;
+    // Off the head's centre line, so the X-mirror's image is a stroke of its own.
     'search: for row in 2..12 {
-        for column in [5, 4, 6, 3, 7] {
+        for column in [4, 6, 3, 7] {
             let at = rect.left_top()
                 + egui::vec2(
                     rect.width() * column as f32 / 10.0,
@@ -2244,6 +2245,14 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
     let history = &harness.state().state.project.history;
     assert_eq!(history.undo.len(), 1, "{}", harness.state().state.message);
     assert_eq!(history.undo[0].label(), "Comb brush");
+    // Several dabs made that one step.
+    let message = harness.state().state.message.clone();
+    let dabs: usize = message
+        .strip_prefix("Comb: ")
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{message}"));
+    assert!(dabs >= 2, "{message}");
     // X-mirror: columns on both sides of the head's plane moved.
     let plane = original.mirror_plane_x();
     let moved_side = |left: bool| {
@@ -2263,6 +2272,41 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
         harness.state().state.document().hair_mesh,
         original.hair_mesh
     );
+
+    // An undo in the middle of a stroke ends it: what it did so far is one step, undone,
+    // and the rest of the drag adds nothing.
+    harness.hover_at(start);
+    harness.run();
+    harness.event(egui::Event::PointerButton {
+        pos: start,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run();
+    for step in 1..=4 {
+        harness.hover_at(start + egui::vec2(12.0 * step as f32, 0.0));
+        harness.run();
+    }
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    for step in 5..=8 {
+        harness.hover_at(start + egui::vec2(12.0 * step as f32, 0.0));
+        harness.run();
+    }
+    harness.event(egui::Event::PointerButton {
+        pos: start + egui::vec2(96.0, 0.0),
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().hair_mesh,
+        original.hair_mesh
+    );
+    assert_eq!(harness.state().state.project.history.undo.len(), 0);
+    assert_eq!(harness.state().state.project.history.redo.len(), 1);
 
     // The length brush grows what it strokes.
     harness.get_by_label("Grow / cut").click();

@@ -7,15 +7,24 @@
 //!
 //! A stroke is a run of dabs; the editor applies each to the mesh the stroke has made so far
 //! and records the stroke as one undo step. Every dab keeps the mesh valid:
-//! - hair keeps its length (comb, puff, smooth and clump turn segments, never stretch them;
-//!   the length brush scales them within bounds), so no layer collapses onto the one below;
-//! - no bundle layer turns over (its corners' winding stays that of the root face): a dab
-//!   that would flip one is applied at a half, a quarter, … of its strength, or not at all;
+//! - the brushed columns keep their segment lengths (comb, puff, smooth and clump turn
+//!   segments, never stretch them; the length brush scales them, down to a floor); interior
+//!   vertices are then placed by the rule, so a segment next to one can change, and no
+//!   segment anywhere is left shorter than the floor (a layer collapsing onto the one below);
+//! - no bundle layer flips against the layer below (see [`turned_layers`]);
 //! - hair stays outside the body: a vertex the dab moves into it is pushed back out along
 //!   the body's distance field.
 //!
-//! With `mirror_x` the dab also acts at its mirror image across the head's plane `x = c`,
-//! each vertex taking the nearer of the two (a dab on the plane does not act twice).
+//! A dab that would break one of these anyway (the push out of the head, or interior
+//! placement, can) is applied at a half, a quarter, an eighth of its strength, or not at
+//! all. Each is judged against the mesh before the dab and against what placing its
+//! interior afresh alone gives (as any edit does), so a sample placed otherwise is not
+//! frozen by a layer the brush did not turn.
+//!
+//! With `mirror_x` the dab also acts at its mirror image across the head's plane `x = c`:
+//! each vertex takes the stronger centre's weight and the weighted mean of their motions
+//! (a dab on the plane does not act twice, and sideways combing cancels there instead of
+//! parting the hair).
 
 use std::collections::BTreeSet;
 
@@ -140,10 +149,11 @@ impl BrushDab {
 }
 
 /// The unit normal of each column's root vertex: the mean of the root faces around it
-/// (Newell's normal, so quads need not be planar). Zero for a column with no root face.
+/// (Newell's normal, so quads need not be planar). Zero for a column with no active root
+/// face (removed bundles do not count).
 pub fn root_normals(mesh: &HairMesh) -> Vec<DVec3> {
     let mut sums = vec![DVec3::ZERO; mesh.columns.len()];
-    for bundle in &mesh.bundles {
+    for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
         let corners: Vec<DVec3> = bundle
             .vertices
             .iter()
@@ -176,25 +186,23 @@ fn newell(corners: &[DVec3]) -> DVec3 {
     n
 }
 
-/// A layer of a bundle that turned over or collapsed: its corners wind against the root
-/// face (or span no area), which no brush, transform or drape should leave behind.
+/// A layer of a bundle that turned over or collapsed: its corners wind against the layer
+/// below's (or span no area), which no brush, transform or drape should leave behind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TurnedLayer {
     pub bundle: u32,
     pub layer: u32,
 }
 
-/// Every layer of every active bundle whose corners wind against its root face, or whose
-/// area falls below a millionth of the root face's. A dab never adds one (a mesh that came
-/// in with one keeps it).
+/// Every layer of every active bundle that turned over or collapsed: its corners wind
+/// against the layer below's (their normals point opposite ways: the cross-section flipped
+/// between two layers), or its area falls below a millionth of the root face's. Hair may
+/// bend and shear any way (a long bundle hanging down the back, a layer sheared along the
+/// strand); only a flip from one layer to the next counts. A dab never adds one (a mesh
+/// that came in with one keeps it).
 pub fn turned_layers(mesh: &HairMesh) -> Vec<TurnedLayer> {
-    turned_layers_of(mesh, 0..mesh.bundles.len())
-}
-
-fn turned_layers_of(mesh: &HairMesh, bundles: impl Iterator<Item = usize>) -> Vec<TurnedLayer> {
     let mut turned = Vec::new();
-    for b in bundles {
-        let bundle = &mesh.bundles[b];
+    for (b, bundle) in mesh.bundles.iter().enumerate() {
         if bundle.removed {
             continue;
         }
@@ -213,15 +221,20 @@ fn turned_layers_of(mesh: &HairMesh, bundles: impl Iterator<Item = usize>) -> Ve
         if root_area <= 0.0 {
             continue;
         }
+        let mut below = root;
         for k in 1..=bundle.layers as usize {
             let Some(normal) = layer_normal(k) else {
                 continue;
             };
-            if normal.dot(root) <= 1e-6 * root_area * root_area {
+            let collapsed = normal.length() <= 1e-6 * root_area;
+            if collapsed || normal.dot(below) < 0.0 {
                 turned.push(TurnedLayer {
                     bundle: b as u32,
                     layer: k as u32,
                 });
+            }
+            if !collapsed {
+                below = normal;
             }
         }
     }
@@ -248,15 +261,20 @@ pub fn apply_brush(
     let topology = Topology::build(mesh);
     let normals = root_normals(mesh);
     let centres = dab.centres();
-    // Each exterior hair vertex under the brush: its weight and the centre that acts on it.
-    let mut weights: Vec<Vec<(f64, usize)>> = mesh
+    // Each brushed hair vertex under the brush: its weight, the centre that acts on it and
+    // the comb's motion there.
+    let mut weights: Vec<Vec<Weight>> = mesh
         .columns
         .iter()
-        .map(|c| vec![(0.0, 0); c.positions.len()])
+        .map(|c| vec![Weight::default(); c.positions.len()])
         .collect();
     let mut touched_columns: BTreeSet<usize> = BTreeSet::new();
     for (c, column) in mesh.columns.iter().enumerate() {
-        if topology.bundles_of_column[c].is_empty() {
+        // Hair of removed bundles is hidden and left alone.
+        let active = topology.bundles_of_column[c]
+            .iter()
+            .any(|&b| !mesh.bundles[b as usize].removed);
+        if !active {
             continue;
         }
         for (k, &p) in column.positions.iter().enumerate().skip(1) {
@@ -265,15 +283,26 @@ pub fn apply_brush(
             if mesh.is_interior(&topology, c, k) && !mesh.is_locked(c, k) {
                 continue;
             }
-            for (i, (centre, _, view)) in centres.iter().enumerate() {
+            // Where the brush and its mirror image overlap (a dab on the head's plane) the
+            // vertex takes the stronger's weight and the weighted mean of their motions, so
+            // sideways combing cancels on the plane instead of parting the hair there.
+            let mut total = 0.0;
+            let mut motion = DVec3::ZERO;
+            for (i, (centre, centre_motion, view)) in centres.iter().enumerate() {
                 if view.is_some_and(|view| normals[c].dot(view) > FACING_AWAY) {
                     continue;
                 }
                 let w = falloff_weight(p.distance(*centre), dab.radius_m) * strength;
-                if w > weights[c][k].0 {
-                    weights[c][k] = (w, i);
+                total += w;
+                motion += *centre_motion * w;
+                if w > weights[c][k].weight {
+                    weights[c][k].weight = w;
+                    weights[c][k].centre = i;
                     touched_columns.insert(c);
                 }
+            }
+            if total > 0.0 {
+                weights[c][k].motion = motion / total;
             }
         }
     }
@@ -281,24 +310,36 @@ pub fn apply_brush(
         return Ok(unchanged());
     }
     let moved = stroke_positions(mesh, &normals, dab, &centres, &weights);
-    // The strongest share of the dab (1, ½, ¼, ⅛) that turns no layer over.
+    // The strongest share of the dab (1, ½, ¼, ⅛) that turns no layer over, crowds none and
+    // puts no hair in the head. Interior placement fits whole layers, so every bundle is
+    // checked, not only those under the brush.
     let affected: BTreeSet<u32> = touched_columns
         .iter()
         .flat_map(|&c| topology.bundles_of_column[c].iter().copied())
         .collect();
-    let turned_before = turned_layers_of(mesh, affected.iter().map(|&b| b as usize));
-    let inside_before = inside_body(mesh, body);
-    let short_before = short_segments(mesh);
+    // What is wrong before the dab, and what placing the interior afresh alone does (any
+    // edit places it; a mesh placed by an older rule, or with locks, may change where no
+    // brush touched): a dab is held back only for what it adds to both.
+    let placed = finish(mesh.clone(), BTreeSet::new(), None)?.mesh;
+    let mut turned_before = turned_layers(mesh);
+    turned_before.extend(turned_layers(&placed));
+    let mut inside_before = inside_body(mesh, body);
+    inside_before.extend(inside_body(&placed, body));
+    let mut short_before = short_segments(mesh);
+    short_before.extend(short_segments(&placed));
     for share in [1.0, 0.5, 0.25, 0.125] {
         let mut out = mesh.clone();
         for &c in &touched_columns {
-            for (k, p) in out.columns[c].positions.iter_mut().enumerate().skip(1) {
-                *p = p.lerp(moved[c][k], share);
-            }
+            blend_column(
+                &mesh.columns[c].positions,
+                &moved[c],
+                share,
+                &mut out.columns[c].positions,
+            );
         }
         keep_outside(&mut out, body, &touched_columns);
         let outcome = finish(out, affected.clone(), None)?;
-        let turned = turned_layers_of(&outcome.mesh, affected.iter().map(|&b| b as usize));
+        let turned = turned_layers(&outcome.mesh);
         // Interior vertices are placed after the push out of the body, so they are checked.
         let inside = inside_body(&outcome.mesh, body);
         let held = turned.iter().all(|t| turned_before.contains(t))
@@ -319,7 +360,7 @@ fn stroke_positions(
     normals: &[DVec3],
     dab: &BrushDab,
     centres: &[(DVec3, DVec3, Option<DVec3>)],
-    weights: &[Vec<(f64, usize)>],
+    weights: &[Vec<Weight>],
 ) -> Vec<Vec<DVec3>> {
     let sign = if dab.invert { -1.0 } else { 1.0 };
     let step = STEP_SHARE * dab.radius_m;
@@ -331,7 +372,11 @@ fn stroke_positions(
     if dab.kind == BrushKind::Clump {
         for (c, column) in mesh.columns.iter().enumerate() {
             for (k, &p) in column.positions.iter().enumerate() {
-                let (w, i) = weights[c][k];
+                let Weight {
+                    weight: w,
+                    centre: i,
+                    ..
+                } = weights[c][k];
                 if w > 0.0 {
                     let slot = &mut clump_centres[i][k];
                     slot.0 += p * w;
@@ -343,13 +388,17 @@ fn stroke_positions(
     let neighbours = column_neighbours(mesh);
     for (c, column) in mesh.columns.iter().enumerate() {
         for (k, &p) in column.positions.iter().enumerate().skip(1) {
-            let (w, i) = weights[c][k];
+            let Weight {
+                weight: w,
+                centre: i,
+                motion,
+            } = weights[c][k];
             if w <= 0.0 {
                 continue;
             }
             let root = column.positions[0];
             target[c][k] = match dab.kind {
-                BrushKind::Comb => p + centres[i].1 * w,
+                BrushKind::Comb => p + motion * w,
                 // Toward (or onto) the scalp's normal, by a share of the vertex's height.
                 BrushKind::Puff => p + normals[c] * (sign * w * STEP_SHARE * p.distance(root)),
                 BrushKind::Smooth => {
@@ -379,7 +428,7 @@ fn stroke_positions(
     }
     // Walk each touched column from the root, segment lengths kept (or scaled).
     for (c, column) in mesh.columns.iter().enumerate() {
-        let column_weight = weights[c].iter().map(|&(w, _)| w).fold(0.0, f64::max);
+        let column_weight = weights[c].iter().map(|w| w.weight).fold(0.0, f64::max);
         if column_weight <= 0.0 {
             continue;
         }
@@ -398,6 +447,33 @@ fn stroke_positions(
         }
     }
     target
+}
+
+/// How a dab acts on one vertex.
+#[derive(Clone, Copy, Debug, Default)]
+struct Weight {
+    /// Falloff × strength of the stronger centre (0: untouched).
+    weight: f64,
+    /// That centre (0: the brush, 1: its mirror image).
+    centre: usize,
+    /// The comb's motion here: the centres' motions weighted by their falloff.
+    motion: DVec3,
+}
+
+/// `share` of the way from a column's `old` positions to its `target` ones, walked from the
+/// root so each segment takes its length in between (a straight blend of the points would
+/// shorten every segment that turns).
+fn blend_column(old: &[DVec3], target: &[DVec3], share: f64, out: &mut [DVec3]) {
+    for k in 1..out.len().min(old.len()).min(target.len()) {
+        let old_segment = old[k] - old[k - 1];
+        let length = old_segment.length()
+            + share * ((target[k] - target[k - 1]).length() - old_segment.length());
+        let direction = (old[k].lerp(target[k], share) - out[k - 1])
+            .try_normalize()
+            .or_else(|| old_segment.try_normalize())
+            .unwrap_or(DVec3::Y);
+        out[k] = out[k - 1] + direction * length;
+    }
 }
 
 /// For each column, the columns it shares a bundle edge with.
@@ -426,7 +502,8 @@ fn short_segments(mesh: &HairMesh) -> BTreeSet<(usize, usize)> {
     let mut short = BTreeSet::new();
     for (c, column) in mesh.columns.iter().enumerate() {
         for (k, s) in column.positions.windows(2).enumerate() {
-            if s[0].distance(s[1]) < MIN_SEGMENT_M {
+            // A hair's breadth of tolerance: a cut to exactly the floor may round under it.
+            if s[0].distance(s[1]) < MIN_SEGMENT_M * 0.999 {
                 short.insert((c, k + 1));
             }
         }
@@ -591,24 +668,68 @@ mod tests {
             d.strength = 0.7;
             let out = apply_brush(&mesh, &sdf, &d).expect("dab").mesh;
             assert_ne!(out, mesh, "{kind:?} acted");
-            for (c, column) in out.columns.iter().enumerate() {
-                let root = mesh.columns[c].positions[0];
-                let image = (0..mesh.columns.len())
-                    .min_by(|&a, &b| {
-                        let m = DVec3::new(-root.x, root.y, root.z);
-                        let da = mesh.columns[a].positions[0].distance(m);
-                        da.total_cmp(&mesh.columns[b].positions[0].distance(m))
-                    })
-                    .expect("a column");
-                for (k, p) in column.positions.iter().enumerate() {
-                    let q = out.columns[image].positions[k];
-                    let mirrored = DVec3::new(-q.x, q.y, q.z);
-                    assert!(
-                        p.distance(mirrored) < 1e-6,
-                        "{kind:?}: column {c} layer {k} at {p} and its image at {q}"
-                    );
-                }
+            assert_mirror_symmetric(&out, &format!("{kind:?}"));
+            // A dab on the plane itself, combing sideways: the two sides' motions cancel
+            // there (no parting, nothing crossing) and the result stays symmetric.
+            let mut on_plane = d;
+            on_plane.centre_m[0] = 0.0;
+            let out = apply_brush(&mesh, &sdf, &on_plane).expect("dab").mesh;
+            assert_ne!(out, mesh, "{kind:?} on the plane acted");
+            assert_mirror_symmetric(&out, &format!("{kind:?} on the plane"));
+        }
+    }
+
+    /// Each column's positions mirror those of the column whose root is nearest its root's
+    /// mirror image across x = 0.
+    fn assert_mirror_symmetric(mesh: &HairMesh, what: &str) {
+        for (c, column) in mesh.columns.iter().enumerate() {
+            let root = column.positions[0];
+            let m = DVec3::new(-root.x, root.y, root.z);
+            let image = (0..mesh.columns.len())
+                .min_by(|&a, &b| {
+                    let da = mesh.columns[a].positions[0].distance(m);
+                    da.total_cmp(&mesh.columns[b].positions[0].distance(m))
+                })
+                .expect("a column");
+            for (k, p) in column.positions.iter().enumerate() {
+                let q = mesh.columns[image].positions[k];
+                let mirrored = DVec3::new(-q.x, q.y, q.z);
+                assert!(
+                    p.distance(mirrored) < 1e-6,
+                    "{what}: column {c} layer {k} at {p} and its image at {q}"
+                );
             }
+        }
+    }
+
+    /// Hair of a removed bundle is hidden: a brush over it leaves it where it was.
+    #[test]
+    fn a_removed_bundle_is_not_brushed() {
+        let (mut mesh, sdf) = head();
+        // The cap's corner bundle: its corner column is its own.
+        let b = 0;
+        mesh.bundles[b].removed = true;
+        let topology = Topology::build(&mesh);
+        let only_removed: Vec<usize> = mesh.bundles[b]
+            .vertices
+            .iter()
+            .map(|&c| c as usize)
+            .filter(|&c| {
+                topology.bundles_of_column[c]
+                    .iter()
+                    .all(|&o| mesh.bundles[o as usize].removed)
+            })
+            .collect();
+        let mut d = dab(
+            BrushKind::Comb,
+            mesh.columns[only_removed[0]].positions[4],
+            0.2,
+        );
+        d.motion_m = [0.02, 0.0, 0.0];
+        let out = apply_brush(&mesh, &sdf, &d).expect("comb");
+        assert!(!out.affected_bundles.is_empty(), "the hair around it moved");
+        for c in only_removed {
+            assert_eq!(out.mesh.columns[c], mesh.columns[c], "column {c}");
         }
     }
 
@@ -683,13 +804,21 @@ mod tests {
                 column_length(&mesh, c)
             );
         }
+        // The cap's hair stands straight out: flattening lays it toward the scalp, and
+        // puffing lifts it back up.
         let height = |m: &HairMesh| m.columns[c].positions[4].length();
-        let puffed = apply_brush(&mesh, &sdf, &dab(BrushKind::Puff, tip, 0.05)).expect("puff");
-        assert!(height(&puffed.mesh) >= height(&mesh) - 1e-9);
         let mut flat = dab(BrushKind::Puff, tip, 0.05);
         flat.invert = true;
-        let flattened = apply_brush(&mesh, &sdf, &flat).expect("flatten");
-        assert!(height(&flattened.mesh) < height(&mesh));
+        let flattened = apply_brush(&mesh, &sdf, &flat).expect("flatten").mesh;
+        assert!(height(&flattened) < height(&mesh) - 1e-4);
+        let lift = dab(BrushKind::Puff, flattened.columns[c].positions[4], 0.05);
+        let puffed = apply_brush(&flattened, &sdf, &lift).expect("puff").mesh;
+        assert!(
+            height(&puffed) > height(&flattened) + 1e-4,
+            "{} → {}",
+            height(&flattened),
+            height(&puffed)
+        );
     }
 
     /// A comb that would drag one corner of a bundle's tip across the bundle (turning the
@@ -697,15 +826,75 @@ mod tests {
     #[test]
     fn a_dab_that_would_turn_a_layer_over_is_held_back() {
         let scalp = grid_scalp(1, 1, |s, t| DVec3::new(0.1 * s, 0.1 * t, 0.0));
-        let mesh = straight_layers(scalp, 1, DVec3::Z * 0.1);
+        let mesh = straight_layers(scalp, 1, DVec3::Z * 0.3);
+        let root = mesh.columns[0].positions[0];
         let corner = mesh.columns[0].positions[1];
         let mut d = dab(BrushKind::Comb, corner, 0.02);
-        d.motion_m = [0.5, 0.5, 0.0];
+        d.motion_m = [1.0, 1.0, 0.0];
+        // The whole dab would turn the tip face over: the segment turned toward the
+        // motion, its length kept, lands past the opposite corner.
+        let mut whole = mesh.clone();
+        whole.columns[0].positions[1] =
+            root + (corner + DVec3::new(1.0, 1.0, 0.0) - root).normalize() * 0.3;
+        assert_ne!(turned_layers(&whole), Vec::new());
         let outcome = apply_brush(&mesh, &BodySdf::empty(), &d).expect("comb");
         assert_eq!(turned_layers(&outcome.mesh), Vec::new());
-        // Cleared for the half-way share or less: the corner moved, but not across.
+        // Held back to a share that keeps the face the right way up: the corner moved.
         let moved = outcome.mesh.columns[0].positions[1];
-        assert!(moved.x < 0.1 && moved.y < 0.1, "{moved}");
+        assert!(moved.distance(corner) > 1e-3, "the corner moved: {moved}");
+        assert!(
+            (moved.distance(root) - 0.3).abs() < 1e-9,
+            "its segment kept its length"
+        );
+    }
+
+    /// On every head sample (draped, curled, hanging down the back: layers that bend and
+    /// shear), a comb dab on the crown acts — the turn-over check flags flips, not bends —
+    /// and leaves no new turned layer.
+    #[test]
+    fn a_comb_acts_on_every_head_sample() {
+        let samples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/samples");
+        let mut checked = 0;
+        for entry in std::fs::read_dir(&samples).expect("the samples folder") {
+            let path = entry.expect("an entry").path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if !name.starts_with("head_") {
+                continue;
+            }
+            let mesh = crate::io::project::load(&path)
+                .unwrap_or_else(|e| panic!("{name}: {e}"))
+                .document
+                .hair_mesh;
+            let (lo, hi) = mesh.bounds().expect("hair");
+            let centre = DVec3::new(0.3 * lo.x + 0.7 * hi.x, hi.y, 0.5 * (lo.z + hi.z));
+            let mut d = dab(BrushKind::Comb, centre, 0.05);
+            d.motion_m = [0.0, 0.0, -0.01];
+            d.strength = 0.5;
+            // Placing the interior afresh alone (as any edit does) may turn a layer of a
+            // sample placed otherwise; the dab adds nothing to that.
+            let placed = finish(mesh.clone(), BTreeSet::new(), None)
+                .expect("placed")
+                .mesh;
+            let mut before = turned_layers(&mesh);
+            before.extend(turned_layers(&placed));
+            let outcome = apply_brush(&mesh, &BodySdf::empty(), &d).expect("comb");
+            assert!(
+                !outcome.affected_bundles.is_empty(),
+                "{name}: the comb acted"
+            );
+            let after = turned_layers(&outcome.mesh);
+            assert!(after.iter().all(|t| before.contains(t)), "{name}");
+            // Draped samples fold here and there (a few percent of their layers); a check
+            // that flagged bends would flag a third of them.
+            let layers: usize = mesh.bundles.iter().map(|b| b.layers as usize).sum();
+            assert!(
+                before.len() * 10 < layers,
+                "{name}: {} of its layers count as turned: the check flags bends",
+                before.len()
+            );
+            checked += 1;
+        }
+        assert!(checked >= 4, "{checked} head samples");
     }
 
     #[test]

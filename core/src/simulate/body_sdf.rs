@@ -405,6 +405,32 @@ impl BodySdf {
         (distance, gradient)
     }
 
+    /// How far along the ray from `origin` (in `direction`'s units made metres: the
+    /// direction is normalised) the body's surface lies, by sphere tracing the field (each
+    /// step as long as the distance to the body, which the field never overstates); `None`
+    /// when the ray passes the body or goes further than `max_m`. The brushes use it so a
+    /// stroke over the face does not reach the hair behind the head.
+    pub fn ray_hit_m(&self, origin: DVec3, direction: DVec3, max_m: f64) -> Option<f64> {
+        let direction = direction.try_normalize()?;
+        if self.is_empty() || !origin.is_finite() || !max_m.is_finite() {
+            return None;
+        }
+        // Half a cell: closer than the field resolves counts as on the surface.
+        let surface_m = 0.5 * self.cell_m;
+        let mut t = 0.0;
+        for _ in 0..512 {
+            let distance = self.distance_m(origin + direction * t);
+            if distance < surface_m {
+                return Some(t);
+            }
+            t += distance;
+            if t > max_m {
+                return None;
+            }
+        }
+        None
+    }
+
     pub fn cell_m(&self) -> f64 {
         self.cell_m
     }
@@ -454,6 +480,30 @@ mod tests {
             );
         }
         assert!(sdf.distance_m(DVec3::NAN) == f64::INFINITY);
+    }
+
+    /// A ray at the sphere meets it one radius short of its centre; one past it, or
+    /// pointing away, meets nothing; a degenerate ray is refused.
+    #[test]
+    fn a_ray_meets_the_sphere_where_it_is() {
+        let sdf = BodySdf::build(&sphere(0.1, 24, 48), 48, 0.05);
+        let origin = DVec3::new(0.0, 0.0, 0.5);
+        let hit = sdf
+            .ray_hit_m(origin, DVec3::new(0.0, 0.0, -2.0), 1.0)
+            .expect("a hit");
+        assert!((hit - 0.4).abs() < 1.5 * sdf.cell_m(), "{hit}");
+        assert_eq!(sdf.ray_hit_m(origin, DVec3::Z, 10.0), None);
+        assert_eq!(
+            sdf.ray_hit_m(origin + DVec3::X * 0.2, -DVec3::Z, 10.0),
+            None
+        );
+        assert_eq!(
+            sdf.ray_hit_m(origin, -DVec3::Z, 0.3),
+            None,
+            "beyond the range"
+        );
+        assert_eq!(sdf.ray_hit_m(origin, DVec3::ZERO, 1.0), None);
+        assert_eq!(BodySdf::empty().ray_hit_m(origin, -DVec3::Z, 1.0), None);
     }
 
     #[test]

@@ -1,9 +1,12 @@
 //! The grooming brushes in the viewport. With Drag ▸ Groom (Tools panel), a left drag strokes
-//! the hair: each step of the pointer of a fifth of the brush is one dab
+//! the hair: each step of the pointer of a tenth of the brush's diameter is one dab
 //! ([`hairloom_core::edit::apply_brush`]) on the mesh the stroke has made so far, the whole
-//! stroke one undo step. Ctrl inverts the brush (cut, flatten, spread). The brush sits where
-//! the pointer's ray meets the hair mesh, and where it meets none, at the depth it last
-//! touched; its circle is drawn at that size in the viewport.
+//! stroke one undo step. Ctrl inverts the brush (cut, flatten, spread); a tablet's pressure,
+//! where egui reports it, scales the strength. The brush sits where the pointer's ray meets
+//! the hair mesh in front of the head (unless X-ray is on), and where it meets none, at the
+//! depth it last touched; its circle is drawn at that size in the viewport. Alt held
+//! (navigation) pauses the stroke; an undo or any other change of the document during the
+//! stroke ends it.
 
 use std::hash::{Hash, Hasher};
 use std::sync::Arc;
@@ -22,6 +25,10 @@ pub(super) struct Stroke {
     /// Where the last dab was applied, on screen and on the hair.
     last_pointer: egui::Pos2,
     last_centre: DVec3,
+    /// The document revision after the stroke's last change: another change ends it.
+    revision: u64,
+    /// The body's distance field, for the whole stroke.
+    field: Arc<BodySdf>,
     dabs: usize,
     held_back: usize,
 }
@@ -37,6 +44,11 @@ pub struct BrushCursor {
 
 /// A dab every this share of the brush's diameter of pointer travel (Blender's spacing).
 const SPACING_OF_DIAMETER: f32 = 0.1;
+/// The most dabs one frame applies (a fast stroke over a slow frame).
+const MAX_DABS_PER_FRAME: usize = 16;
+/// Hair this far behind the body's surface along the pointer's ray still counts as in
+/// front (the hair mesh's root layer lies on the scalp).
+const IN_FRONT_TOLERANCE_M: f64 = 0.003;
 
 /// A cheap identity of a body mesh, so its distance field is built once per body.
 fn body_fingerprint(body: &BodyMesh) -> u64 {
@@ -50,17 +62,30 @@ fn body_fingerprint(body: &BodyMesh) -> u64 {
 }
 
 impl Viewport {
-    /// Where the brush touches: the hair mesh under `pointer`, else the point at the depth
-    /// of `fallback` (the last centre of the stroke), else nothing.
+    /// Where the brush touches: the hair mesh under `pointer` (in front of the head unless
+    /// `through_body`), else the point at the depth of `fallback` (the last centre of the
+    /// stroke), else nothing. The flag says whether it touches hair.
     fn brush_centre(
         state: &EditorState,
         projector: &Projector,
+        field: Option<&BodySdf>,
         pointer: egui::Pos2,
         fallback: Option<DVec3>,
     ) -> Option<(DVec3, bool)> {
         let (origin, direction) = projector.ray(pointer);
-        match pick_bundle(&state.document().hair_mesh, origin, direction) {
-            Some((_, t)) => Some((origin + direction * t, true)),
+        let hit = pick_bundle(&state.document().hair_mesh, origin, direction)
+            .map(|(_, t)| origin + direction * t)
+            .filter(|&at| {
+                let Some(field) = field.filter(|_| !state.tool.xray) else {
+                    return true;
+                };
+                let hair_m = at.distance(origin);
+                field
+                    .ray_hit_m(origin, direction, hair_m + 1.0)
+                    .is_none_or(|body_m| hair_m <= body_m + IN_FRONT_TOLERANCE_M)
+            });
+        match hit {
+            Some(at) => Some((at, true)),
             None => fallback.map(|at| (projector.unproject(pointer, at), false)),
         }
     }
@@ -77,7 +102,8 @@ impl Viewport {
         }
     }
 
-    /// The body's distance field for the document's body (built once per body).
+    /// The body's distance field for the document's body (built once per body, on the first
+    /// stroke: about 0.4 s for the head scan).
     fn body_field(&mut self, state: &EditorState) -> Arc<BodySdf> {
         let document = state.document();
         let key = body_fingerprint(&document.body);
@@ -91,6 +117,28 @@ impl Viewport {
         field
     }
 
+    /// Ends the stroke, keeping what it did as one undo step.
+    fn end_stroke(&mut self, state: &mut EditorState, why: &str) {
+        let Some(stroke) = self.stroke.take() else {
+            return;
+        };
+        state.commit_edit();
+        let kind = state.tool.brush.kind.label();
+        state.message = format!(
+            "{kind}: {} dabs{}{why}",
+            stroke.dabs,
+            if stroke.held_back > 0 {
+                format!(
+                    ", {} left the hair as it was (no hair under the brush, or the step would \
+                     have turned a layer over, crowded it or reached into the head)",
+                    stroke.held_back
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
+
     /// Strokes the hair when the drag tool is Groom; `true` when it took the pointer this
     /// frame (a drag), so region selection does not also run. Clicks still select.
     pub(super) fn groom(
@@ -102,14 +150,37 @@ impl Viewport {
     ) -> bool {
         self.brush_cursor = None;
         if state.tool.drag != DragTool::Groom {
-            self.stroke = None;
+            self.end_stroke(state, " (the drag tool changed)");
             return false;
         }
+        // An undo, a redo or any other edit during the stroke ends it (its dabs so far are
+        // one step; the next dab would start from a document the stroke did not make).
+        if self
+            .stroke
+            .as_ref()
+            .is_some_and(|stroke| stroke.revision != state.revision)
+        {
+            self.stroke = None;
+            state.message = format!(
+                "{}: the stroke ended (the document changed under it)",
+                state.tool.brush.kind.label()
+            );
+        }
         let brush = state.tool.brush;
+        // The stroke's field, or before a stroke the last one built (the hover circle).
+        let field = self
+            .stroke
+            .as_ref()
+            .map(|s| s.field.clone())
+            .or_else(|| self.body_field.as_ref().map(|(_, field)| field.clone()));
         let pointer = response.interact_pointer_pos().or(response.hover_pos());
         let fallback = self.stroke.as_ref().map(|s| s.last_centre);
-        let under =
-            pointer.and_then(|p| Some((p, Self::brush_centre(state, &projector, p, fallback)?)));
+        let under = pointer.and_then(|p| {
+            Some((
+                p,
+                Self::brush_centre(state, &projector, field.as_deref(), p, fallback)?,
+            ))
+        });
         if let Some((at, (centre, touches_hair))) = under {
             let toward = projector.ray(at).1;
             self.brush_cursor = Some(BrushCursor {
@@ -122,77 +193,104 @@ impl Viewport {
         if response.drag_started_by(egui::PointerButton::Primary) && !alt {
             state.commit_edit();
             state.stop_playback_for_editing();
-            self.stroke = under
-                .filter(|(_, (_, hair))| *hair)
-                .map(|(p, (centre, _))| Stroke {
-                    last_pointer: p,
-                    last_centre: centre,
-                    dabs: 0,
-                    held_back: 0,
-                });
+            let field = self.body_field(state);
+            // The start is picked again with the field: never a point behind the head.
+            let start = pointer.and_then(|p| {
+                Some((
+                    p,
+                    Self::brush_centre(state, &projector, Some(&field), p, None)?,
+                ))
+            });
+            self.stroke = start.map(|(p, (centre, _))| Stroke {
+                last_pointer: p,
+                last_centre: centre,
+                revision: state.revision,
+                field,
+                dabs: 0,
+                held_back: 0,
+            });
             if self.stroke.is_none() {
                 state.message = format!("{}: start the stroke on the hair", brush.kind.label());
             }
         }
-        let Some(stroke) = self.stroke.as_mut() else {
+        if self.stroke.is_none() {
             return response.dragged_by(egui::PointerButton::Primary) && !alt;
-        };
+        }
         if response.drag_stopped() {
-            state.commit_edit();
-            state.message = format!(
-                "{}: {} dabs{}",
-                brush.kind.label(),
-                stroke.dabs,
-                if stroke.held_back > 0 {
-                    format!(
-                        ", {} left the hair as it was (no hair under the brush, or the step would \
-                         have turned a layer over, crowded it or reached into the head)",
-                        stroke.held_back
-                    )
-                } else {
-                    String::new()
-                }
-            );
-            self.stroke = None;
+            self.end_stroke(state, "");
             return true;
         }
-        let Some((at, (centre, _))) = under else {
+        let (Some((at, _)), Some(stroke)) = (under, self.stroke.as_mut()) else {
             return true;
         };
+        if alt {
+            // Navigating: the stroke waits, and resumes from where the pointer is then.
+            stroke.last_pointer = at;
+            return true;
+        }
         let spacing_px =
             (self.brush_cursor.map_or(8.0, |c| c.radius_px) * 2.0 * SPACING_OF_DIAMETER).max(2.0);
-        if at.distance(stroke.last_pointer) < spacing_px {
+        let travel = at.distance(stroke.last_pointer);
+        if travel < spacing_px {
             return true;
         }
-        let motion = projector.unproject(at, stroke.last_centre)
-            - projector.unproject(stroke.last_pointer, stroke.last_centre);
-        let view = projector.ray(at).1;
-        let dab = BrushDab {
-            kind: brush.kind,
-            centre_m: centre.to_array(),
-            radius_m: brush.radius_m,
-            strength: brush.strength,
-            invert: ui.input(|i| i.modifiers.command),
-            motion_m: motion.to_array(),
-            view_direction: brush.front_only.then(|| view.to_array()),
-            mirror_x: brush.mirror_x,
-            mirror_plane_x: state.document().mirror_plane_x(),
-        };
-        let stroke_pointer = at;
-        let field = self.body_field(state);
-        let Some(stroke) = self.stroke.as_mut() else {
-            return true;
-        };
-        stroke.last_pointer = stroke_pointer;
-        stroke.last_centre = centre;
-        match apply_brush(&state.document().hair_mesh, &field, &dab) {
-            Ok(outcome) if outcome.affected_bundles.is_empty() => stroke.held_back += 1,
-            Ok(outcome) => {
-                stroke.dabs += 1;
-                let label = format!("{} brush", brush.kind.label());
-                state.edit(ChangeKind::Reshape, &label).hair_mesh = outcome.mesh;
+        // Pressure from a pen or touch, where egui reports one.
+        let pressure = ui.input(|i| {
+            i.events.iter().rev().find_map(|event| match event {
+                egui::Event::Touch {
+                    force: Some(force), ..
+                } => Some(force.clamp(0.0, 1.0) as f64),
+                _ => None,
+            })
+        });
+        let invert = ui.input(|i| i.modifiers.command);
+        let plane_x = state.document().mirror_plane_x();
+        let steps = ((travel / spacing_px) as usize).clamp(1, MAX_DABS_PER_FRAME);
+        let from = stroke.last_pointer;
+        for step in 1..=steps {
+            let Some(stroke) = self.stroke.as_ref() else {
+                break;
+            };
+            let point = from + (at - from) * (step as f32 / steps as f32);
+            let field = stroke.field.clone();
+            let Some((centre, _)) = Self::brush_centre(
+                state,
+                &projector,
+                Some(&field),
+                point,
+                Some(stroke.last_centre),
+            ) else {
+                continue;
+            };
+            let motion = projector.unproject(point, stroke.last_centre)
+                - projector.unproject(stroke.last_pointer, stroke.last_centre);
+            let dab = BrushDab {
+                kind: brush.kind,
+                centre_m: centre.to_array(),
+                radius_m: brush.radius_m,
+                strength: brush.strength * pressure.unwrap_or(1.0),
+                invert,
+                motion_m: motion.to_array(),
+                view_direction: brush.front_only.then(|| projector.ray(point).1.to_array()),
+                mirror_x: brush.mirror_x,
+                mirror_plane_x: plane_x,
+            };
+            let result = apply_brush(&state.document().hair_mesh, &field, &dab);
+            let Some(stroke) = self.stroke.as_mut() else {
+                break;
+            };
+            stroke.last_pointer = point;
+            stroke.last_centre = centre;
+            match result {
+                Ok(outcome) if outcome.affected_bundles.is_empty() => stroke.held_back += 1,
+                Ok(outcome) => {
+                    stroke.dabs += 1;
+                    let label = format!("{} brush", brush.kind.label());
+                    state.edit(ChangeKind::Reshape, &label).hair_mesh = outcome.mesh;
+                    stroke.revision = state.revision;
+                }
+                Err(error) => state.message = format!("{}: {error}", brush.kind.label()),
             }
-            Err(error) => state.message = format!("{}: {error}", brush.kind.label()),
         }
         true
     }

@@ -221,7 +221,7 @@ impl Viewport {
                 }
             }
         }
-        // The grooming brush: its circle at its size on the hair (fainter off the hair).dashed off the hair).
+        // The grooming brush: its circle at its size on the hair (fainter off the hair).
         if state.tool.drag == DragTool::Groom
             && let Some(cursor) = self.brush_cursor
         {
