@@ -1,4 +1,4 @@
-//! Grooming brushes: comb, length, puff, smooth and clump dabs on the hair mesh's exterior
+//! Grooming brushes: comb, length, puff, smooth, clump and part dabs on the hair mesh's exterior
 //! vertices, as a groom artist strokes them over the head. Interior vertices follow by the
 //! existing rule ([`crate::geometry::interior`], through [`finish`]).
 //!
@@ -50,15 +50,19 @@ pub enum BrushKind {
     Smooth,
     /// Gather the hair under the brush toward its centre, layer by layer (inverted: spread).
     Clump,
+    /// Part the hair along the stroke: each strand falls away from the stroke's line to the
+    /// side its root lies on (a middle part is a stroke along the head's centre).
+    Part,
 }
 
 impl BrushKind {
-    pub const ALL: [BrushKind; 5] = [
+    pub const ALL: [BrushKind; 6] = [
         BrushKind::Comb,
         BrushKind::Length,
         BrushKind::Puff,
         BrushKind::Smooth,
         BrushKind::Clump,
+        BrushKind::Part,
     ];
 
     pub fn label(self) -> &'static str {
@@ -68,6 +72,7 @@ impl BrushKind {
             BrushKind::Puff => "Puff",
             BrushKind::Smooth => "Smooth",
             BrushKind::Clump => "Clump",
+            BrushKind::Part => "Part",
         }
     }
 }
@@ -422,6 +427,22 @@ fn stroke_positions(
                     let pull = (sign * w * 0.5).max(-step / toward.length().max(1e-12));
                     p + toward * pull
                 }
+                // Away from the stroke's line, across it and along the scalp: the side is
+                // the root's, so a whole strand goes one way.
+                BrushKind::Part => {
+                    let across = motion
+                        .cross(normals[c])
+                        .try_normalize()
+                        .unwrap_or(DVec3::ZERO);
+                    // A root on the line itself stays (f64::signum would send it right).
+                    let offset = (root - centres[i].0).dot(across);
+                    let side = if offset.abs() <= 1e-9 {
+                        0.0
+                    } else {
+                        offset.signum()
+                    };
+                    p + across * (side * w * step)
+                }
                 BrushKind::Length => p,
             };
         }
@@ -589,7 +610,7 @@ mod tests {
         let mut random = SplitMix64::new(7);
         let mut acted = 0;
         for step in 0..300 {
-            let kind = BrushKind::ALL[(random.next_u64() % 5) as usize];
+            let kind = BrushKind::ALL[(random.next_u64() as usize) % BrushKind::ALL.len()];
             let c = (random.next_u64() as usize) % mesh.columns.len();
             let column = &mesh.columns[c].positions;
             let on = column[(random.next_u64() as usize) % column.len()];
@@ -700,6 +721,41 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A part stroke along the head's centre line sends each side's hair away from it: the
+    /// tips on the right move right, those on the left move left, as mirror images.
+    #[test]
+    fn a_part_along_the_centre_sends_each_side_away_from_it() {
+        let (mesh, sdf) = head();
+        let mut out = mesh.clone();
+        for i in 0..8 {
+            let z = -0.04 + 0.01 * i as f64;
+            let top = DVec3::new(0.0, (RADIUS_M * RADIUS_M - z * z).sqrt() + 0.08, z);
+            let mut d = dab(BrushKind::Part, top, 0.06);
+            d.motion_m = [0.0, 0.0, 0.01];
+            d.mirror_x = true;
+            out = apply_brush(&out, &sdf, &d).expect("part").mesh;
+        }
+        let (mut right, mut left) = (0, 0);
+        for (c, column) in out.columns.iter().enumerate() {
+            let root_x = column.positions[0].x;
+            let moved = column.positions[4].x - mesh.columns[c].positions[4].x;
+            if root_x > 0.01 && moved > 1e-4 {
+                right += 1;
+            }
+            if root_x < -0.01 && moved < -1e-4 {
+                left += 1;
+            }
+            if root_x > 0.01 {
+                assert!(
+                    moved > -1e-9,
+                    "column {c} on the right moved left by {moved}"
+                );
+            }
+        }
+        assert!(right >= 3 && right == left, "{right} right, {left} left");
+        assert_mirror_symmetric(&out, "part");
     }
 
     /// Hair of a removed bundle is hidden: a brush over it leaves it where it was.

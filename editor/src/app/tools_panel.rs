@@ -43,6 +43,9 @@ fn brush_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
                     BrushKind::Puff => "Lift hair off the scalp (Ctrl: flatten)",
                     BrushKind::Smooth => "Relax kinks along and across the hair",
                     BrushKind::Clump => "Gather the hair under the brush (Ctrl: spread)",
+                    BrushKind::Part => {
+                        "Part the hair along the stroke (a stroke along the centre: a middle part)"
+                    }
                 });
         }
     });

@@ -15,7 +15,7 @@
 //! bundles' roots, drag the wave arrow, the twist ring or the curl ring; one undo step each.
 //!
 //! Grooming brushes (`groom_brush.rs`): with Drag ▸ Groom, a left drag combs, grows or cuts,
-//! puffs, smooths or clumps the hair under the brush, X-mirrored and front-facing by
+//! puffs, smooths, clumps or parts the hair under the brush, X-mirrored and front-facing by
 //! default; one undo step per stroke.
 //!
 //! Transform (modal, like Blender): G moves, R rotates, S scales the selection following
