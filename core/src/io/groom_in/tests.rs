@@ -501,6 +501,26 @@ fn usdc_names_and_paths_the_library_cannot_compose_are_named_errors() {
     for (name, text, (from, to), says) in cases {
         assert_refused(dir.path(), name, &usdc_of(text, from, to), says);
     }
+    // Inside a `.usdz` package the crate is checked the same (the resolver opens each of a
+    // package's layers); the package's own crate groom reads.
+    let package = |name: &str, layer: &[u8]| {
+        use std::io::Write as _;
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        let mut zip = zip::ZipWriter::new(&mut bytes);
+        let stored = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Stored);
+        zip.start_file(name, stored).expect("a package entry");
+        zip.write_all(layer).expect("the layer");
+        zip.finish().expect("the package");
+        bytes.into_inner()
+    };
+    let brace = usdc_of("#usda 1.0\ndef \"Zq9Wk\"\n{\n}\n", "Zq9Wk", "}q9Wk");
+    assert_refused(
+        dir.path(),
+        "brace.usdz",
+        &package("brace.usdc", &brace),
+        "brace.usdz[brace.usdc]: prim name \"}q9Wk\"",
+    );
     // A crate groom of identifiers, namespaced properties and a reference reads.
     let valid = "#usda 1.0\ndef Xform \"Root\"\n{\n    def BasisCurves \"Hair_1\"\n    {\n\
         int[] curveVertexCounts = [2]\n        point3f[] points = [(0,0,0), (0,1,0)]\n\
@@ -510,6 +530,14 @@ fn usdc_names_and_paths_the_library_cannot_compose_are_named_errors() {
     let groom = read_groom(&file, GroomLimits::default(), &mut no_progress())
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(groom.curve_count(), 2, "the curves and their reference");
+    let file = write(
+        dir.path(),
+        "valid.usdz",
+        &package("valid.usdc", &usdc_of(valid, "", "")),
+    );
+    let groom = read_groom(&file, GroomLimits::default(), &mut no_progress())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(groom.curve_count(), 2, "the package's curves");
 }
 
 /// Found by the `groom_in` fuzz target in the crate reader (`openusd` 0.6, patched in
