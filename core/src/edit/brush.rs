@@ -31,8 +31,9 @@ use std::collections::BTreeSet;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use crate::edit::select::vertex_neighbours;
 use crate::edit::{EditError, EditOutcome, falloff_weight, finish};
-use crate::model::mesh::{HairMesh, Topology};
+use crate::model::mesh::{HairMesh, Topology, VertexRef};
 use crate::simulate::BodySdf;
 
 /// What a dab does to the vertices under it.
@@ -314,7 +315,7 @@ pub fn apply_brush(
     if touched_columns.is_empty() {
         return Ok(unchanged());
     }
-    let moved = stroke_positions(mesh, &normals, dab, &centres, &weights);
+    let moved = stroke_positions(mesh, &topology, &normals, dab, &centres, &weights);
     // The strongest share of the dab (1, ½, ¼, ⅛) that turns no layer over, crowds none and
     // puts no hair in the head. Interior placement fits whole layers, so every bundle is
     // checked, not only those under the brush.
@@ -362,6 +363,7 @@ pub fn apply_brush(
 /// segment keeps its length (or, for the length brush, its scaled length).
 fn stroke_positions(
     mesh: &HairMesh,
+    topology: &Topology,
     normals: &[DVec3],
     dab: &BrushDab,
     centres: &[(DVec3, DVec3, Option<DVec3>)],
@@ -390,7 +392,6 @@ fn stroke_positions(
             }
         }
     }
-    let neighbours = column_neighbours(mesh);
     for (c, column) in mesh.columns.iter().enumerate() {
         for (k, &p) in column.positions.iter().enumerate().skip(1) {
             let Weight {
@@ -407,19 +408,16 @@ fn stroke_positions(
                 // Toward (or onto) the scalp's normal, by a share of the vertex's height.
                 BrushKind::Puff => p + normals[c] * (sign * w * STEP_SHARE * p.distance(root)),
                 BrushKind::Smooth => {
-                    let mut sum = column.positions[k - 1];
-                    let mut count = 1.0;
-                    if let Some(&above) = column.positions.get(k + 1) {
-                        sum += above;
-                        count += 1.0;
-                    }
-                    for &n in &neighbours[c] {
-                        if let Some(&q) = mesh.columns[n].positions.get(k) {
-                            sum += q;
-                            count += 1.0;
-                        }
-                    }
-                    p.lerp(sum / count, 0.5 * w)
+                    // Along the column and across its layer's face edges, each once.
+                    let here = VertexRef {
+                        column: c as u32,
+                        layer: k as u32,
+                    };
+                    let neighbours: BTreeSet<VertexRef> = vertex_neighbours(mesh, topology, here)
+                        .into_iter()
+                        .collect();
+                    let sum: DVec3 = neighbours.iter().filter_map(|&n| mesh.position(n)).sum();
+                    p.lerp(sum / neighbours.len().max(1) as f64, 0.5 * w)
                 }
                 BrushKind::Clump => {
                     let (sum, total) = clump_centres[i][k];
@@ -495,26 +493,6 @@ fn blend_column(old: &[DVec3], target: &[DVec3], share: f64, out: &mut [DVec3]) 
             .unwrap_or(DVec3::Y);
         out[k] = out[k - 1] + direction * length;
     }
-}
-
-/// For each column, the columns it shares a bundle edge with.
-fn column_neighbours(mesh: &HairMesh) -> Vec<Vec<usize>> {
-    let mut neighbours: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); mesh.columns.len()];
-    for bundle in mesh.bundles.iter().filter(|b| !b.removed) {
-        let n = bundle.vertices.len();
-        for i in 0..n {
-            let (a, b) = (
-                bundle.vertices[i] as usize,
-                bundle.vertices[(i + 1) % n] as usize,
-            );
-            neighbours[a].insert(b);
-            neighbours[b].insert(a);
-        }
-    }
-    neighbours
-        .into_iter()
-        .map(|s| s.into_iter().collect())
-        .collect()
 }
 
 /// The segments `(column, upper layer)` shorter than [`MIN_SEGMENT_M`]: a layer collapsing

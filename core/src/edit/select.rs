@@ -318,7 +318,11 @@ pub fn shrink_bundles(
 }
 
 /// Vertices joined to `v` by an edge: along its column and along its layer's face edges.
-fn vertex_neighbours(mesh: &HairMesh, topology: &Topology, v: VertexRef) -> Vec<VertexRef> {
+pub(crate) fn vertex_neighbours(
+    mesh: &HairMesh,
+    topology: &Topology,
+    v: VertexRef,
+) -> Vec<VertexRef> {
     let mut out = Vec::new();
     if v.layer > 0 {
         out.push(VertexRef {
