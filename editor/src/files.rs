@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use hairloom_core::Document;
 use hairloom_core::io::alembic::{AlembicTarget, groom::Groom, groom_file};
-use hairloom_core::io::import::{ImportOptions, import_file};
+use hairloom_core::io::import::{ImportOptions, ImportedMesh, import_file};
 use hairloom_core::io::project::write_atomic;
 use hairloom_core::io::runtime_bundle::{runtime_bundle, write_bundle_folder};
+use hairloom_core::io::scalp_region::ScalpRegion;
 use hairloom_core::io::strand_files::{
     ScalpMesh, StrandExportSize, StrandLook, glb_lines, hair_file, usda_file,
 };
@@ -37,18 +38,33 @@ pub fn export_vertices_log2(document: &Document) -> u32 {
 /// The strand file formats, by extension.
 pub const STRAND_EXTENSIONS: [&str; 4] = ["hair", "usda", "glb", "abc"];
 
-/// A document made from a glTF/GLB scalp (every face becomes a bare bundle, the whole mesh
-/// the body), and a one-line summary of what was read.
+/// A document made from a glTF/GLB scalp (every face in `region` becomes a bare bundle, the
+/// whole mesh the body), and a one-line summary of what was read.
 pub fn scalp_document(
     scalp: &Path,
     options: &ImportOptions,
+    region: &ScalpRegion,
     generate_uv: bool,
 ) -> anyhow::Result<(Document, String)> {
     if !(options.scale.is_finite() && options.scale > 0.0) {
         bail!("the scale must be a positive number, got {}", options.scale);
     }
     let imported = import_file(scalp, options)?;
-    let mut hair_mesh = imported.to_hair_mesh(|_| true);
+    scalp_document_from(scalp, &imported, region, generate_uv)
+}
+
+/// [`scalp_document`] from a mesh already read (the editor reads the file once, then asks
+/// where hair grows).
+pub fn scalp_document_from(
+    scalp: &Path,
+    imported: &ImportedMesh,
+    region: &ScalpRegion,
+    generate_uv: bool,
+) -> anyhow::Result<(Document, String)> {
+    let keep = region
+        .faces(imported)
+        .with_context(|| format!("{}: where hair grows", scalp.display()))?;
+    let mut hair_mesh = imported.to_hair_mesh(|f| keep[f]);
     if generate_uv || !imported.has_uv {
         hairloom_core::geometry::uv::generate_uv(&mut hair_mesh, None);
     }
@@ -76,11 +92,24 @@ pub fn scalp_document(
     document
         .validate()
         .with_context(|| format!("{} produced an invalid document", scalp.display()))?;
+    let kept = |corners: usize| {
+        (imported.faces.iter().zip(&keep))
+            .filter(|(face, keep)| **keep && face.len() == corners)
+            .count()
+    };
+    let region_text = if *region == ScalpRegion::All {
+        String::new()
+    } else {
+        format!(
+            " with hair on {region} (body only: {})",
+            hairloom_core::io::scalp_region::face_count(keep.iter().filter(|k| !**k).count())
+        )
+    };
     let summary = format!(
-        "{}: {} quads, {} triangles ({} source triangles, {} collapsed by welding){}",
+        "{}: {} quads, {} triangles{region_text} ({} source triangles, {} collapsed by welding){}",
         scalp.display(),
-        imported.quad_count(),
-        imported.triangle_count(),
+        kept(4),
+        kept(3),
         imported.source_triangles,
         imported.degenerate_triangles,
         if imported.has_uv {

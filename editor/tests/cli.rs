@@ -176,6 +176,60 @@ fn import_takes_the_body_animation_into_the_scene() {
     assert!((motion.head_animation[1].yaw_deg - 90.0).abs() < 1e-3);
 }
 
+/// Issue 35: `--hair-on` names where hair grows on an imported body; the rest stays body.
+#[test]
+fn import_grows_hair_only_where_hair_on_says() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = dir.path().join("body.glb");
+    std::fs::write(&glb, hairloom_tests::body_with_materials_glb()).expect("write");
+    let out = dir.path().join("body.hairloom");
+    let (code, stdout, stderr) = run(hairloom()
+        .arg("import")
+        .arg(&glb)
+        .args(["--hair-on", "material:Scalp", "--out"])
+        .arg(&out));
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("2 quads") && stdout.contains("(body only: 1 face)"),
+        "{stdout}"
+    );
+    let document = hairloom_core::io::project::load(&out)
+        .expect("project")
+        .document;
+    assert_eq!(document.hair_mesh.bundles.len(), 2);
+    assert_eq!(document.body.triangles.len(), 6);
+
+    let (code, _, stderr) = run(hairloom()
+        .arg("import")
+        .arg(&glb)
+        .args(["--hair-on", "colour:r>0.75", "--out"])
+        .arg(&out));
+    assert_eq!(code, 0, "{stderr}");
+    let document = hairloom_core::io::project::load(&out)
+        .expect("project")
+        .document;
+    assert_eq!(document.hair_mesh.bundles.len(), 1);
+
+    // Named refusals: no such material (the file's are listed), a malformed region.
+    let (code, _, stderr) = run(hairloom()
+        .arg("import")
+        .arg(&glb)
+        .args(["--hair-on", "material:Hair", "--out"])
+        .arg(&out));
+    assert_ne!(code, 0);
+    assert!(
+        stderr.contains("no material named \"Hair\"") && stderr.contains("\"Skin\" (1 face)"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = run(hairloom()
+        .arg("import")
+        .arg(&glb)
+        .args(["--hair-on", "colour:r=1", "--out"])
+        .arg(&out));
+    assert_eq!(code, 2);
+    assert!(stderr.contains("colour:r=1"), "{stderr}");
+}
+
 /// Runs a validator; `None` when it is not installed (allowed outside `make test`).
 fn validator(program: &Path, args: &[&Path], cwd: &Path) -> Option<(i32, String)> {
     if !program.exists() && program.components().count() > 1 {

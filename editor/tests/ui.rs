@@ -622,6 +622,156 @@ fn importing_a_scalp_is_one_undo_step() {
     assert_eq!(harness.state().state.document(), &original);
 }
 
+/// Issue 35: importing a body with several materials (or painted vertex colours) asks
+/// where hair grows; the scalp material is chosen by default, the painted mask counts its
+/// faces as it is set, and the whole mesh stays the body. One undo step.
+#[test]
+fn importing_a_body_asks_where_hair_grows_and_the_rest_stays_body() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = dir.path().join("body.glb");
+    std::fs::write(&glb, hairloom_tests::body_with_materials_glb()).expect("write");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Chosen(glb.clone()), DialogAnswer::Chosen(glb)]),
+    );
+    let original = harness.state().state.document().clone();
+    file_menu(&mut harness, "Import scalp…");
+    harness.run();
+    assert!(
+        harness.state().scalp_import.is_some(),
+        "the question is open"
+    );
+    assert_eq!(harness.state().state.document(), &original, "nothing yet");
+    {
+        use egui_kittest::kittest::NodeT;
+        assert_eq!(
+            harness
+                .get_by_label("Scalp (2 faces)")
+                .accesskit_node()
+                .toggled(),
+            Some(egui::accesskit::Toggled::True),
+            "a material named Scalp is chosen by default"
+        );
+    }
+    harness.get_by_label("2 of 3 faces become bundles");
+    harness
+        .get_by_label("faces painted in the vertex colours")
+        .click();
+    harness.run();
+    // Mean red 1, ½ and 0 along the strip: above 0.5 is the first quad only.
+    harness.get_by_label("1 of 3 faces become bundles");
+    harness.get_by_label("faces with these materials").click();
+    harness.run();
+    harness.get_by_label("Import").click();
+    harness.run();
+    let state = &harness.state().state;
+    assert!(harness.state().scalp_import.is_none());
+    let document = state.document();
+    assert_eq!(document.hair_mesh.bundles.len(), 2, "{}", state.message);
+    assert_eq!(
+        document.body.triangles.len(),
+        6,
+        "the whole strip is the body"
+    );
+    assert!(
+        state.message.contains("material:Scalp"),
+        "{}",
+        state.message
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().state.document(), &original, "one undo step");
+
+    // Cancel imports nothing.
+    file_menu(&mut harness, "Import scalp…");
+    harness.run();
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert!(harness.state().scalp_import.is_none());
+    assert_eq!(harness.state().state.document(), &original);
+}
+
+/// Issue 35: a scalp cut from an imported body by selection — Edit ▸ Delete selected
+/// bundles (or the Delete key) drops the selected bundles for good, Edit ▸ Keep only
+/// selected bundles drops the others; each one undo step.
+#[test]
+fn delete_and_keep_only_selected_cut_the_scalp_as_undo_steps() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = dir.path().join("body.glb");
+    std::fs::write(&glb, hairloom_tests::body_with_materials_glb()).expect("write");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Chosen(glb)]),
+    );
+    file_menu(&mut harness, "Import scalp…");
+    harness.run();
+    harness.get_by_label("every face (3)").click();
+    harness.run();
+    harness.get_by_label("Import").click();
+    harness.run();
+    let steps = harness.state().state.project.history.undo.len();
+    assert_eq!(harness.state().state.document().hair_mesh.bundles.len(), 3);
+
+    click_bundle_in_outliner(&mut harness, 2);
+    edit_menu(&mut harness, "Delete selected bundles");
+    let state = &harness.state().state;
+    assert_eq!(
+        state.document().hair_mesh.bundles.len(),
+        2,
+        "{}",
+        state.message
+    );
+    assert!(state.selection.is_empty());
+    assert_eq!(
+        state.document().body.triangles.len(),
+        6,
+        "the body keeps the face"
+    );
+
+    click_bundle_in_outliner(&mut harness, 0);
+    edit_menu(&mut harness, "Keep only selected bundles");
+    let state = &harness.state().state;
+    assert_eq!(
+        state.document().hair_mesh.bundles.len(),
+        1,
+        "{}",
+        state.message
+    );
+    assert_eq!(state.project.history.undo.len(), steps + 2);
+    state.document().validate().expect("a valid document");
+    // With everything selected there is nothing to delete: said, not done.
+    edit_menu(&mut harness, "Keep only selected bundles");
+    let state = &harness.state().state;
+    assert!(
+        state.message.contains("nothing to delete"),
+        "{}",
+        state.message
+    );
+    assert_eq!(state.project.history.undo.len(), steps + 2);
+    undo(&mut harness, 2);
+    assert_eq!(harness.state().state.document().hair_mesh.bundles.len(), 3);
+
+    // The Delete key deletes the selected bundles; the last one cannot go.
+    click_bundle_in_outliner(&mut harness, 1);
+    harness.key_press(egui::Key::Delete);
+    harness.run();
+    assert_eq!(harness.state().state.document().hair_mesh.bundles.len(), 2);
+    assert_eq!(harness.state().state.project.history.undo.len(), steps + 1);
+}
+
+/// Clicks Edit ▸ `item` (its label may end in a shortcut such as "Delete"; the History
+/// panel may list a step of the same name lower down).
+fn edit_menu(harness: &mut Harness<'static, HairloomApp>, item: &str) {
+    harness.get_by_label("Edit").click();
+    harness.run();
+    harness
+        .query_all_by_label_contains(item)
+        .min_by(|a, b| a.rect().min.y.total_cmp(&b.rect().min.y))
+        .unwrap_or_else(|| panic!("no Edit menu item {item:?}"))
+        .click();
+    harness.run();
+}
+
 #[test]
 fn without_a_native_dialog_a_typed_path_is_asked_for() {
     let dir = tempfile::tempdir().expect("temp dir");

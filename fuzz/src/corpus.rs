@@ -240,7 +240,14 @@ fn gltf_seeds() -> Vec<(String, Vec<u8>)> {
         edit(&mut json);
         json
     };
-    let mut seeds = vec![("quad.glb".to_string(), glb(&builder.json()))];
+    let mut seeds = vec![
+        ("quad.glb".to_string(), glb(&builder.json())),
+        // Two materials and 8-bit vertex colours: where hair grows on a body.
+        (
+            "body_materials_colours.glb".to_string(),
+            hairloom_tests::body_with_materials_glb(),
+        ),
+    ];
     // The same quad as glTF JSON with its buffer in a data URI.
     let data = {
         use base64::Engine as _;

@@ -76,6 +76,23 @@ fn gltf_import(input: &[u8]) {
     if let Ok(imported) = import_slice(input, None, "fuzz.glb", &ImportOptions::default()) {
         let _ = imported.to_body().validate();
         let _ = imported.to_hair_mesh(|_| true).validate();
+        // Every way of choosing where hair grows, on whatever materials and colours the
+        // input claims.
+        let mut regions = vec![
+            hairloom_core::io::scalp_region::ScalpRegion::All,
+            "colour:r>0.5".parse().expect("a valid region"),
+        ];
+        let materials = hairloom_core::io::scalp_region::material_faces(&imported);
+        if let Some((name, _)) = materials.first() {
+            regions.push(hairloom_core::io::scalp_region::ScalpRegion::Materials(
+                vec![name.clone()],
+            ));
+        }
+        for region in regions {
+            if let Ok(keep) = region.faces(&imported) {
+                let _ = imported.to_hair_mesh(|f| keep[f]).validate();
+            }
+        }
     }
 }
 

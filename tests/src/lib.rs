@@ -126,6 +126,51 @@ impl GltfBuilder {
     }
 }
 
+/// A body made of a strip of three unit quads along x as one mesh, "body": the first two
+/// quads in a primitive with material "Scalp", the third in one with material "Skin", and
+/// an 8-bit normalised COLOR_0 painted red (1) on the vertices at x = 0 and 1, black at
+/// x = 2 and 3 (so the faces' mean red is 1, ½ and 0 along the strip).
+pub fn body_with_materials_glb() -> Vec<u8> {
+    let mut builder = GltfBuilder::default();
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    let mut colours = Vec::new();
+    for y in 0..2 {
+        for x in 0..4 {
+            positions.extend([x as f32, y as f32, 0.0]);
+            uvs.extend([x as f32 / 3.0, y as f32]);
+            colours.extend([if x <= 1 { 255u8 } else { 0 }, 0, 0, 255]);
+        }
+    }
+    let p = builder.add_f32(&positions, "VEC3", 8);
+    let t = builder.add_f32(&uvs, "VEC2", 8);
+    let offset = builder.bin.len();
+    builder.bin.extend_from_slice(&colours);
+    builder
+        .views
+        .push(serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": colours.len()}));
+    builder.accessors.push(serde_json::json!({
+        "bufferView": builder.views.len() - 1, "componentType": 5121, "normalized": true,
+        "count": 8, "type": "VEC4"
+    }));
+    let c = builder.accessors.len() - 1;
+    // Quad x..x+1 is vertices (x, x+1, x+5, x+4), counter-clockwise seen from +z.
+    let quad = |x: u32| [x, x + 1, x + 5, x, x + 5, x + 4];
+    let scalp = builder.add_indices(&[quad(0), quad(1)].concat());
+    let skin = builder.add_indices(&quad(2));
+    let attributes = serde_json::json!({"POSITION": p, "TEXCOORD_0": t, "COLOR_0": c});
+    builder.meshes.push(serde_json::json!({
+        "name": "body",
+        "primitives": [
+            {"attributes": attributes, "indices": scalp, "mode": 4, "material": 0},
+            {"attributes": attributes, "indices": skin, "mode": 4, "material": 1}
+        ]
+    }));
+    let mut json = builder.json();
+    json["materials"] = serde_json::json!([{"name": "Scalp"}, {"name": "Skin"}]);
+    builder.glb(&json)
+}
+
 /// A quad mesh whose node (translated by (0, 1, 0) and scaled 2×) is turned 90° about Y over
 /// one second and lifted 0.5 along Y, with LINEAR keys; `edit` changes the JSON first.
 pub fn animated_quad_glb(edit: impl Fn(&mut serde_json::Value)) -> Vec<u8> {

@@ -492,3 +492,148 @@ fn malformed_animations_are_refused_by_name() {
         assert!(text.contains("crafted.glb"), "{text}");
     }
 }
+
+/// Issue 35: where hair grows on an imported body — by material, by a painted vertex-colour
+/// mask, or by faces — and what each refuses by name.
+#[test]
+fn a_scalp_region_is_cut_by_material_or_painted_mask_and_the_body_stays_whole() {
+    use hairloom_core::io::scalp_region::{ScalpRegion, ScalpRegionError, material_faces};
+    let mesh = import(
+        &hairloom_tests::body_with_materials_glb(),
+        &ImportOptions::default(),
+    )
+    .expect("valid file");
+    // Three quads; the strip's two Scalp quads are not paired with the Skin one even where
+    // the shapes would allow it.
+    assert_eq!(mesh.quad_count(), 3, "{:?}", mesh.faces);
+    assert_eq!(
+        material_faces(&mesh),
+        vec![("Scalp".to_string(), 2), ("Skin".to_string(), 1)]
+    );
+    let red: Vec<f64> = mesh
+        .face_colours
+        .as_ref()
+        .expect("COLOR_0 read")
+        .iter()
+        .map(|c| c[0])
+        .collect();
+    let mut sorted = red.clone();
+    sorted.sort_by(f64::total_cmp);
+    assert_eq!(sorted, vec![0.0, 0.5, 1.0], "8-bit normalised colours");
+
+    let centre_x = |face: usize| {
+        mesh.faces[face]
+            .iter()
+            .map(|&v| mesh.positions[v as usize].x)
+            .sum::<f64>()
+            / 4.0
+    };
+    let hair_at = |region: &str| -> Vec<f64> {
+        let keep = region
+            .parse::<ScalpRegion>()
+            .expect("parses")
+            .faces(&mesh)
+            .expect("a region");
+        let mut xs: Vec<f64> = (0..mesh.faces.len())
+            .filter(|&f| keep[f])
+            .map(centre_x)
+            .collect();
+        xs.sort_by(f64::total_cmp);
+        xs
+    };
+    assert_eq!(hair_at("all"), vec![0.5, 1.5, 2.5]);
+    assert_eq!(hair_at("material:Scalp"), vec![0.5, 1.5]);
+    assert_eq!(hair_at("material: Skin , Scalp"), vec![0.5, 1.5, 2.5]);
+    assert_eq!(hair_at("colour:r>0.75"), vec![0.5]);
+    assert_eq!(hair_at("color:R<0.75"), vec![1.5, 2.5]);
+    assert_eq!(hair_at("colour:a>0.5"), vec![0.5, 1.5, 2.5]);
+
+    // The scalp holds the region's faces only; the body is the whole mesh.
+    let keep = ScalpRegion::Materials(vec!["Scalp".into()])
+        .faces(&mesh)
+        .expect("region");
+    let scalp = mesh.to_hair_mesh(|f| keep[f]);
+    scalp.validate().expect("a valid scalp");
+    assert_eq!(scalp.bundles.len(), 2);
+    assert_eq!(scalp.columns.len(), 6);
+    assert_eq!(mesh.to_body().triangles.len(), 6);
+
+    // Named errors.
+    let error = ScalpRegion::Materials(vec!["Hair".into()])
+        .faces(&mesh)
+        .expect_err("no such material")
+        .to_string();
+    assert!(
+        error.contains("\"Hair\"") && error.contains("\"Scalp\" (2 faces)"),
+        "{error}"
+    );
+    let error = "colour:g>0.5"
+        .parse::<ScalpRegion>()
+        .expect("parses")
+        .faces(&mesh)
+        .expect_err("nothing is green");
+    assert!(matches!(error, ScalpRegionError::Empty { .. }), "{error}");
+    let error = ScalpRegion::Faces(vec![0, 3])
+        .faces(&mesh)
+        .expect_err("face 3 does not exist");
+    assert!(error.to_string().contains("face 3"), "{error}");
+    for bad in [
+        "",
+        "material:",
+        "colour:r=0.5",
+        "colour:x>0.5",
+        "colour:r>2",
+        "colour:r>nan",
+        "grow:everywhere",
+    ] {
+        let error = bad.parse::<ScalpRegion>().expect_err(bad).to_string();
+        assert!(error.contains(&format!("\"{bad}\"")), "{bad}: {error}");
+    }
+    // A file with no vertex colours cannot be cut by a mask.
+    let mut builder = GltfBuilder::default();
+    builder.add_quad_mesh("scalp");
+    let plain = import(&builder.glb(&builder.json()), &ImportOptions::default()).expect("valid");
+    assert!(plain.face_colours.is_none());
+    assert!(material_faces(&plain).is_empty());
+    let error = "colour:r>0.5"
+        .parse::<ScalpRegion>()
+        .expect("parses")
+        .faces(&plain)
+        .expect_err("no COLOR_0");
+    assert!(
+        matches!(error, ScalpRegionError::NoVertexColour { .. }),
+        "{error}"
+    );
+    // Colour round-trips through Display and FromStr.
+    let region: ScalpRegion = "colour:b<0.25".parse().expect("parses");
+    assert_eq!(region.to_string().parse::<ScalpRegion>(), Ok(region));
+}
+
+#[test]
+fn a_colour_accessor_of_the_wrong_length_or_not_finite_is_named() {
+    let mut glb_json = {
+        let mut builder = GltfBuilder::default();
+        builder.add_quad_mesh("scalp");
+        let colours = builder.add_f32(&[1.0, 0.0, 0.0, f32::NAN, 0.0, 0.0], "VEC3", 2);
+        let mut json = builder.json();
+        json["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = serde_json::json!(colours);
+        (builder, json)
+    };
+    let error = match import(&glb_json.0.glb(&glb_json.1), &ImportOptions::default()) {
+        Ok(_) => panic!("a NaN colour must be refused"),
+        Err(error) => error.to_string(),
+    };
+    assert!(
+        error.contains("COLOR_0") && error.contains("not finite"),
+        "{error}"
+    );
+    glb_json.1["accessors"][3]["count"] = serde_json::json!(1);
+    let error = match import(&glb_json.0.glb(&glb_json.1), &ImportOptions::default()) {
+        Ok(_) => panic!("too few colours must be refused"),
+        Err(error) => error.to_string(),
+    };
+    assert!(
+        error.contains("COLOR_0") && error.contains("1 colours for 4"),
+        "{error}"
+    );
+}

@@ -32,8 +32,8 @@ pub use brush::{BrushDab, BrushKind, apply_brush, turned_layers};
 pub use coordinates::{set_corner_uvs, set_w, set_w_mode};
 pub use split_merge::{merge_bundles, split_bundles};
 pub use topology::{
-    ExtrudeDirection, delete_layer, extrude, insert_layer, layer_closure, set_density, set_removed,
-    subdivide,
+    ExtrudeDirection, bundle_renumbering, delete_bundles, delete_layer, extrude, insert_layer,
+    layer_closure, set_density, set_removed, subdivide,
 };
 pub use transform::{VertexTransform, falloff_weight, transform_vertices};
 pub use wisps::{bundle_layer_centre, growth_direction, mirror_shape, mirror_styling, paste_shape};
@@ -67,6 +67,8 @@ pub enum EditError {
         "no vertex of the selected bundles has a twin at the same root (what a split leaves): nothing to merge"
     )]
     NothingToMerge,
+    #[error("that would delete every bundle: a scalp needs at least one face to grow hair on")]
+    NothingLeft,
     #[error("the edit would leave an invalid mesh: {0}")]
     Invalid(#[from] crate::model::mesh::InvalidMesh),
 }
@@ -634,5 +636,78 @@ mod tests {
         assert!(moved(6, 1) > 0.0);
         // Root layer untouched by soft selection.
         assert!((0..mesh.columns.len()).all(|c| moved(c, 0) == 0.0));
+    }
+
+    #[test]
+    fn deleting_bundles_renumbers_what_is_left_and_shortens_columns() {
+        use crate::model::styling::{StylingGroup, StylingSet};
+        // 3 × 2 grid, 3 layers; the middle column of bundles 1 and 4 is extruded two more.
+        let mut mesh = grid(3, 2, 3, 0.1);
+        for _ in 0..2 {
+            mesh = extrude(
+                &mesh,
+                &[1, 4],
+                ExtrudeDirection::AlongNormal { distance: 0.1 },
+            )
+            .expect("extrude")
+            .mesh;
+        }
+        mesh.set_locked(&[at(0, 1), at(5, 2)], true);
+        let tallest_before = mesh.columns.iter().map(|c| c.positions.len()).max();
+        assert_eq!(tallest_before, Some(6));
+
+        let out = delete_bundles(&mesh, &[1, 4]).expect("delete");
+        out.mesh.validate().expect("valid");
+        assert_eq!(out.mesh.bundles.len(), 4);
+        assert_eq!(out.affected_bundles, vec![0, 1, 2, 3]);
+        // Every column is exactly as tall as its tallest bundle now (no tall bundle left).
+        assert!(out.mesh.columns.iter().all(|c| c.positions.len() == 4));
+        // Columns no bundle uses are gone: the grid's 12 root vertices all remain used.
+        assert_eq!(out.mesh.columns.len(), 12);
+        // Survivors keep their order and geometry (bundle 2 became bundle 1).
+        let root = |m: &HairMesh, b: usize| {
+            m.bundles[b]
+                .vertices
+                .iter()
+                .map(|&v| m.columns[v as usize].positions[0])
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(root(&out.mesh, 1), root(&mesh, 2));
+        assert!(
+            out.mesh
+                .locked
+                .iter()
+                .all(|v| out.mesh.position(*v).is_some())
+        );
+        assert_eq!(out.mesh.locked.len(), 2);
+
+        // Deleting a corner bundle drops the column only it used.
+        let corner = delete_bundles(&mesh, &[0]).expect("delete");
+        assert_eq!(corner.mesh.columns.len(), 11);
+        corner.mesh.validate().expect("valid");
+
+        // Styling groups follow; deleting everything is refused; bad indices are named.
+        let mut styling = StylingSet {
+            groups: vec![StylingGroup {
+                name: "left".into(),
+                bundles: vec![0, 1, 2, 4, 5, 99],
+                params: Default::default(),
+            }],
+            ..Default::default()
+        };
+        styling.renumber_bundles(&bundle_renumbering(6, &[1, 4]));
+        assert_eq!(styling.groups[0].bundles, vec![0, 1, 3]);
+        assert!(matches!(
+            delete_bundles(&mesh, &[0, 1, 2, 3, 4, 5]),
+            Err(EditError::NothingLeft)
+        ));
+        assert!(matches!(
+            delete_bundles(&mesh, &[6]),
+            Err(EditError::BundleOutOfRange { index: 6, .. })
+        ));
+        assert!(matches!(
+            delete_bundles(&mesh, &[]),
+            Err(EditError::EmptySelection)
+        ));
     }
 }

@@ -243,6 +243,80 @@ pub fn set_removed(
     finish(out, bundles.iter().copied().collect(), None)
 }
 
+/// Deletes bundles for good (unlike [`set_removed`], nothing is kept to restore): their
+/// root faces leave the scalp — the body keeps them — columns no remaining bundle uses go,
+/// and every column shortens to its tallest remaining bundle. What is left is renumbered in
+/// order; `affected_bundles` lists the survivors' new indices. Deleting every bundle is
+/// refused (a scalp with no face has nothing to grow on).
+pub fn delete_bundles(mesh: &HairMesh, bundles: &[u32]) -> Result<EditOutcome, EditError> {
+    check_bundles(mesh, bundles)?;
+    let gone: BTreeSet<u32> = bundles.iter().copied().collect();
+    if gone.len() == mesh.bundles.len() {
+        return Err(EditError::NothingLeft);
+    }
+    let mut remap = vec![u32::MAX; mesh.columns.len()];
+    let mut out = HairMesh {
+        bundles: Vec::with_capacity(mesh.bundles.len() - gone.len()),
+        columns: Vec::new(),
+        w_mode: mesh.w_mode,
+        locked: Vec::new(),
+    };
+    for (index, bundle) in mesh.bundles.iter().enumerate() {
+        if gone.contains(&(index as u32)) {
+            continue;
+        }
+        let mut kept = bundle.clone();
+        for v in &mut kept.vertices {
+            let column = &mut remap[*v as usize];
+            if *column == u32::MAX {
+                *column = out.columns.len() as u32;
+                out.columns.push(mesh.columns[*v as usize].clone());
+            }
+            *v = *column;
+        }
+        out.bundles.push(kept);
+    }
+    let topology = Topology::build(&out);
+    for (c, column) in out.columns.iter_mut().enumerate() {
+        let length = 1 + topology.bundles_of_column[c]
+            .iter()
+            .map(|&b| out.bundles[b as usize].layers as usize)
+            .max()
+            .unwrap_or(0);
+        column.positions.truncate(length);
+        column.w.truncate(length);
+    }
+    out.locked = mesh
+        .locked
+        .iter()
+        .filter_map(|v| {
+            let column = remap[v.column as usize];
+            (column != u32::MAX).then_some(VertexRef {
+                column,
+                layer: v.layer,
+            })
+        })
+        .collect();
+    out.locked.sort();
+    let survivors = (0..out.bundles.len() as u32).collect();
+    finish(out, survivors, None)
+}
+
+/// The new index of each of `count` bundles after [`delete_bundles`] deleted `gone`
+/// (`None` for a deleted one): survivors keep their order.
+pub fn bundle_renumbering(count: usize, gone: &[u32]) -> Vec<Option<u32>> {
+    let gone: BTreeSet<u32> = gone.iter().copied().collect();
+    let mut next = 0;
+    (0..count as u32)
+        .map(|b| {
+            (!gone.contains(&b)).then(|| {
+                next += 1;
+                next - 1
+            })
+        })
+        .collect()
+}
+
 /// Sets the fraction of strands the selected bundles grow (`Bundle::density`, `[0, 1]`;
 /// anything else is refused with the bundle's field named). Geometry is untouched.
 pub fn set_density(

@@ -121,6 +121,15 @@ pub struct ImportedMesh {
     pub has_uv: bool,
     /// Triangles read from the file, before welding and pairing.
     pub source_triangles: usize,
+    /// The glTF primitive each face came from (faces never span two primitives: a quad is
+    /// paired only from triangles of one primitive, so a material's border stays a border).
+    pub face_primitives: Vec<u32>,
+    /// Each primitive's material name (`material N` when the material has none), `None`
+    /// where the primitive names no material.
+    pub primitive_materials: Vec<Option<String>>,
+    /// Each face's mean vertex colour (COLOR_0, linear RGBA) over its corners, when any
+    /// primitive has one; primitives without COLOR_0 count as white, as glTF specifies.
+    pub face_colours: Option<Vec<[f64; 4]>>,
     /// Triangles dropped because welding collapsed them.
     pub degenerate_triangles: usize,
     /// The body's motion from the file's first animation that moves the mesh's node
@@ -285,6 +294,10 @@ pub fn import_slice(
     let mut positions: Vec<DVec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut corner_uvs: Vec<[DVec2; 3]> = Vec::new();
+    let mut triangle_primitives: Vec<u32> = Vec::new();
+    let mut triangle_colours: Vec<[f64; 4]> = Vec::new();
+    let mut has_colour = false;
+    let mut primitive_materials = Vec::with_capacity(mesh.primitives.len());
     let mut has_uv = false;
     for (p_index, primitive) in mesh.primitives.iter().enumerate() {
         reader.primitive = p_index;
@@ -351,6 +364,35 @@ pub fn import_slice(
             }
             None => None,
         };
+        let colours = match attribute(json::mesh::Semantic::Colors(0)) {
+            Some(accessor) => {
+                let components = match reader.accessor(accessor, "COLOR_0")?.type_ {
+                    Checked::Valid(json::accessor::Type::Vec3) => 3,
+                    _ => 4,
+                };
+                let colours = reader.read(accessor, "COLOR_0", components)?;
+                if colours.len() / components != vertex_count {
+                    return Err(reader.error(
+                        accessor,
+                        "COLOR_0",
+                        format!(
+                            "{} colours for {vertex_count} positions",
+                            colours.len() / components
+                        ),
+                    ));
+                }
+                has_colour = true;
+                Some((colours, components))
+            }
+            None => None,
+        };
+        primitive_materials.push(primitive.material.map(|m| {
+            let m = m.value();
+            root.materials
+                .get(m)
+                .and_then(|material| material.name.clone())
+                .unwrap_or_else(|| format!("material {m}"))
+        }));
         let indices: Vec<u32> = match primitive.indices.map(|i| i.value()) {
             Some(accessor) => {
                 let count = reader.count(accessor, "indices")?;
@@ -424,37 +466,77 @@ pub fn import_slice(
                 Some(uvs) => DVec2::new(uvs[2 * i as usize], uvs[2 * i as usize + 1]),
                 None => DVec2::ZERO,
             });
+            let colour = match &colours {
+                Some((colours, components)) => {
+                    let mut mean = [0.0, 0.0, 0.0, 1.0];
+                    for c in 0..*components {
+                        mean[c] = t
+                            .iter()
+                            .map(|&i| colours[components * i as usize + c])
+                            .sum::<f64>()
+                            / 3.0;
+                    }
+                    mean
+                }
+                None => [1.0; 4],
+            };
             triangles.push(t.map(|i| i + base));
             corner_uvs.push(uv);
+            triangle_primitives.push(p_index as u32);
+            triangle_colours.push(colour);
         }
         positions.extend(world);
     }
     let source_triangles = triangles.len();
-    let (positions, triangles, corner_uvs, degenerate) = weld(
-        &positions,
-        &triangles,
-        &corner_uvs,
-        options.weld_tolerance_relative,
-    );
+    let (positions, welded) = weld(&positions, &triangles, options.weld_tolerance_relative);
+    let degenerate = source_triangles - welded.len();
+    let corner_uvs: Vec<[DVec2; 3]> = welded.iter().map(|&(t, _)| corner_uvs[t]).collect();
+    let triangle_primitives: Vec<u32> = welded
+        .iter()
+        .map(|&(t, _)| triangle_primitives[t])
+        .collect();
+    let triangle_colours: Vec<[f64; 4]> =
+        welded.iter().map(|&(t, _)| triangle_colours[t]).collect();
+    let triangles: Vec<[u32; 3]> = welded.into_iter().map(|(_, t)| t).collect();
     if triangles.is_empty() {
         return Err(ImportError::Empty {
             file: file.to_string(),
             mesh: mesh_name,
         });
     }
-    let (faces, uvs) = if options.pair_quads {
+    let (faces, uvs, face_triangles) = if options.pair_quads {
         pair_quads(
             &positions,
             &triangles,
             &corner_uvs,
+            &triangle_primitives,
             options.max_quad_fold_deg,
         )
     } else {
         (
             triangles.iter().map(|t| t.to_vec()).collect(),
             corner_uvs.iter().map(|u| u.to_vec()).collect(),
+            (0..triangles.len()).map(|t| vec![t]).collect(),
         )
     };
+    let face_primitives = face_triangles
+        .iter()
+        .map(|ts| triangle_primitives[ts[0]])
+        .collect();
+    let face_colours = has_colour.then(|| {
+        face_triangles
+            .iter()
+            .map(|ts| {
+                let mut mean = [0.0; 4];
+                for &t in ts {
+                    for (m, c) in mean.iter_mut().zip(triangle_colours[t]) {
+                        *m += c / ts.len() as f64;
+                    }
+                }
+                mean
+            })
+            .collect()
+    });
     let body_animation = match placement {
         Some((node, parent)) => body_animation(&root, node, parent, &mut reader)?,
         None => Vec::new(),
@@ -466,6 +548,9 @@ pub fn import_slice(
         uvs,
         has_uv,
         source_triangles,
+        face_primitives,
+        primitive_materials,
+        face_colours,
         degenerate_triangles: degenerate,
         body_animation,
     })
@@ -1129,18 +1214,14 @@ impl AccessorReader<'_> {
     }
 }
 
-/// Merges vertices closer than `relative_tolerance × bounding-box diagonal`, keeps corner uv
-/// and drops triangles that collapse. Returns (positions, triangles, uvs, dropped).
-#[expect(
-    clippy::type_complexity,
-    reason = "a private helper returning four parallel results"
-)]
+/// Merges vertices closer than `relative_tolerance × bounding-box diagonal` and drops
+/// triangles that collapse. Returns the welded positions and each surviving triangle as
+/// (its index in `triangles`, its welded corners), so per-triangle data follows it.
 fn weld(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
-    uvs: &[[DVec2; 3]],
     relative_tolerance: f64,
-) -> (Vec<DVec3>, Vec<[u32; 3]>, Vec<[DVec2; 3]>, usize) {
+) -> (Vec<DVec3>, Vec<(usize, [u32; 3])>) {
     let (min, max) = positions.iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
@@ -1193,21 +1274,17 @@ fn weld(
         remap.push(index);
     }
     let mut out_triangles = Vec::with_capacity(triangles.len());
-    let mut out_uvs = Vec::with_capacity(triangles.len());
-    let mut dropped = 0;
-    for (t, uv) in triangles.iter().zip(uvs) {
+    for (index, t) in triangles.iter().enumerate() {
         let m = t.map(|i| remap[i as usize]);
         if m[0] == m[1] || m[1] == m[2] || m[0] == m[2] {
-            dropped += 1;
             continue;
         }
-        out_triangles.push(m);
-        out_uvs.push(*uv);
+        out_triangles.push((index, m));
     }
     // Drop vertices no triangle uses (for example, only used by collapsed triangles).
     let mut used = vec![u32::MAX; welded.len()];
     let mut compact = Vec::new();
-    for t in &mut out_triangles {
+    for (_, t) in &mut out_triangles {
         for i in t.iter_mut() {
             if used[*i as usize] == u32::MAX {
                 used[*i as usize] = compact.len() as u32;
@@ -1216,7 +1293,7 @@ fn weld(
             *i = used[*i as usize];
         }
     }
-    (compact, out_triangles, out_uvs, dropped)
+    (compact, out_triangles)
 }
 
 /// Quad made of triangles `a` and `b` if they share an edge (in opposite directions), agree
@@ -1276,23 +1353,30 @@ fn try_pair(
 
 /// Pairs triangles into quads: first consecutive triangles (exporters write a quad as two
 /// consecutive triangles), then any remaining neighbours across the longest edge of both
-/// (the quad's diagonal is its longest edge in well-shaped quads).
+/// (the quad's diagonal is its longest edge in well-shaped quads). Only triangles of one
+/// `group` (the glTF primitive) pair. Returns faces, their corner uvs and the triangles
+/// each face was made of.
 #[expect(
     clippy::type_complexity,
-    reason = "a private helper returning parallel face and uv lists"
+    reason = "a private helper returning parallel face, uv and source lists"
 )]
 fn pair_quads(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
     uvs: &[[DVec2; 3]],
+    group: &[u32],
     max_fold_deg: f64,
-) -> (Vec<Vec<u32>>, Vec<Vec<DVec2>>) {
+) -> (Vec<Vec<u32>>, Vec<Vec<DVec2>>, Vec<Vec<usize>>) {
     let min_fold_cos = max_fold_deg.to_radians().cos();
     let count = triangles.len();
     let mut partner: Vec<Option<(usize, [u32; 4], [DVec2; 4])>> = vec![None; count];
     let mut paired = vec![false; count];
     let mut t = 0;
     while t + 1 < count {
+        if group[t] != group[t + 1] {
+            t += 1;
+            continue;
+        }
         if let Some((quad, quad_uv)) = try_pair(
             positions,
             triangles[t],
@@ -1340,7 +1424,7 @@ fn pair_quads(
             continue;
         };
         for &other in candidates {
-            if other == t || paired[other] {
+            if other == t || paired[other] || group[other] != group[t] {
                 continue;
             }
             if let Some((quad, quad_uv)) = try_pair(
@@ -1360,6 +1444,7 @@ fn pair_quads(
     }
     let mut faces = Vec::with_capacity(count);
     let mut face_uvs = Vec::with_capacity(count);
+    let mut face_triangles = Vec::with_capacity(count);
     let mut emitted = vec![false; count];
     for t in 0..count {
         if emitted[t] {
@@ -1371,16 +1456,18 @@ fn pair_quads(
                 emitted[*other] = true;
                 faces.push(quad.to_vec());
                 face_uvs.push(quad_uv.to_vec());
+                face_triangles.push(vec![t, *other]);
             }
             None if !paired[t] => {
                 emitted[t] = true;
                 faces.push(triangles[t].to_vec());
                 face_uvs.push(uvs[t].to_vec());
+                face_triangles.push(vec![t]);
             }
             None => {}
         }
     }
-    (faces, face_uvs)
+    (faces, face_uvs, face_triangles)
 }
 
 #[cfg(test)]
@@ -1393,9 +1480,14 @@ mod tests {
         let uv = |i: u32| DVec2::new(positions[i as usize].x, positions[i as usize].y);
         let tris = vec![[0, 1, 2], [0, 2, 3]];
         let uvs: Vec<[DVec2; 3]> = tris.iter().map(|t: &[u32; 3]| t.map(uv)).collect();
-        let (faces, face_uvs) = pair_quads(&positions, &tris, &uvs, 30.0);
+        let (faces, face_uvs, sources) = pair_quads(&positions, &tris, &uvs, &[0, 0], 30.0);
         assert_eq!(faces, vec![vec![0, 1, 2, 3]]);
         assert_eq!(face_uvs[0][1], DVec2::X);
+        assert_eq!(sources, vec![vec![0, 1]]);
+        // Triangles of two primitives (two materials) never become one quad.
+        let (faces, _, sources) = pair_quads(&positions, &tris, &uvs, &[0, 1], 30.0);
+        assert_eq!(faces.len(), 2);
+        assert_eq!(sources, vec![vec![0], vec![1]]);
         // Fold the quad by 90°: stays two triangles.
         let folded = vec![
             DVec3::ZERO,
@@ -1403,7 +1495,7 @@ mod tests {
             DVec3::new(1.0, 1.0, 0.0),
             DVec3::new(0.0, 1.0, -1.0),
         ];
-        let (faces, _) = pair_quads(&folded, &tris, &uvs, 30.0);
+        let (faces, _, _) = pair_quads(&folded, &tris, &uvs, &[0, 0], 30.0);
         assert_eq!(faces.len(), 2);
     }
 
@@ -1418,10 +1510,9 @@ mod tests {
             DVec3::Y * 1e-12,
         ];
         let tris = vec![[0, 1, 2], [3, 4, 2], [0, 5, 1]];
-        let uvs = vec![[DVec2::ZERO; 3]; 3];
-        let (p, t, _, dropped) = weld(&positions, &tris, &uvs, 1e-6);
+        let (p, t) = weld(&positions, &tris, 1e-6);
         assert_eq!(p.len(), 4);
-        assert_eq!(t, vec![[0, 1, 2], [1, 3, 2]]);
-        assert_eq!(dropped, 1);
+        // The third triangle collapses; the survivors keep their source index.
+        assert_eq!(t, vec![(0, [0, 1, 2]), (1, [1, 3, 2])]);
     }
 }

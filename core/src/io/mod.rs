@@ -10,4 +10,5 @@ pub mod input_files;
 pub mod ktx2;
 pub mod project;
 pub mod runtime_bundle;
+pub mod scalp_region;
 pub mod strand_files;

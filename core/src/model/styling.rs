@@ -288,6 +288,20 @@ pub struct StylingGroup {
 }
 
 impl StylingSet {
+    /// Follows a renumbering of the bundles (`renumber[old]` is the new index, `None` for a
+    /// deleted bundle): groups keep their members under their new numbers and lose deleted
+    /// ones (a group left empty stays, with its parameters, for the artist to refill).
+    /// Indices past `renumber` (which `validate` would name) are dropped too.
+    pub fn renumber_bundles(&mut self, renumber: &[Option<u32>]) {
+        for group in &mut self.groups {
+            group.bundles = group
+                .bundles
+                .iter()
+                .filter_map(|&b| renumber.get(b as usize).copied().flatten())
+                .collect();
+        }
+    }
+
     pub fn params_for(&self, bundle: u32) -> &StylingParams {
         self.group_of(bundle)
             .map(|g| &self.groups[g].params)

@@ -22,6 +22,7 @@ pub mod viewport;
 pub use state::EditorState;
 
 pub mod groom_import;
+pub mod scalp_import;
 
 use hairloom_core::io::alembic::AlembicTarget;
 use std::path::PathBuf;
@@ -169,6 +170,9 @@ pub struct HairloomApp {
     pub export: Option<ExportJob>,
     /// File ▸ Import groom…: the scalp question, then the fit on a worker.
     pub groom_import: Option<groom_import::GroomImport>,
+    /// File ▸ Import scalp… on a file with several materials or vertex colours: where hair
+    /// grows.
+    pub scalp_import: Option<scalp_import::ScalpImport>,
     /// The application the next `.abc` export is for (File ▸ Export groom for ▸).
     pub alembic_target: AlembicTarget,
     /// "Save changes?" is being asked before this action.
@@ -217,6 +221,7 @@ impl HairloomApp {
             prompt: None,
             export: None,
             groom_import: None,
+            scalp_import: None,
             alembic_target: AlembicTarget::default(),
             confirm: None,
             after_save: None,
@@ -318,6 +323,7 @@ impl HairloomApp {
             || self.prompt.is_some()
             || self.export.is_some()
             || self.groom_import.is_some()
+            || self.scalp_import.is_some()
     }
 
     fn shortcuts(&mut self, ui: &mut egui::Ui) {
@@ -380,6 +386,13 @@ impl HairloomApp {
         }
         if ui.input_mut(|i| i.consume_shortcut(&quit)) {
             self.request(AfterConfirm::Quit);
+        }
+        if !typing
+            && self.state.tool.mode == state::SelectMode::Bundles
+            && !self.state.selection.is_empty()
+            && ui.input_mut(|i| i.consume_shortcut(&DELETE))
+        {
+            self.state.delete_bundles(false);
         }
         if !typing && ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::E)) {
             // Over the viewport E is interactive (the pointer sets the distance, a click
@@ -571,14 +584,54 @@ impl HairloomApp {
         self.autosaved.1 = self.state.revision;
     }
 
+    /// Reads the scalp file; asks where hair grows when the file offers a choice (several
+    /// materials, vertex colours), else imports every face.
     fn import_scalp(&mut self, path: &std::path::Path) {
         let options = hairloom_core::io::import::ImportOptions::default();
-        match crate::files::scalp_document(path, &options, false) {
+        match hairloom_core::io::import::import_file(path, &options) {
+            Ok(mesh) if scalp_import::ScalpImport::offers_choice(&mesh) => {
+                self.scalp_import = Some(scalp_import::ScalpImport::new(path.to_path_buf(), mesh));
+            }
+            Ok(mesh) => self.finish_scalp_import(
+                path,
+                &mesh,
+                &hairloom_core::io::scalp_region::ScalpRegion::All,
+            ),
+            Err(error) => self.state.message = format!("import failed: {error}"),
+        }
+    }
+
+    fn finish_scalp_import(
+        &mut self,
+        path: &std::path::Path,
+        mesh: &hairloom_core::io::import::ImportedMesh,
+        region: &hairloom_core::io::scalp_region::ScalpRegion,
+    ) {
+        match crate::files::scalp_document_from(path, mesh, region, false) {
             Ok((document, summary)) => {
                 self.state.import_scalp(document, &summary);
                 self.viewport.reframe();
             }
             Err(error) => self.state.message = format!("import failed: {error:#}"),
+        }
+    }
+
+    /// The "where does hair grow?" modal of a scalp import.
+    fn scalp_import_modal(&mut self, ui: &mut egui::Ui) {
+        let Some(import) = &mut self.scalp_import else {
+            return;
+        };
+        match import.ui(ui) {
+            scalp_import::ScalpImportAction::Waiting => {}
+            scalp_import::ScalpImportAction::Closed => {
+                self.scalp_import = None;
+                self.state.message = "import cancelled".into();
+            }
+            scalp_import::ScalpImportAction::Import(region) => {
+                if let Some(import) = self.scalp_import.take() {
+                    self.finish_scalp_import(&import.path, &import.mesh, &region);
+                }
+            }
         }
     }
 
@@ -732,6 +785,33 @@ impl HairloomApp {
                     self.state.redo();
                     ui.close();
                 }
+                ui.separator();
+                // Cutting the scalp out of an imported body: select it, keep it.
+                let any = !self.state.selection.is_empty();
+                if ui
+                    .add_enabled(
+                        any,
+                        egui::Button::new("Delete selected bundles")
+                            .shortcut_text(ui.ctx().format_shortcut(&shortcut::DELETE)),
+                    )
+                    .on_hover_text(
+                        "For good: their faces leave the scalp and stay in the body (Remove in Tools keeps them)",
+                    )
+                    .clicked()
+                {
+                    self.state.delete_bundles(false);
+                    ui.close();
+                }
+                if ui
+                    .add_enabled(any, egui::Button::new("Keep only selected bundles"))
+                    .on_hover_text(
+                        "Delete every other bundle: box-select the scalp on an imported body, then keep it",
+                    )
+                    .clicked()
+                {
+                    self.state.delete_bundles(true);
+                    ui.close();
+                }
             });
             ui.menu_button("View", |ui| {
                 let settings = &mut self.viewport.settings;
@@ -763,11 +843,12 @@ impl HairloomApp {
         });
     }
 
-    /// The modal windows: recovery offer, groom import, "save changes?", typed path, export
-    /// progress.
+    /// The modal windows: recovery offer, groom and scalp import, "save changes?", typed
+    /// path, export progress.
     fn modals(&mut self, ui: &mut egui::Ui) {
         self.recovery_offer(ui);
         self.groom_import_modal(ui);
+        self.scalp_import_modal(ui);
         if let Some(action) = self.confirm.clone() {
             let mut choice = None;
             let modal =
@@ -1070,6 +1151,8 @@ mod shortcut {
     pub const OPEN: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
     pub const NEW: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::N);
     pub const QUIT: KeyboardShortcut = KeyboardShortcut::new(Modifiers::COMMAND, Key::Q);
+    /// Deletes the selected bundles (bundle mode, nothing typed into).
+    pub const DELETE: KeyboardShortcut = KeyboardShortcut::new(Modifiers::NONE, Key::Delete);
 }
 
 /// The File menu's name of an Alembic target, with the axes and units it gets.

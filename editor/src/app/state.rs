@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use std::collections::BTreeSet;
 
-use hairloom_core::edit::select;
+use hairloom_core::edit::{self, select};
 use hairloom_core::edit::{EditError, EditOutcome};
 use hairloom_core::io::project::{self, Project};
 use hairloom_core::model::change::{ChangeKind, ChangeLog};
@@ -454,6 +454,62 @@ impl EditorState {
         self.selection.retain(|&b| b < count);
         self.vertex_selection
             .retain(|v| mesh.position(*v).is_some());
+    }
+
+    /// Deletes the selected bundles for good (`keep_selected`: every other one — a scalp cut
+    /// from an imported body by selecting it), as one undo step. Their root faces stay in
+    /// the body; styling groups follow the renumbering. The survivors stay selected after
+    /// a keep; a delete clears the selection.
+    pub fn delete_bundles(&mut self, keep_selected: bool) -> bool {
+        let label = if keep_selected {
+            "Keep only selected bundles"
+        } else {
+            "Delete bundles"
+        };
+        self.commit_edit();
+        self.stop_playback_for_editing();
+        let count = self.project.document.hair_mesh.bundles.len();
+        let gone: Vec<u32> = if keep_selected {
+            if self.selection.is_empty() {
+                self.message = format!("{label}: {}", EditError::EmptySelection);
+                return false;
+            }
+            (0..count as u32)
+                .filter(|b| !self.selection.contains(b))
+                .collect()
+        } else {
+            self.selection.iter().copied().collect()
+        };
+        if keep_selected && gone.is_empty() {
+            self.message = format!("{label}: every bundle is selected; nothing to delete");
+            return false;
+        }
+        match edit::delete_bundles(&self.project.document.hair_mesh, &gone) {
+            Ok(outcome) => {
+                let kept = outcome.affected_bundles.len();
+                let document = self.edit(ChangeKind::Rebuild, label);
+                document.hair_mesh = outcome.mesh;
+                document
+                    .styling
+                    .renumber_bundles(&edit::bundle_renumbering(count, &gone));
+                self.commit_edit();
+                self.vertex_selection.clear();
+                self.selection = if keep_selected {
+                    (0..kept as u32).collect()
+                } else {
+                    BTreeSet::new()
+                };
+                self.message = format!(
+                    "{label}: {} deleted, {kept} left (their faces stay in the body)",
+                    gone.len()
+                );
+                true
+            }
+            Err(error) => {
+                self.message = format!("{label}: {error}");
+                false
+            }
+        }
     }
 
     /// Applies a hair-mesh edit of the selected bundles as one undo step; an error (named in

@@ -50,7 +50,13 @@ fn scalp_source(path: &Path, scale: f64) -> anyhow::Result<ScalpSource> {
             scale,
             ..ImportOptions::default()
         };
-        files::scalp_document(path, &options, false)?.0
+        files::scalp_document(
+            path,
+            &options,
+            &hairloom_core::io::scalp_region::ScalpRegion::All,
+            false,
+        )?
+        .0
     };
     Ok(ScalpSource::Given {
         scalp: document.hair_mesh,

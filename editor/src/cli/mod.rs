@@ -66,6 +66,11 @@ enum Command {
         /// Replace the file's uv with a seamless generated projection.
         #[arg(long)]
         generate_uv: bool,
+        /// Where hair grows (the whole mesh stays the body): `all`, `material:NAME[,NAME…]`
+        /// (faces using those glTF materials) or `colour:r>0.5` / `colour:g<0.5` (a mask
+        /// painted into the vertex colours, channel r, g, b or a).
+        #[arg(long, default_value = "all")]
+        hair_on: hairloom_core::io::scalp_region::ScalpRegion,
         /// Raise the import cap on vertices (default 4,000,000; triangles may be twice as
         /// many). See docs/resource-policy.md.
         #[arg(long)]
@@ -247,8 +252,17 @@ pub fn main() -> ExitCode {
             mesh,
             scale,
             generate_uv,
+            hair_on,
             max_vertices,
-        }) => import(&scalp, &out, mesh, scale, generate_uv, max_vertices),
+        }) => import(
+            &scalp,
+            &out,
+            mesh,
+            scale,
+            &hair_on,
+            generate_uv,
+            max_vertices,
+        ),
         Some(Command::Fit(args)) => fit::run(args),
         Some(Command::Export {
             project,
@@ -460,6 +474,7 @@ fn import(
     out: &Path,
     mesh: Option<String>,
     scale: f64,
+    hair_on: &hairloom_core::io::scalp_region::ScalpRegion,
     generate_uv: bool,
     max_vertices: Option<usize>,
 ) -> anyhow::Result<()> {
@@ -474,7 +489,7 @@ fn import(
         limits,
         ..hairloom_core::io::import::ImportOptions::default()
     };
-    let (document, summary) = files::scalp_document(scalp, &options, generate_uv)?;
+    let (document, summary) = files::scalp_document(scalp, &options, hair_on, generate_uv)?;
     project::save(out, &hairloom_core::Project::new(document))?;
     println!("{summary} → {}", out.display());
     Ok(())

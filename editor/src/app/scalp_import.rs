@@ -1,0 +1,199 @@
+//! File ▸ Import scalp…, for a file that offers a choice: where hair grows. A whole body
+//! imported face for face would make every face of the face, neck and shoulders a bundle;
+//! here the artist picks the scalp by the file's materials or by a mask painted into its
+//! vertex colours (the count updates as they choose), or imports every face and keeps only
+//! a box-selected region afterwards (Edit ▸ Keep only selected bundles). The whole mesh stays the
+//! body either way. A file with one material and no vertex colours imports at once.
+
+use std::path::PathBuf;
+
+use hairloom_core::io::import::ImportedMesh;
+use hairloom_core::io::scalp_region::{ColourChannel, ScalpRegion, face_count, material_faces};
+
+/// How the artist names the scalp.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Choice {
+    Everything,
+    Materials,
+    VertexColour,
+}
+
+/// The question, with the mesh already read (the file is read once).
+pub struct ScalpImport {
+    pub path: PathBuf,
+    /// Boxed: a mesh is large and this sits in the app.
+    pub mesh: Box<ImportedMesh>,
+    choice: Choice,
+    /// Each material, its face count and whether it is chosen.
+    materials: Vec<(String, usize, bool)>,
+    channel: ColourChannel,
+    above: bool,
+    threshold: f64,
+}
+
+/// What the modal asks of the app.
+pub enum ScalpImportAction {
+    Waiting,
+    /// Cancel: nothing is imported.
+    Closed,
+    /// Import with hair on this region.
+    Import(ScalpRegion),
+}
+
+/// Material names that suggest where hair grows: chosen by default.
+fn looks_like_scalp(name: &str) -> bool {
+    let name = name.to_ascii_lowercase();
+    ["scalp", "hair", "head_skin"]
+        .iter()
+        .any(|word| name.contains(word))
+}
+
+impl ScalpImport {
+    /// Whether the file offers a choice (several materials, or vertex colours).
+    pub fn offers_choice(mesh: &ImportedMesh) -> bool {
+        material_faces(mesh).len() > 1 || mesh.face_colours.is_some()
+    }
+
+    pub fn new(path: PathBuf, mesh: ImportedMesh) -> Self {
+        let materials: Vec<(String, usize, bool)> = material_faces(&mesh)
+            .into_iter()
+            .map(|(name, faces)| {
+                let chosen = looks_like_scalp(&name);
+                (name, faces, chosen)
+            })
+            .collect();
+        let choice = if materials.iter().any(|m| m.2) {
+            Choice::Materials
+        } else {
+            Choice::Everything
+        };
+        Self {
+            path,
+            mesh: Box::new(mesh),
+            choice,
+            materials,
+            channel: ColourChannel::Red,
+            above: true,
+            threshold: 0.5,
+        }
+    }
+
+    /// The region as chosen now.
+    pub fn region(&self) -> ScalpRegion {
+        match self.choice {
+            Choice::Everything => ScalpRegion::All,
+            Choice::Materials => ScalpRegion::Materials(
+                self.materials
+                    .iter()
+                    .filter(|m| m.2)
+                    .map(|m| m.0.clone())
+                    .collect(),
+            ),
+            Choice::VertexColour => ScalpRegion::VertexColour {
+                channel: self.channel,
+                above: self.above,
+                threshold: self.threshold,
+            },
+        }
+    }
+
+    pub fn ui(&mut self, ui: &mut egui::Ui) -> ScalpImportAction {
+        let mut action = ScalpImportAction::Waiting;
+        let total = self.mesh.faces.len();
+        egui::Modal::new(egui::Id::unique("hairloom import scalp")).show(ui.ctx(), |ui| {
+            ui.heading("Import scalp");
+            ui.label(self.path.display().to_string());
+            ui.label(format!(
+                "Hair grows on (all {total} faces of \"{}\" stay the body):",
+                self.mesh.mesh_name
+            ));
+            ui.radio_value(
+                &mut self.choice,
+                Choice::Everything,
+                format!("every face ({total})"),
+            );
+            if !self.materials.is_empty() {
+                ui.radio_value(
+                    &mut self.choice,
+                    Choice::Materials,
+                    "faces with these materials",
+                );
+                ui.add_enabled_ui(self.choice == Choice::Materials, |ui| {
+                    ui.indent("materials", |ui| {
+                        for (name, faces, chosen) in &mut self.materials {
+                            ui.checkbox(chosen, format!("{name} ({})", face_count(*faces)));
+                        }
+                    });
+                });
+            }
+            if self.mesh.face_colours.is_some() {
+                ui.radio_value(
+                    &mut self.choice,
+                    Choice::VertexColour,
+                    "faces painted in the vertex colours",
+                );
+                ui.add_enabled_ui(self.choice == Choice::VertexColour, |ui| {
+                    ui.indent("mask", |ui| {
+                        ui.horizontal(|ui| {
+                            let label = ui.label("channel");
+                            egui::ComboBox::from_id_salt("mask channel")
+                                .selected_text(channel_name(self.channel))
+                                .show_ui(ui, |ui| {
+                                    for channel in ColourChannel::ALL {
+                                        ui.selectable_value(
+                                            &mut self.channel,
+                                            channel,
+                                            channel_name(channel),
+                                        );
+                                    }
+                                })
+                                .response
+                                .labelled_by(label.id);
+                            ui.selectable_value(&mut self.above, true, "above");
+                            ui.selectable_value(&mut self.above, false, "below");
+                            ui.add(
+                                egui::Slider::new(&mut self.threshold, 0.0..=1.0)
+                                    .text("mask threshold"),
+                            );
+                        });
+                    });
+                });
+            }
+            let counted = self.region().faces(&self.mesh);
+            let ready = match &counted {
+                Ok(keep) => {
+                    ui.label(format!(
+                        "{} of {total} faces become bundles",
+                        keep.iter().filter(|k| **k).count()
+                    ));
+                    true
+                }
+                Err(error) => {
+                    ui.colored_label(ui.visuals().warn_fg_color, error.to_string());
+                    false
+                }
+            };
+            ui.label(
+                "Or import every face, box-select the scalp and use Edit > Keep only selected bundles.",
+            );
+            ui.horizontal(|ui| {
+                if ui.add_enabled(ready, egui::Button::new("Import")).clicked() {
+                    action = ScalpImportAction::Import(self.region());
+                }
+                if ui.button("Cancel").clicked() {
+                    action = ScalpImportAction::Closed;
+                }
+            });
+        });
+        action
+    }
+}
+
+fn channel_name(channel: ColourChannel) -> &'static str {
+    match channel {
+        ColourChannel::Red => "red",
+        ColourChannel::Green => "green",
+        ColourChannel::Blue => "blue",
+        ColourChannel::Alpha => "alpha",
+    }
+}
