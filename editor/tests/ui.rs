@@ -2350,6 +2350,34 @@ fn the_tools_and_history_panes_show_their_controls_at_the_default_size() {
 /// Issue 35: with Drag ▸ Groom, a stroke of the comb over the hair moves it (both sides of
 /// the head with X-mirror), as one undo step that undo takes back exactly; the length
 /// brush makes the hair under it longer.
+/// Issue 35: the brushes' body distance field (about 0.4 s for the head scan) is built off
+/// the UI thread from the moment Groom is chosen, not on the first stroke, where it froze
+/// the pointer.
+#[test]
+fn choosing_groom_builds_the_body_field_before_the_first_stroke() {
+    let mut harness = harness();
+    assert_eq!(harness.state().viewport.brush_field_status(), "none");
+    harness.get_by_label("Groom").click();
+    harness.run();
+    assert_ne!(
+        harness.state().viewport.brush_field_status(),
+        "none",
+        "choosing Groom starts the build"
+    );
+    let started = std::time::Instant::now();
+    while harness.state().viewport.brush_field_status() == "building"
+        && started.elapsed().as_secs() < 120
+    {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert_eq!(harness.state().viewport.brush_field_status(), "ready");
+    assert_eq!(
+        harness.state().state.project.history.undo.len(),
+        0,
+        "no stroke was made"
+    );
+}
+
 #[test]
 fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
     let mut harness = harness();

@@ -20,6 +20,22 @@ use hairloom_core::simulate::BodySdf;
 use super::camera::Projector;
 use super::{DragTool, EditorState, Viewport};
 
+/// The body's distance field for one body (a fingerprint of its mesh): building on a worker
+/// thread, or built. It takes about 0.4 s for the head scan, so it starts when the Groom
+/// tool is chosen rather than at the first stroke, where it froze the pointer.
+pub(super) enum BodyField {
+    Building(u64, std::thread::JoinHandle<BodySdf>),
+    Ready(u64, Arc<BodySdf>),
+}
+
+impl BodyField {
+    fn key(&self) -> u64 {
+        match self {
+            Self::Building(key, _) | Self::Ready(key, _) => *key,
+        }
+    }
+}
+
 /// A stroke in progress.
 pub(super) struct Stroke {
     /// Where the last dab was applied, on screen and on the hair.
@@ -102,19 +118,80 @@ impl Viewport {
         }
     }
 
-    /// The body's distance field for the document's body (built once per body, on the first
-    /// stroke: about 0.4 s for the head scan).
-    fn body_field(&mut self, state: &EditorState) -> Arc<BodySdf> {
+    /// Starts building the distance field of the document's body on a worker thread, unless
+    /// it is built or building already.
+    fn prepare_body_field(&mut self, state: &EditorState) {
         let document = state.document();
         let key = body_fingerprint(&document.body);
-        if let Some((cached, field)) = &self.body_field
-            && *cached == key
-        {
-            return field.clone();
+        if self.body_field.as_ref().is_some_and(|f| f.key() == key) {
+            return;
         }
-        let field = Arc::new(BodySdf::for_hair(&document.body, &document.hair_mesh));
-        self.body_field = Some((key, field.clone()));
-        field
+        let (body, hair) = (document.body.clone(), document.hair_mesh.clone());
+        let build = std::thread::Builder::new()
+            .name("brush body field".into())
+            .spawn(move || BodySdf::for_hair(&body, &hair));
+        self.body_field = Some(match build {
+            Ok(handle) => BodyField::Building(key, handle),
+            // No thread to be had: build it here, as the first stroke once did.
+            Err(_) => BodyField::Ready(
+                key,
+                Arc::new(BodySdf::for_hair(&document.body, &document.hair_mesh)),
+            ),
+        });
+    }
+
+    /// The field once it is built, without waiting (the hover circle).
+    fn ready_body_field(&mut self) -> Option<Arc<BodySdf>> {
+        if let Some(BodyField::Building(_, handle)) = &self.body_field
+            && !handle.is_finished()
+        {
+            return None;
+        }
+        self.take_built_field()
+    }
+
+    /// The field for the document's body, waiting for a build in flight (a stroke begun
+    /// right after choosing Groom).
+    fn body_field(&mut self, state: &EditorState) -> Arc<BodySdf> {
+        self.prepare_body_field(state);
+        match self.take_built_field() {
+            Some(field) => field,
+            None => {
+                // The worker panicked (it never has): build it here instead.
+                let document = state.document();
+                let field = Arc::new(BodySdf::for_hair(&document.body, &document.hair_mesh));
+                self.body_field = Some(BodyField::Ready(
+                    body_fingerprint(&document.body),
+                    field.clone(),
+                ));
+                field
+            }
+        }
+    }
+
+    /// Joins a finished (or, waiting, an unfinished) build and keeps its field.
+    fn take_built_field(&mut self) -> Option<Arc<BodySdf>> {
+        match self.body_field.take()? {
+            BodyField::Ready(key, field) => {
+                self.body_field = Some(BodyField::Ready(key, field.clone()));
+                Some(field)
+            }
+            BodyField::Building(key, handle) => {
+                let field = Arc::new(handle.join().ok()?);
+                self.body_field = Some(BodyField::Ready(key, field.clone()));
+                Some(field)
+            }
+        }
+    }
+
+    /// Whether the brushes' body field is built ("ready"), building, or not asked for
+    /// ("none"): tests check that choosing Groom starts it.
+    pub fn brush_field_status(&self) -> &'static str {
+        match &self.body_field {
+            None => "none",
+            Some(BodyField::Building(_, handle)) if !handle.is_finished() => "building",
+            Some(_) => "ready",
+        }
     }
 
     /// Ends the stroke, keeping what it did as one undo step.
@@ -167,12 +244,14 @@ impl Viewport {
             );
         }
         let brush = state.tool.brush;
-        // The stroke's field, or before a stroke the last one built (the hover circle).
-        let field = self
-            .stroke
-            .as_ref()
-            .map(|s| s.field.clone())
-            .or_else(|| self.body_field.as_ref().map(|(_, field)| field.clone()));
+        if self.stroke.is_none() {
+            self.prepare_body_field(state);
+        }
+        // The stroke's field, or before a stroke the one built (the hover circle).
+        let field = match &self.stroke {
+            Some(stroke) => Some(stroke.field.clone()),
+            None => self.ready_body_field(),
+        };
         let pointer = response.interact_pointer_pos().or(response.hover_pos());
         let fallback = self.stroke.as_ref().map(|s| s.last_centre);
         let under = pointer.and_then(|p| {

@@ -244,9 +244,9 @@ pub struct Viewport {
     stroke: Option<groom_brush::Stroke>,
     /// The grooming brush under the pointer, as drawn last (tests aim with it).
     pub brush_cursor: Option<BrushCursor>,
-    /// The body's distance field the brushes keep hair out of, for the body it was built
-    /// for (a fingerprint of its mesh).
-    body_field: Option<(u64, Arc<hairloom_core::simulate::BodySdf>)>,
+    /// The body's distance field the brushes keep hair out of, built (or building, off the
+    /// UI thread, from the moment Groom is chosen) for the body it belongs to.
+    body_field: Option<groom_brush::BodyField>,
     /// Styling frames per layer and column for the document revision they were computed at.
     frames: Option<(
         u64,
