@@ -60,6 +60,11 @@ fn groom_seeds() -> Vec<(String, Vec<u8>)> {
             groom_input("abc", &abc(AlembicTarget::Unreal)),
         ),
         ("grid.usda".into(), groom_input("usda", usda.as_bytes())),
+        // Curves under nested transforms, written by the Alembic C++ library.
+        (
+            "xform_groom.abc".into(),
+            groom_input("abc", include_bytes!("../../assets/grooms/xform_groom.abc")),
+        ),
     ];
     // cyHair: a header that claims 2³¹ strands of 2¹⁶ points over an empty body.
     let mut claims = hair[..128.min(hair.len())].to_vec();

@@ -155,10 +155,12 @@ impl DataChunk {
         }
 
         const DATA_OFFSET: u64 = 16;
+        // Hairloom patch: an empty sample (size 0, allowed above) took 16 from its size and
+        // wrapped to an element count near 2^64; every count below saturates instead.
 
         match data_type.pod_type {
             PodType::String => {
-                let char_count = (self.size - 16) as usize;
+                let char_count = self.size.saturating_sub(16) as usize;
                 let mut char_buffer = vec![0u8; char_count];
                 self.read(16, reader, &mut char_buffer)?;
 
@@ -176,65 +178,74 @@ impl DataChunk {
                 Ok(PodArray::String(strings))
             }
             PodType::WString => todo!(),
-            PodType::Boolean => todo!(),
+            // Hairloom patch: booleans (an Xform's `.inherits`) were `todo!()`; the Alembic
+            // library stores one byte each.
+            PodType::Boolean => {
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize;
+                let mut buffer = vec![0u8; element_count];
+                reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
+                reader.read_exact(&mut buffer)?;
+                Ok(PodArray::Boolean(buffer.into_iter().map(|b| b != 0).collect()))
+            }
             PodType::U8 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<u8>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<u8>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_exact(&mut buffer)?;
                 Ok(PodArray::U8(buffer))
             }
             PodType::I8 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<i8>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<i8>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_i8_into(&mut buffer)?;
                 Ok(PodArray::I8(buffer))
             }
             PodType::U16 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<u16>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<u16>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_u16_into::<LittleEndian>(&mut buffer)?;
                 Ok(PodArray::U16(buffer))
             }
             PodType::I16 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<i16>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<i16>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_i16_into::<LittleEndian>(&mut buffer)?;
                 Ok(PodArray::I16(buffer))
             }
             PodType::U32 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<u32>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<u32>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_u32_into::<LittleEndian>(&mut buffer)?;
                 Ok(PodArray::U32(buffer))
             }
             PodType::I32 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<i32>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<i32>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_i32_into::<LittleEndian>(&mut buffer)?;
                 Ok(PodArray::I32(buffer))
             }
             PodType::U64 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<u64>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<u64>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_u64_into::<LittleEndian>(&mut buffer)?;
                 Ok(PodArray::U64(buffer))
             }
             PodType::I64 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<i64>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<i64>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_i64_into::<LittleEndian>(&mut buffer)?;
                 Ok(PodArray::I64(buffer))
             }
             PodType::F16 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<f32>();
+                // Hairloom patch: counted halves as 4 bytes each, reading half of them.
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<u16>();
                 let mut buffer = vec![0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_u16_into::<LittleEndian>(&mut buffer)?;
@@ -245,14 +256,14 @@ impl DataChunk {
                 Ok(PodArray::F16(buffer))
             }
             PodType::F32 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<f32>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<f32>();
                 let mut buffer = vec![0.0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_f32_into::<LittleEndian>(&mut buffer)?;
                 Ok(PodArray::F32(buffer))
             }
             PodType::F64 => {
-                let element_count = (self.size - DATA_OFFSET) as usize / std::mem::size_of::<f64>();
+                let element_count = self.size.saturating_sub(DATA_OFFSET) as usize / std::mem::size_of::<f64>();
                 let mut buffer = vec![0.0; element_count];
                 reader.seek(SeekFrom::Start(self.position + DATA_OFFSET + 8))?;
                 reader.read_f64_into::<LittleEndian>(&mut buffer)?;

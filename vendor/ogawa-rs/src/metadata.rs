@@ -71,7 +71,11 @@ pub(crate) fn read_indexed_meta_data(
 
         let meta_data_size = buffer.read_u8()?;
 
-        let meta_data = if buffer.position() + meta_data_size as u64 == data.size {
+        // Hairloom patch: the Alembic library (`ReadIndexedMetaData`) keeps an empty entry
+        // only when the size byte is the buffer's last byte; this compared where the entry
+        // *ends* instead, so the table's last entry (often an Xform's schema) was read as
+        // empty metadata and its object lost its schema.
+        let meta_data = if buffer.position() == data.size {
             buffer.seek(SeekFrom::Current(meta_data_size as i64))?;
             MetaData {
                 tokens: BTreeMap::new(),

@@ -9,13 +9,17 @@
 //! Ogawa tree and refuses any blob or group that does not fit inside the file; a panic left
 //! in the crate becomes a named error ([`without_panics`]).
 //!
-//! Not read: transforms (`ogawa-rs` 0.4 reads no `IXform` samples). A non-identity
-//! transform above a curves object is reported in the groom's notes.
+//! Transforms: every `IXform` above a curves object applies, as the Alembic library composes
+//! them (`.ops` and `.vals` read here, since `ogawa-rs` 0.4 reads no `IXform` samples; see
+//! [`xform_matrix`]): scale, translate, axis-angle and axis rotations and matrices in stack
+//! order, each transform on its parent's unless `.inherits` says not. Widths scale with the
+//! transform's mean scale. The first sample of an animated transform is read.
 
 use std::io::{Cursor, Read, Seek, SeekFrom};
 use std::ops::ControlFlow;
 use std::path::Path;
 
+use glam::{DMat4, DVec3};
 use ogawa_rs::{Archive, ArchiveReader, ObjectReader, PodArray, PropertyReader, Schema};
 
 use super::{GroomBuilder, GroomLimits, GroomReadError, InputGroom, without_panics};
@@ -70,16 +74,16 @@ pub fn parse(
             archive: &archive,
             builder: &mut builder,
             guides_skipped: 0,
-            transforms_ignored: 0,
+            transforms_applied: 0,
         };
-        walk.object(&root, 0, false)?;
-        let (guides, transforms) = (walk.guides_skipped, walk.transforms_ignored);
+        walk.object(&root, 0, DMat4::IDENTITY)?;
+        let (guides, transforms) = (walk.guides_skipped, walk.transforms_applied);
         if guides > 0 {
             builder.note(format!("{guides} guide curves skipped"));
         }
         if transforms > 0 {
             builder.note(format!(
-                "{transforms} non-identity transforms above curves were not applied (ogawa-rs reads no transform samples): apply transforms before exporting"
+                "{transforms} curves objects placed by the transforms above them"
             ));
         }
         builder.note("Alembic (Ogawa)");
@@ -200,7 +204,8 @@ struct Walk<'a, 'b> {
     archive: &'a Archive,
     builder: &'a mut GroomBuilder<'b>,
     guides_skipped: usize,
-    transforms_ignored: usize,
+    /// Curves objects with a non-identity world transform.
+    transforms_applied: usize,
 }
 
 impl Walk<'_, '_> {
@@ -209,11 +214,12 @@ impl Walk<'_, '_> {
             .format_error(format!("{}: {what}: {e:?}", object.header.full_name))
     }
 
+    /// Reads `object` and its children; `world` is the transform its parent places it by.
     fn object(
         &mut self,
         object: &ObjectReader,
         depth: usize,
-        transformed: bool,
+        world: DMat4,
     ) -> Result<(), GroomReadError> {
         if depth > MAX_DEPTH {
             return Err(self
@@ -221,20 +227,17 @@ impl Walk<'_, '_> {
                 .format_error(format!("objects nest deeper than {MAX_DEPTH}")));
         }
         let schema = object.header.meta_data.tokens.get("schema").cloned();
-        let mut transformed = transformed;
+        let mut world = world;
         match schema.as_deref() {
             Some("AbcGeom_Curve_v2") => {
-                if transformed {
-                    self.transforms_ignored += 1;
+                if world != DMat4::IDENTITY {
+                    self.transforms_applied += 1;
                 }
-                self.curves(object)?;
+                self.curves(object, world)?;
             }
             Some("AbcGeom_Xform_v3") => {
-                if let Ok(Schema::Xform(xform)) = Schema::parse(object, self.reader, self.archive)
-                    && !xform.is_constant_identity()
-                {
-                    transformed = true;
-                }
+                let (local, inherits) = self.xform(object)?;
+                world = if inherits { world * local } else { local };
             }
             _ => {}
         }
@@ -247,9 +250,59 @@ impl Walk<'_, '_> {
                     &self.archive.time_samplings,
                 )
                 .map_err(|e| self.error(object, "child", e))?;
-            self.object(&child, depth + 1, transformed)?;
+            self.object(&child, depth + 1, world)?;
         }
         Ok(())
+    }
+
+    /// An `IXform`'s own matrix (first sample) and whether it applies on top of its
+    /// parent's (`.inherits`, true when absent), from its `.xform` compound's `.ops` (one
+    /// byte per operation: type in the high nibble) and `.vals` (every channel of every
+    /// operation, in order; scalar, or an array property when long).
+    fn xform(&mut self, object: &ObjectReader) -> Result<(DMat4, bool), GroomReadError> {
+        let Some(props) = object.properties() else {
+            return Ok((DMat4::IDENTITY, true));
+        };
+        let schema = match props
+            .load_sub_property_by_name(".xform", self.reader, self.archive)
+            .map_err(|e| self.error(object, ".xform", e))?
+        {
+            Some(PropertyReader::Compound(c)) => c,
+            _ => return Ok((DMat4::IDENTITY, true)),
+        };
+        let mut first_sample = |name: &str| -> Result<Option<PodArray>, GroomReadError> {
+            let property = schema
+                .load_sub_property_by_name(name, self.reader, self.archive)
+                .map_err(|e| self.error(object, name, e))?;
+            let sample = match property {
+                Some(PropertyReader::Scalar(p)) if p.sample_count() > 0 => {
+                    p.load_sample(0, self.reader)
+                }
+                Some(PropertyReader::Array(a)) if a.sample_count() > 0 => {
+                    a.load_sample(0, self.reader)
+                }
+                _ => return Ok(None),
+            };
+            sample.map(Some).map_err(|e| self.error(object, name, e))
+        };
+        let ops = match first_sample(".ops")? {
+            Some(PodArray::U8(ops)) => ops,
+            None => Vec::new(),
+            Some(other) => {
+                return Err(self.error(object, ".ops", format!("not bytes: {other:?}")));
+            }
+        };
+        let vals = match first_sample(".vals")? {
+            Some(PodArray::F64(vals)) => vals,
+            None => Vec::new(),
+            Some(_) => return Err(self.error(object, ".vals", "not 64-bit floats")),
+        };
+        let inherits = match first_sample(".inherits")? {
+            Some(PodArray::Boolean(b)) => b.first().copied().unwrap_or(true),
+            _ => true,
+        };
+        let matrix = xform_matrix(&ops, &vals).map_err(|e| self.error(object, ".vals", e))?;
+        Ok((matrix, inherits))
     }
 
     /// The array `name` of the curves' `.arbGeomParams`, first sample.
@@ -278,7 +331,8 @@ impl Walk<'_, '_> {
         }
     }
 
-    fn curves(&mut self, object: &ObjectReader) -> Result<(), GroomReadError> {
+    /// The curves of `object`, placed by `world`.
+    fn curves(&mut self, object: &ObjectReader, world: DMat4) -> Result<(), GroomReadError> {
         let Schema::Curves(curves) = Schema::parse(object, self.reader, self.archive)
             .map_err(|e| self.error(object, "curves", e))?
         else {
@@ -290,6 +344,22 @@ impl Walk<'_, '_> {
         let points = curves
             .load_positions_sample(0, self.reader)
             .map_err(|e| self.error(object, "P", e))?;
+        // Points in the groom's space; widths by the transform's mean scale.
+        let width_scale = world.determinant().abs().cbrt() as f32;
+        let points: Vec<[f32; 3]> = if world == DMat4::IDENTITY {
+            points
+        } else {
+            points
+                .iter()
+                .map(|p| {
+                    // Projective, as Imath's `V3d * M44d` (a well-formed transform is affine).
+                    world
+                        .project_point3(glam::Vec3::from_array(*p).as_dvec3())
+                        .as_vec3()
+                        .to_array()
+                })
+                .collect()
+        };
         let total: i64 = counts.iter().map(|&c| i64::from(c.max(0))).sum();
         if counts.iter().any(|&c| c < 0) || total != points.len() as i64 {
             return Err(self.builder.format_error(format!(
@@ -348,6 +418,11 @@ impl Walk<'_, '_> {
                 }
                 _ => false,
             };
+            if width_scale != 1.0 {
+                for w in &mut curve_widths {
+                    *w *= width_scale;
+                }
+            }
             self.builder.push(
                 points[span].iter().copied(),
                 have_widths.then_some(curve_widths.as_slice()),
@@ -357,4 +432,51 @@ impl Walk<'_, '_> {
         }
         Ok(())
     }
+}
+
+/// An `IXform` sample's matrix from its operation codes and channel values, as the Alembic
+/// library's `XformSample::getMatrix` builds it: each operation (scale 0, translate 1,
+/// rotate about an axis by degrees 2, matrix 3, rotate about x / y / z 4–6; high nibble of
+/// its code) is applied before the ones listed ahead of it — in Imath's row-vector terms
+/// `M = m_n … m_1`, here with column vectors `M = m_1 … m_n`. Channels the values run short
+/// of are 0, as the library leaves them; an unknown operation has no channels and no effect,
+/// as in the library; a rotation about a zero axis is none. Non-finite values are refused.
+pub fn xform_matrix(ops: &[u8], vals: &[f64]) -> Result<DMat4, String> {
+    if let Some(bad) = vals.iter().find(|v| !v.is_finite()) {
+        return Err(format!("a transform value is not finite ({bad})"));
+    }
+    let mut at = 0usize;
+    let mut take = |count: usize| -> Vec<f64> {
+        let channels = (0..count)
+            .map(|k| vals.get(at + k).copied().unwrap_or(0.0))
+            .collect();
+        at += count;
+        channels
+    };
+    let rotation = |axis: DVec3, degrees: f64| match axis.try_normalize() {
+        Some(axis) => DMat4::from_axis_angle(axis, degrees.to_radians()),
+        None => DMat4::IDENTITY,
+    };
+    let mut matrix = DMat4::IDENTITY;
+    for &op in ops {
+        let local = match op >> 4 {
+            0 => DMat4::from_scale(DVec3::from_slice(&take(3))),
+            1 => DMat4::from_translation(DVec3::from_slice(&take(3))),
+            2 => {
+                let c = take(4);
+                rotation(DVec3::new(c[0], c[1], c[2]), c[3])
+            }
+            // Imath's row-major rows are glam's columns: the same 16 values in order.
+            3 => DMat4::from_cols_slice(&take(16)),
+            4 => rotation(DVec3::X, take(1)[0]),
+            5 => rotation(DVec3::Y, take(1)[0]),
+            6 => rotation(DVec3::Z, take(1)[0]),
+            _ => DMat4::IDENTITY,
+        };
+        matrix *= local;
+    }
+    if !matrix.is_finite() {
+        return Err("the transform is not finite".into());
+    }
+    Ok(matrix)
 }

@@ -577,3 +577,80 @@ fn usdc_counts_that_claim_more_than_the_file_holds_are_errors() {
         "{errors} of the patched crates were refused"
     );
 }
+
+/// Curves under nested transforms, written by the Alembic C++ library
+/// (`tools/make_xform_groom.py`: a Maya-style translate / axis-angle rotate / scale stack
+/// over a matrix and x-rotation, and a sibling that does not inherit), land where the
+/// library itself places them (its world points, in `xform_groom.json`).
+#[test]
+fn alembic_transforms_place_curves_as_the_alembic_library_does() {
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/grooms");
+    let groom = read_groom(
+        &assets.join("xform_groom.abc"),
+        GroomLimits::default(),
+        &mut no_progress(),
+    )
+    .expect("reads");
+    let expected: std::collections::BTreeMap<String, Vec<[f64; 3]>> = serde_json::from_slice(
+        &std::fs::read(assets.join("xform_groom.json")).expect("expected points"),
+    )
+    .expect("json");
+    // Objects are read in file order: the tilted hair, then the detached strays.
+    let wanted: Vec<[f64; 3]> = ["/groom_xform/tilted/hair", "/groom_xform/detached/strays"]
+        .iter()
+        .flat_map(|name| expected[*name].clone())
+        .collect();
+    assert_eq!(groom.points.len(), wanted.len());
+    for (i, (got, want)) in groom.points.iter().zip(&wanted).enumerate() {
+        let d = glam::Vec3::from_array(*got).as_dvec3() - glam::DVec3::from_array(*want);
+        assert!(d.length() < 1e-6, "point {i}: {got:?} vs {want:?}");
+    }
+    assert!(
+        groom
+            .notes
+            .iter()
+            .any(|n| n.contains("2 curves objects placed")),
+        "{:?}",
+        groom.notes
+    );
+}
+
+#[test]
+fn transform_operations_compose_in_stack_order_and_refuse_non_finite_values() {
+    use super::alembic::xform_matrix;
+    let p = glam::DVec3::new(1.0, 0.0, 0.0);
+    // Translate, then rotate 90° about z, then scale 2 (Maya's order in the stack): the
+    // point is scaled first, then rotated, then moved.
+    let m =
+        xform_matrix(&[0x10, 0x60, 0x00], &[0.0, 0.0, 5.0, 90.0, 2.0, 2.0, 2.0]).expect("finite");
+    assert!((m.transform_point3(p) - glam::DVec3::new(0.0, 2.0, 5.0)).length() < 1e-12);
+    // A matrix op is Imath's rows, in order: the translation is the last row.
+    let mut rows = [0.0; 16];
+    for k in 0..4 {
+        rows[5 * k] = 1.0;
+    }
+    rows[12..15].copy_from_slice(&[1.0, 2.0, 3.0]);
+    let m = xform_matrix(&[0x30], &rows).expect("finite");
+    assert_eq!(
+        m.transform_point3(glam::DVec3::ZERO),
+        glam::DVec3::new(1.0, 2.0, 3.0)
+    );
+    // Short values leave channels at 0 (a zero scale), unknown ops do nothing, a zero axis
+    // is no rotation, and nothing is identity.
+    assert_eq!(xform_matrix(&[], &[]), Ok(glam::DMat4::IDENTITY));
+    assert_eq!(xform_matrix(&[0xF0], &[1.0]), Ok(glam::DMat4::IDENTITY));
+    assert_eq!(
+        xform_matrix(&[0x20], &[0.0, 0.0, 0.0, 45.0]),
+        Ok(glam::DMat4::IDENTITY)
+    );
+    let flat = xform_matrix(&[0x00], &[2.0]).expect("finite");
+    assert_eq!(
+        flat.transform_point3(glam::DVec3::ONE),
+        glam::DVec3::new(2.0, 0.0, 0.0)
+    );
+    let error = xform_matrix(&[0x10], &[f64::NAN, 0.0, 0.0]).expect_err("NaN");
+    assert!(error.contains("not finite"), "{error}");
+    let error = xform_matrix(&[0x00, 0x00], &[1e300, 1e300, 1e300, 1e300, 1e300, 1e300])
+        .expect_err("overflow");
+    assert!(error.contains("not finite"), "{error}");
+}
