@@ -682,12 +682,22 @@ fn importing_a_body_asks_where_hair_grows_and_the_rest_stays_body() {
     harness.run();
     assert_eq!(harness.state().state.document(), &original, "one undo step");
 
-    // Cancel imports nothing.
+    // Cancel imports nothing, and neither does Escape.
     file_menu(&mut harness, "Import scalp…");
     harness.run();
     harness.get_by_label("Cancel").click();
     harness.run();
     assert!(harness.state().scalp_import.is_none());
+    assert_eq!(harness.state().state.document(), &original);
+    harness.state_mut().dialogs = Box::new(ScriptedDialogs::new([DialogAnswer::Chosen(
+        dir.path().join("body.glb"),
+    )]));
+    file_menu(&mut harness, "Import scalp…");
+    harness.run();
+    assert!(harness.state().scalp_import.is_some());
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    assert!(harness.state().scalp_import.is_none(), "Escape closes it");
     assert_eq!(harness.state().state.document(), &original);
 }
 
@@ -712,8 +722,25 @@ fn delete_and_keep_only_selected_cut_the_scalp_as_undo_steps() {
     let steps = harness.state().state.project.history.undo.len();
     assert_eq!(harness.state().state.document().hair_mesh.bundles.len(), 3);
 
+    // A copied wisp shape follows its bundle's new number.
     click_bundle_in_outliner(&mut harness, 2);
+    harness.get_by_label("Copy shape").scroll_to_me();
+    harness.run();
+    harness.get_by_label("Copy shape").click();
+    harness.run();
+    assert_eq!(
+        harness.state().tools.copied_shape,
+        Some(2),
+        "{}",
+        harness.state().state.message
+    );
+    click_bundle_in_outliner(&mut harness, 1);
     edit_menu(&mut harness, "Delete selected bundles");
+    assert_eq!(
+        harness.state().tools.copied_shape,
+        Some(1),
+        "bundle 2 is now 1"
+    );
     let state = &harness.state().state;
     assert_eq!(
         state.document().hair_mesh.bundles.len(),
@@ -730,6 +757,11 @@ fn delete_and_keep_only_selected_cut_the_scalp_as_undo_steps() {
 
     click_bundle_in_outliner(&mut harness, 0);
     edit_menu(&mut harness, "Keep only selected bundles");
+    assert_eq!(
+        harness.state().tools.copied_shape,
+        None,
+        "its bundle is gone"
+    );
     let state = &harness.state().state;
     assert_eq!(
         state.document().hair_mesh.bundles.len(),
@@ -2347,9 +2379,6 @@ fn the_tools_and_history_panes_show_their_controls_at_the_default_size() {
     );
 }
 
-/// Issue 35: with Drag ▸ Groom, a stroke of the comb over the hair moves it (both sides of
-/// the head with X-mirror), as one undo step that undo takes back exactly; the length
-/// brush makes the hair under it longer.
 /// Issue 35: the brushes' body distance field (about 0.4 s for the head scan) is built off
 /// the UI thread from the moment Groom is chosen, not on the first stroke, where it froze
 /// the pointer.
@@ -2370,6 +2399,9 @@ fn choosing_groom_builds_the_body_field_before_the_first_stroke() {
     {
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
+    // The next frame takes the worker's field ("ready here" would mean the UI thread built
+    // it).
+    harness.run();
     assert_eq!(harness.state().viewport.brush_field_status(), "ready");
     assert_eq!(
         harness.state().state.project.history.undo.len(),
@@ -2378,6 +2410,9 @@ fn choosing_groom_builds_the_body_field_before_the_first_stroke() {
     );
 }
 
+/// Issue 35: with Drag ▸ Groom, a stroke of the comb over the hair moves it (both sides of
+/// the head with X-mirror), as one undo step that undo takes back exactly; the length
+/// brush makes the hair under it longer.
 #[test]
 fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
     let mut harness = harness();

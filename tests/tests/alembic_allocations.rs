@@ -87,9 +87,9 @@ fn name_sizes_that_claim_gigabytes_are_errors_not_allocations() {
     };
     let (valid, valid_largest) = read(&bytes);
     valid.expect("our own groom reads");
-    // An object's name ("P" is a property name; the curves object is the one child of
-    // the top object) and a property's name, each claiming 4 GiB.
-    let names = [".geom", "P"];
+    // An object's name ("guides", a child of the top object) and two property names (the
+    // curves schema's compound and its points), each claiming 4 GiB.
+    let names = ["guides", ".geom", "P"];
     for name in names {
         let at = *prefixed(&bytes, name)
             .first()

@@ -503,8 +503,8 @@ fn a_scalp_region_is_cut_by_material_or_painted_mask_and_the_body_stays_whole() 
         &ImportOptions::default(),
     )
     .expect("valid file");
-    // Three quads; the strip's two Scalp quads are not paired with the Skin one even where
-    // the shapes would allow it.
+    // Three quads, each one primitive's (that triangles of two primitives never pair is
+    // `pair_quads`' own unit test).
     assert_eq!(mesh.quad_count(), 3, "{:?}", mesh.faces);
     assert_eq!(
         material_faces(&mesh),

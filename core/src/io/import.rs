@@ -295,7 +295,8 @@ pub fn import_slice(
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut corner_uvs: Vec<[DVec2; 3]> = Vec::new();
     let mut triangle_primitives: Vec<u32> = Vec::new();
-    let mut triangle_colours: Vec<[f64; 4]> = Vec::new();
+    // Each triangle's corner colours (white without COLOR_0, as glTF specifies).
+    let mut triangle_colours: Vec<[[f64; 4]; 3]> = Vec::new();
     let mut has_colour = false;
     let mut primitive_materials = Vec::with_capacity(mesh.primitives.len());
     let mut has_uv = false;
@@ -466,20 +467,16 @@ pub fn import_slice(
                 Some(uvs) => DVec2::new(uvs[2 * i as usize], uvs[2 * i as usize + 1]),
                 None => DVec2::ZERO,
             });
-            let colour = match &colours {
+            let colour = t.map(|i| match &colours {
                 Some((colours, components)) => {
-                    let mut mean = [0.0, 0.0, 0.0, 1.0];
-                    for c in 0..*components {
-                        mean[c] = t
-                            .iter()
-                            .map(|&i| colours[components * i as usize + c])
-                            .sum::<f64>()
-                            / 3.0;
+                    let mut rgba = [0.0, 0.0, 0.0, 1.0];
+                    for (c, value) in rgba.iter_mut().enumerate().take(*components) {
+                        *value = colours[components * i as usize + c];
                     }
-                    mean
+                    rgba
                 }
                 None => [1.0; 4],
-            };
+            });
             triangles.push(t.map(|i| i + base));
             corner_uvs.push(uv);
             triangle_primitives.push(p_index as u32);
@@ -495,7 +492,7 @@ pub fn import_slice(
         .iter()
         .map(|&(t, _)| triangle_primitives[t])
         .collect();
-    let triangle_colours: Vec<[f64; 4]> =
+    let triangle_colours: Vec<[[f64; 4]; 3]> =
         welded.iter().map(|&(t, _)| triangle_colours[t]).collect();
     let triangles: Vec<[u32; 3]> = welded.into_iter().map(|(_, t)| t).collect();
     if triangles.is_empty() {
@@ -523,14 +520,24 @@ pub fn import_slice(
         .iter()
         .map(|ts| triangle_primitives[ts[0]])
         .collect();
+    // A face's colour is the mean over its distinct corners (a quad's diagonal corners
+    // count once, whichever diagonal the exporter split it along).
     let face_colours = has_colour.then(|| {
         face_triangles
             .iter()
             .map(|ts| {
-                let mut mean = [0.0; 4];
+                let mut corners: Vec<(u32, [f64; 4])> = Vec::with_capacity(4);
                 for &t in ts {
-                    for (m, c) in mean.iter_mut().zip(triangle_colours[t]) {
-                        *m += c / ts.len() as f64;
+                    for (&vertex, colour) in triangles[t].iter().zip(triangle_colours[t]) {
+                        if !corners.iter().any(|(v, _)| *v == vertex) {
+                            corners.push((vertex, colour));
+                        }
+                    }
+                }
+                let mut mean = [0.0; 4];
+                for (_, colour) in &corners {
+                    for (m, c) in mean.iter_mut().zip(colour) {
+                        *m += c / corners.len() as f64;
                     }
                 }
                 mean

@@ -392,7 +392,7 @@ impl HairloomApp {
             && !self.state.selection.is_empty()
             && ui.input_mut(|i| i.consume_shortcut(&DELETE))
         {
-            self.state.delete_bundles(false);
+            self.delete_bundles(false);
         }
         if !typing && ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::E)) {
             // Over the viewport E is interactive (the pointer sets the distance, a click
@@ -403,6 +403,17 @@ impl HairloomApp {
             } else {
                 self.tools.extrude(&mut self.state);
             }
+        }
+    }
+
+    /// Edit ▸ Delete selected bundles / Keep only selected bundles; the copied wisp shape
+    /// follows its bundle's new number (or is dropped with it).
+    fn delete_bundles(&mut self, keep_selected: bool) {
+        if let Some(renumbering) = self.state.delete_bundles(keep_selected) {
+            self.tools.copied_shape = self
+                .tools
+                .copied_shape
+                .and_then(|b| renumbering.get(b as usize).copied().flatten());
         }
     }
 
@@ -787,7 +798,8 @@ impl HairloomApp {
                 }
                 ui.separator();
                 // Cutting the scalp out of an imported body: select it, keep it.
-                let any = !self.state.selection.is_empty();
+                let any = !self.state.selection.is_empty()
+                    && self.state.tool.mode == state::SelectMode::Bundles;
                 if ui
                     .add_enabled(
                         any,
@@ -799,7 +811,7 @@ impl HairloomApp {
                     )
                     .clicked()
                 {
-                    self.state.delete_bundles(false);
+                    self.delete_bundles(false);
                     ui.close();
                 }
                 if ui
@@ -809,7 +821,7 @@ impl HairloomApp {
                     )
                     .clicked()
                 {
-                    self.state.delete_bundles(true);
+                    self.delete_bundles(true);
                     ui.close();
                 }
             });

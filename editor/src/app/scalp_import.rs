@@ -29,6 +29,9 @@ pub struct ScalpImport {
     channel: ColourChannel,
     above: bool,
     threshold: f64,
+    /// The region last counted and its count (or why it is no region): counted again only
+    /// when the choice changes, not every frame.
+    counted: Option<(ScalpRegion, Result<usize, String>)>,
 }
 
 /// What the modal asks of the app.
@@ -49,9 +52,14 @@ fn looks_like_scalp(name: &str) -> bool {
 }
 
 impl ScalpImport {
-    /// Whether the file offers a choice (several materials, or vertex colours).
+    /// Whether the file offers a choice: several materials, one material on only some of
+    /// the faces, or vertex colours.
     pub fn offers_choice(mesh: &ImportedMesh) -> bool {
-        material_faces(mesh).len() > 1 || mesh.face_colours.is_some()
+        let materials = material_faces(mesh);
+        let with_material: usize = materials.iter().map(|(_, faces)| faces).sum();
+        materials.len() > 1
+            || (materials.len() == 1 && with_material < mesh.faces.len())
+            || mesh.face_colours.is_some()
     }
 
     pub fn new(path: PathBuf, mesh: ImportedMesh) -> Self {
@@ -75,6 +83,7 @@ impl ScalpImport {
             channel: ColourChannel::Red,
             above: true,
             threshold: 0.5,
+            counted: None,
         }
     }
 
@@ -100,7 +109,7 @@ impl ScalpImport {
     pub fn ui(&mut self, ui: &mut egui::Ui) -> ScalpImportAction {
         let mut action = ScalpImportAction::Waiting;
         let total = self.mesh.faces.len();
-        egui::Modal::new(egui::Id::unique("hairloom import scalp")).show(ui.ctx(), |ui| {
+        let modal = egui::Modal::new(egui::Id::unique("hairloom import scalp")).show(ui.ctx(), |ui| {
             ui.heading("Import scalp");
             ui.label(self.path.display().to_string());
             ui.label(format!(
@@ -120,9 +129,17 @@ impl ScalpImport {
                 );
                 ui.add_enabled_ui(self.choice == Choice::Materials, |ui| {
                     ui.indent("materials", |ui| {
-                        for (name, faces, chosen) in &mut self.materials {
-                            ui.checkbox(chosen, format!("{name} ({})", face_count(*faces)));
-                        }
+                        // A body may have hundreds of materials: the buttons stay in view.
+                        egui::ScrollArea::vertical()
+                            .max_height(240.0)
+                            .show(ui, |ui| {
+                                for (name, faces, chosen) in &mut self.materials {
+                                    ui.checkbox(
+                                        chosen,
+                                        format!("{name} ({})", face_count(*faces)),
+                                    );
+                                }
+                            });
                     });
                 });
             }
@@ -159,19 +176,24 @@ impl ScalpImport {
                     });
                 });
             }
-            let counted = self.region().faces(&self.mesh);
-            let ready = match &counted {
-                Ok(keep) => {
-                    ui.label(format!(
-                        "{} of {total} faces become bundles",
-                        keep.iter().filter(|k| **k).count()
-                    ));
+            let region = self.region();
+            if self.counted.as_ref().is_none_or(|(r, _)| *r != region) {
+                let count = region
+                    .faces(&self.mesh)
+                    .map(|keep| keep.iter().filter(|k| **k).count())
+                    .map_err(|e| e.to_string());
+                self.counted = Some((region, count));
+            }
+            let ready = match self.counted.as_ref().map(|(_, count)| count) {
+                Some(Ok(count)) => {
+                    ui.label(format!("{count} of {total} faces become bundles"));
                     true
                 }
-                Err(error) => {
-                    ui.colored_label(ui.visuals().warn_fg_color, error.to_string());
+                Some(Err(error)) => {
+                    ui.colored_label(ui.visuals().warn_fg_color, error);
                     false
                 }
+                None => false,
             };
             ui.label(
                 "Or import every face, box-select the scalp and use Edit > Keep only selected bundles.",
@@ -185,6 +207,10 @@ impl ScalpImport {
                 }
             });
         });
+        // Escape (or a click outside) closes it, as the other dialogs do.
+        if modal.should_close() && matches!(action, ScalpImportAction::Waiting) {
+            action = ScalpImportAction::Closed;
+        }
         action
     }
 }
@@ -195,5 +221,52 @@ fn channel_name(channel: ColourChannel) -> &'static str {
         ColourChannel::Green => "green",
         ColourChannel::Blue => "blue",
         ColourChannel::Alpha => "alpha",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hairloom_core::io::import::{ImportOptions, import_slice};
+
+    #[test]
+    fn a_file_offers_a_choice_when_its_faces_differ() {
+        let mut mesh = import_slice(
+            &hairloom_tests::body_with_materials_glb(),
+            None,
+            "body.glb",
+            &ImportOptions::default(),
+        )
+        .expect("valid");
+        assert!(
+            ScalpImport::offers_choice(&mesh),
+            "two materials and colours"
+        );
+        mesh.face_colours = None;
+        assert!(ScalpImport::offers_choice(&mesh), "two materials");
+        // A "Scalp" material on some faces, none on the rest: still a choice.
+        mesh.primitive_materials[1] = None;
+        assert!(
+            ScalpImport::offers_choice(&mesh),
+            "one material on some faces"
+        );
+        // One material on every face, or none at all: nothing to choose.
+        mesh.primitive_materials[1] = mesh.primitive_materials[0].clone();
+        assert!(!ScalpImport::offers_choice(&mesh));
+        mesh.primitive_materials = vec![None, None];
+        assert!(!ScalpImport::offers_choice(&mesh));
+        // The scalp material is chosen by default.
+        let mesh = import_slice(
+            &hairloom_tests::body_with_materials_glb(),
+            None,
+            "body.glb",
+            &ImportOptions::default(),
+        )
+        .expect("valid");
+        let import = ScalpImport::new("body.glb".into(), mesh);
+        assert_eq!(
+            import.region(),
+            ScalpRegion::Materials(vec!["Scalp".into()])
+        );
     }
 }

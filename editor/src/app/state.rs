@@ -459,8 +459,10 @@ impl EditorState {
     /// Deletes the selected bundles for good (`keep_selected`: every other one — a scalp cut
     /// from an imported body by selecting it), as one undo step. Their root faces stay in
     /// the body; styling groups follow the renumbering. The survivors stay selected after
-    /// a keep; a delete clears the selection.
-    pub fn delete_bundles(&mut self, keep_selected: bool) -> bool {
+    /// a keep; a delete clears the selection. Returns the renumbering (each old bundle's new
+    /// index, `None` when deleted) for what else holds bundle indices, or `None` when
+    /// nothing was deleted.
+    pub fn delete_bundles(&mut self, keep_selected: bool) -> Option<Vec<Option<u32>>> {
         let label = if keep_selected {
             "Keep only selected bundles"
         } else {
@@ -472,7 +474,7 @@ impl EditorState {
         let gone: Vec<u32> = if keep_selected {
             if self.selection.is_empty() {
                 self.message = format!("{label}: {}", EditError::EmptySelection);
-                return false;
+                return None;
             }
             (0..count as u32)
                 .filter(|b| !self.selection.contains(b))
@@ -482,16 +484,15 @@ impl EditorState {
         };
         if keep_selected && gone.is_empty() {
             self.message = format!("{label}: every bundle is selected; nothing to delete");
-            return false;
+            return None;
         }
         match edit::delete_bundles(&self.project.document.hair_mesh, &gone) {
             Ok(outcome) => {
                 let kept = outcome.affected_bundles.len();
                 let document = self.edit(ChangeKind::Rebuild, label);
                 document.hair_mesh = outcome.mesh;
-                document
-                    .styling
-                    .renumber_bundles(&edit::bundle_renumbering(count, &gone));
+                let renumbering = edit::bundle_renumbering(count, &gone);
+                document.styling.renumber_bundles(&renumbering);
                 self.commit_edit();
                 self.vertex_selection.clear();
                 self.selection = if keep_selected {
@@ -503,11 +504,11 @@ impl EditorState {
                     "{label}: {} deleted, {kept} left (their faces stay in the body)",
                     gone.len()
                 );
-                true
+                Some(renumbering)
             }
             Err(error) => {
                 self.message = format!("{label}: {error}");
-                false
+                None
             }
         }
     }

@@ -440,7 +440,8 @@ impl Walk<'_, '_> {
 /// its code) is applied before the ones listed ahead of it — in Imath's row-vector terms
 /// `M = m_n … m_1`, here with column vectors `M = m_1 … m_n`. Channels the values run short
 /// of are 0, as the library leaves them; an unknown operation has no channels and no effect,
-/// as in the library; a rotation about a zero axis is none. Non-finite values are refused.
+/// as in the library; a rotation about a zero axis scales by its cosine, as Imath's does.
+/// Non-finite values are refused.
 pub fn xform_matrix(ops: &[u8], vals: &[f64]) -> Result<DMat4, String> {
     if let Some(bad) = vals.iter().find(|v| !v.is_finite()) {
         return Err(format!("a transform value is not finite ({bad})"));
@@ -453,9 +454,11 @@ pub fn xform_matrix(ops: &[u8], vals: &[f64]) -> Result<DMat4, String> {
         at += count;
         channels
     };
+    // Imath normalises a zero axis to zero, which leaves cos θ on the diagonal: a uniform
+    // scale (a crafted file; kept as the library reads it).
     let rotation = |axis: DVec3, degrees: f64| match axis.try_normalize() {
         Some(axis) => DMat4::from_axis_angle(axis, degrees.to_radians()),
-        None => DMat4::IDENTITY,
+        None => DMat4::from_scale(DVec3::splat(degrees.to_radians().cos())),
     };
     let mut matrix = DMat4::IDENTITY;
     for &op in ops {

@@ -21,17 +21,25 @@ use super::camera::Projector;
 use super::{DragTool, EditorState, Viewport};
 
 /// The body's distance field for one body (a fingerprint of its mesh): building on a worker
-/// thread, or built. It takes about 0.4 s for the head scan, so it starts when the Groom
-/// tool is chosen rather than at the first stroke, where it froze the pointer.
+/// thread, built (and whether on the worker), or failed there. It takes about 0.4 s for the
+/// head scan, so it starts when the Groom tool is chosen rather than at the first stroke,
+/// where it froze the pointer.
 pub(super) enum BodyField {
     Building(u64, std::thread::JoinHandle<BodySdf>),
-    Ready(u64, Arc<BodySdf>),
+    Ready {
+        key: u64,
+        field: Arc<BodySdf>,
+        on_worker: bool,
+    },
+    /// The worker panicked (it never has): not tried again on the worker for this body; a
+    /// stroke builds it on the UI thread.
+    Failed(u64),
 }
 
 impl BodyField {
     fn key(&self) -> u64 {
         match self {
-            Self::Building(key, _) | Self::Ready(key, _) => *key,
+            Self::Building(key, _) | Self::Ready { key, .. } | Self::Failed(key) => *key,
         }
     }
 }
@@ -118,14 +126,29 @@ impl Viewport {
         }
     }
 
+    /// The fingerprint of the document's body, hashed again only when the document changed
+    /// (it is asked for every frame while Groom is the drag tool; a large body hashes tens
+    /// of megabytes).
+    fn body_key(&mut self, state: &EditorState) -> u64 {
+        match self.body_key {
+            Some((revision, key)) if revision == state.revision => key,
+            _ => {
+                let key = body_fingerprint(&state.document().body);
+                self.body_key = Some((state.revision, key));
+                key
+            }
+        }
+    }
+
     /// Starts building the distance field of the document's body on a worker thread, unless
-    /// it is built or building already.
+    /// it is built, building or failed for this body. A build for a body that changed since
+    /// is left to finish on its own (its result is dropped).
     fn prepare_body_field(&mut self, state: &EditorState) {
-        let document = state.document();
-        let key = body_fingerprint(&document.body);
+        let key = self.body_key(state);
         if self.body_field.as_ref().is_some_and(|f| f.key() == key) {
             return;
         }
+        let document = state.document();
         let (body, hair) = (document.body.clone(), document.hair_mesh.clone());
         let build = std::thread::Builder::new()
             .name("brush body field".into())
@@ -133,10 +156,11 @@ impl Viewport {
         self.body_field = Some(match build {
             Ok(handle) => BodyField::Building(key, handle),
             // No thread to be had: build it here, as the first stroke once did.
-            Err(_) => BodyField::Ready(
+            Err(_) => BodyField::Ready {
                 key,
-                Arc::new(BodySdf::for_hair(&document.body, &document.hair_mesh)),
-            ),
+                field: Arc::new(BodySdf::for_hair(&document.body, &document.hair_mesh)),
+                on_worker: false,
+            },
         });
     }
 
@@ -154,43 +178,71 @@ impl Viewport {
     /// right after choosing Groom).
     fn body_field(&mut self, state: &EditorState) -> Arc<BodySdf> {
         self.prepare_body_field(state);
-        match self.take_built_field() {
-            Some(field) => field,
-            None => {
-                // The worker panicked (it never has): build it here instead.
-                let document = state.document();
-                let field = Arc::new(BodySdf::for_hair(&document.body, &document.hair_mesh));
-                self.body_field = Some(BodyField::Ready(
-                    body_fingerprint(&document.body),
-                    field.clone(),
-                ));
-                field
-            }
+        if let Some(field) = self.take_built_field() {
+            return field;
         }
+        // The worker failed: build it here.
+        let document = state.document();
+        let field = Arc::new(BodySdf::for_hair(&document.body, &document.hair_mesh));
+        self.body_field = Some(BodyField::Ready {
+            key: self.body_key(state),
+            field: field.clone(),
+            on_worker: false,
+        });
+        field
     }
 
-    /// Joins a finished (or, waiting, an unfinished) build and keeps its field.
+    /// Joins a finished (or, waiting, an unfinished) build and keeps its field; `None` when
+    /// there is none or the worker failed.
     fn take_built_field(&mut self) -> Option<Arc<BodySdf>> {
         match self.body_field.take()? {
-            BodyField::Ready(key, field) => {
-                self.body_field = Some(BodyField::Ready(key, field.clone()));
+            BodyField::Ready {
+                key,
+                field,
+                on_worker,
+            } => {
+                self.body_field = Some(BodyField::Ready {
+                    key,
+                    field: field.clone(),
+                    on_worker,
+                });
                 Some(field)
             }
-            BodyField::Building(key, handle) => {
-                let field = Arc::new(handle.join().ok()?);
-                self.body_field = Some(BodyField::Ready(key, field.clone()));
-                Some(field)
+            BodyField::Building(key, handle) => match handle.join() {
+                Ok(field) => {
+                    let field = Arc::new(field);
+                    self.body_field = Some(BodyField::Ready {
+                        key,
+                        field: field.clone(),
+                        on_worker: true,
+                    });
+                    Some(field)
+                }
+                Err(_) => {
+                    self.body_field = Some(BodyField::Failed(key));
+                    None
+                }
+            },
+            BodyField::Failed(key) => {
+                self.body_field = Some(BodyField::Failed(key));
+                None
             }
         }
     }
 
-    /// Whether the brushes' body field is built ("ready"), building, or not asked for
-    /// ("none"): tests check that choosing Groom starts it.
+    /// Whether the brushes' body field is built on the worker thread ("ready"), built on
+    /// the UI thread ("ready here"), building, failed, or not asked for ("none"): tests
+    /// check that choosing Groom builds it off the UI thread.
     pub fn brush_field_status(&self) -> &'static str {
         match &self.body_field {
             None => "none",
             Some(BodyField::Building(_, handle)) if !handle.is_finished() => "building",
-            Some(_) => "ready",
+            Some(BodyField::Building(..)) => "built, not yet joined",
+            Some(BodyField::Ready {
+                on_worker: true, ..
+            }) => "ready",
+            Some(BodyField::Ready { .. }) => "ready here",
+            Some(BodyField::Failed(_)) => "failed",
         }
     }
 

@@ -247,6 +247,8 @@ pub struct Viewport {
     /// The body's distance field the brushes keep hair out of, built (or building, off the
     /// UI thread, from the moment Groom is chosen) for the body it belongs to.
     body_field: Option<groom_brush::BodyField>,
+    /// The fingerprint of the document's body at a document revision.
+    body_key: Option<(u64, u64)>,
     /// Styling frames per layer and column for the document revision they were computed at.
     frames: Option<(
         u64,
@@ -349,6 +351,7 @@ impl Viewport {
             stroke: None,
             brush_cursor: None,
             body_field: None,
+            body_key: None,
             frames: None,
         }
     }
