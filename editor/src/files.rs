@@ -15,6 +15,7 @@ use hairloom_core::io::scalp_region::ScalpRegion;
 use hairloom_core::io::strand_files::{
     ScalpMesh, StrandExportSize, StrandLook, glb_lines, hair_file, usda_file,
 };
+use hairloom_core::model::document::BodyMesh;
 use hairloom_core::runtime::hair::{LodEntry, RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::{Filtering, runtime_strands};
 use hairloom_core::runtime::textures::Precision;
@@ -50,14 +51,16 @@ pub fn scalp_document(
         bail!("the scale must be a positive number, got {}", options.scale);
     }
     let imported = import_file(scalp, options)?;
-    scalp_document_from(scalp, &imported, region, generate_uv)
+    let body = imported.to_body();
+    scalp_document_from(scalp, &imported, body, region, generate_uv)
 }
 
 /// [`scalp_document`] from a mesh already read (the editor reads the file once, then asks
-/// where hair grows).
+/// where hair grows), with `body` the body: the mesh's own, or every mesh of the file.
 pub fn scalp_document_from(
     scalp: &Path,
     imported: &ImportedMesh,
+    body: BodyMesh,
     region: &ScalpRegion,
     generate_uv: bool,
 ) -> anyhow::Result<(Document, String)> {
@@ -74,7 +77,7 @@ pub fn scalp_document_from(
         .unwrap_or_else(|| "scalp".into());
     let mut document = Document::new(name, hair_mesh);
     document.source = format!("imported from {}", scalp.display());
-    document.body = imported.to_body();
+    document.body = body;
     // The file's body animation becomes the scene's head animation: the scene then has
     // motion, and the hair is simulated following the body.
     let animation = if imported.body_animation.is_empty() {

@@ -230,6 +230,40 @@ fn import_grows_hair_only_where_hair_on_says() {
     assert!(stderr.contains("colour:r=1"), "{stderr}");
 }
 
+/// Issue 35: `--mesh` names the mesh hair grows on; `--whole-body` makes every mesh the
+/// body.
+#[test]
+fn import_whole_body_takes_every_mesh_as_the_body() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = dir.path().join("character.glb");
+    std::fs::write(&glb, hairloom_tests::two_mesh_glb()).expect("write");
+    let out = dir.path().join("character.hairloom");
+    let (code, _, stderr) = run(hairloom().arg("import").arg(&glb).arg("--out").arg(&out));
+    assert_ne!(code, 0);
+    assert!(
+        stderr.contains("several meshes") && stderr.contains("\"scalp\""),
+        "{stderr}"
+    );
+    for (whole, triangles) in [(false, 2), (true, 4)] {
+        let mut command = hairloom();
+        command
+            .arg("import")
+            .arg(&glb)
+            .args(["--mesh", "scalp", "--out"])
+            .arg(&out);
+        if whole {
+            command.arg("--whole-body");
+        }
+        let (code, stdout, stderr) = run(&mut command);
+        assert_eq!(code, 0, "{stderr}");
+        let document = hairloom_core::io::project::load(&out)
+            .expect("project")
+            .document;
+        assert_eq!(document.hair_mesh.bundles.len(), 1);
+        assert_eq!(document.body.triangles.len(), triangles, "{stdout}");
+    }
+}
+
 /// Runs a validator; `None` when it is not installed (allowed outside `make test`).
 fn validator(program: &Path, args: &[&Path], cwd: &Path) -> Option<(i32, String)> {
     if !program.exists() && program.components().count() > 1 {

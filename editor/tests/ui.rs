@@ -701,6 +701,53 @@ fn importing_a_body_asks_where_hair_grows_and_the_rest_stays_body() {
     assert_eq!(harness.state().state.document(), &original);
 }
 
+/// Issue 35: a character of several meshes asks which one hair grows on (a mesh named
+/// scalp is chosen by default); every mesh becomes the body.
+#[test]
+fn importing_several_meshes_asks_which_grows_hair_and_all_are_the_body() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let glb = dir.path().join("character.glb");
+    std::fs::write(&glb, hairloom_tests::two_mesh_glb()).expect("write");
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([DialogAnswer::Chosen(glb)]),
+    );
+    let original = harness.state().state.document().clone();
+    file_menu(&mut harness, "Import scalp…");
+    harness.run();
+    assert!(
+        harness.state().mesh_choice.is_some(),
+        "{}",
+        harness.state().state.message
+    );
+    {
+        use egui_kittest::kittest::NodeT;
+        assert_eq!(
+            harness.get_by_label("scalp").accesskit_node().toggled(),
+            Some(egui::accesskit::Toggled::True),
+            "the mesh named scalp is chosen"
+        );
+    }
+    harness.get_by_label("Next").click();
+    harness.run();
+    let state = &harness.state().state;
+    assert!(harness.state().mesh_choice.is_none());
+    assert_eq!(
+        state.document().hair_mesh.bundles.len(),
+        1,
+        "{}",
+        state.message
+    );
+    assert_eq!(
+        state.document().body.triangles.len(),
+        4,
+        "both meshes are the body"
+    );
+    assert_eq!(state.project.history.undo.len(), 1);
+    undo(&mut harness, 1);
+    assert_eq!(harness.state().state.document(), &original);
+}
+
 /// Issue 35: a scalp cut from an imported body by selection — Edit ▸ Delete selected
 /// bundles (or the Delete key) drops the selected bundles for good, Edit ▸ Keep only
 /// selected bundles drops the others; each one undo step.

@@ -126,6 +126,14 @@ impl GltfBuilder {
     }
 }
 
+/// A character of two meshes, "body" and "scalp", each a unit quad.
+pub fn two_mesh_glb() -> Vec<u8> {
+    let mut builder = GltfBuilder::default();
+    builder.add_quad_mesh("body");
+    builder.add_quad_mesh("scalp");
+    builder.glb(&builder.json())
+}
+
 /// A body made of a strip of three unit quads along x as one mesh, "body": the first two
 /// quads in a primitive with material "Scalp", the third in one with material "Skin", and
 /// an 8-bit normalised COLOR_0 painted red (1) on the vertices at x = 0 and 1, black at

@@ -101,6 +101,63 @@ fn several_meshes_need_a_name_and_the_named_one_is_read() {
     );
 }
 
+/// Issue 35: a character made of several meshes — hair on one, every mesh the body.
+#[test]
+fn every_mesh_of_a_file_becomes_the_body_under_one_cap() {
+    use hairloom_core::io::import::import_body;
+    let mut builder = GltfBuilder::default();
+    builder.add_quad_mesh("scalp");
+    builder.add_quad_mesh("");
+    builder.add_quad_mesh("lashes");
+    let mut json = builder.json();
+    // The second mesh has no name (it is "#1"); the third is drawn as lines.
+    json["meshes"][1]
+        .as_object_mut()
+        .expect("mesh")
+        .remove("name");
+    json["meshes"][2]["primitives"][0]["mode"] = serde_json::json!(1);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("character.glb");
+    std::fs::write(&path, builder.glb(&json)).expect("write");
+    match import_file(&path, &ImportOptions::default()) {
+        Err(ImportError::SeveralMeshes { names, .. }) => {
+            assert_eq!(names, vec!["scalp", "#1", "lashes"])
+        }
+        other => panic!("{:?}", other.map(|m| m.mesh_name)),
+    }
+    let unnamed = import_file(
+        &path,
+        &ImportOptions {
+            mesh_name: Some("#1".into()),
+            ..Default::default()
+        },
+    )
+    .expect("an unnamed mesh by its index");
+    assert_eq!(unnamed.mesh_name, "mesh 1");
+    let (body, skipped) = import_body(&path, &ImportOptions::default()).expect("a body");
+    assert_eq!(body.triangles.len(), 4, "two quads; the lines are left out");
+    assert_eq!(body.positions.len(), 8);
+    body.validate()
+        .expect("indices stay in range across meshes");
+    assert_eq!(skipped, vec!["lashes"]);
+    // The caps count every mesh together: two quads are four triangles.
+    let capped = import_body(
+        &path,
+        &ImportOptions {
+            limits: hairloom_core::io::import::ImportLimits {
+                max_triangles: 3,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+    );
+    let error = capped.expect_err("over the cap").to_string();
+    assert!(
+        error.contains("triangles") && error.contains("cap of 1"),
+        "{error}"
+    );
+}
+
 #[test]
 fn truncated_file_is_an_error() {
     let mut builder = GltfBuilder::default();

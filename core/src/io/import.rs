@@ -1,6 +1,7 @@
 //! Scalp import from glTF 2.0 (`.gltf` with external or embedded buffers, `.glb`).
 //!
-//! Reads POSITION, NORMAL, TEXCOORD_0 and indices of every triangle primitive of one mesh,
+//! Reads POSITION, NORMAL, TEXCOORD_0, COLOR_0, materials and indices of every triangle
+//! primitive of one mesh (or, for a body, of every mesh: [`import_body`]),
 //! applies the world transform of the first node that instances it, welds vertices that lie
 //! within a tolerance of each other (keeping per-corner uv, so uv seams survive), and pairs
 //! triangles back into quads because hair meshes are quad-dominant while glTF stores
@@ -85,6 +86,11 @@ pub enum ImportError {
     Gltf { file: String, message: String },
     #[error("{file}: {message}")]
     NoMesh { file: String, message: String },
+    #[error(
+        "{file}: the file has several meshes; choose the one hair grows on by name ({})",
+        quoted_names(names)
+    )]
+    SeveralMeshes { file: String, names: Vec<String> },
     #[error("{file}: mesh \"{mesh}\", primitive {primitive}: {message}")]
     Primitive {
         file: String,
@@ -121,6 +127,8 @@ pub struct ImportedMesh {
     pub has_uv: bool,
     /// Triangles read from the file, before welding and pairing.
     pub source_triangles: usize,
+    /// Vertices read from the file, before welding.
+    pub source_vertices: usize,
     /// The glTF primitive each face came from (faces never span two primitives: a quad is
     /// paired only from triangles of one primitive, so a material's border stays a border).
     pub face_primitives: Vec<u32>,
@@ -223,15 +231,38 @@ impl Default for ImportLimits {
 /// Imports a mesh from a `.gltf` or `.glb` file. External buffers are read only from the
 /// file's own folder (see [`crate::io::input_files`]).
 pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedMesh, ImportError> {
+    let (file, bytes, folder) = read_gltf_file(path, &options.limits)?;
+    import_slice(&bytes, Some(&folder), &file, options)
+}
+
+/// The file's name for messages, its bytes (capped) and the folder its buffers may be read
+/// from.
+fn read_gltf_file(
+    path: &Path,
+    limits: &ImportLimits,
+) -> Result<(String, Vec<u8>, InputFolder), ImportError> {
     let file = path.display().to_string();
     let input = |source| ImportError::Input {
         file: file.clone(),
         source,
     };
-    let bytes =
-        read_regular_file(path, options.limits.max_file_bytes, "a glTF file").map_err(input)?;
+    let bytes = read_regular_file(path, limits.max_file_bytes, "a glTF file").map_err(input)?;
     let folder = InputFolder::of_file(path).map_err(input)?;
-    import_slice(&bytes, Some(&folder), &file, options)
+    Ok((file, bytes, folder))
+}
+
+/// The glTF JSON (read with `gltf-json`'s deserializer only) and the GLB's binary chunk.
+fn parse_gltf<'a>(
+    bytes: &'a [u8],
+    file: &str,
+) -> Result<(json::Root, Option<&'a [u8]>), ImportError> {
+    let gltf_error = |message: String| ImportError::Gltf {
+        file: file.to_string(),
+        message,
+    };
+    let (json_bytes, blob) = split_glb(bytes).map_err(gltf_error)?;
+    let root = json::Root::from_slice(json_bytes).map_err(|e| gltf_error(e.to_string()))?;
+    Ok((root, blob))
 }
 
 /// Imports from bytes; `folder` is where external buffer URIs may lead (none: only the GLB
@@ -246,14 +277,74 @@ pub fn import_slice(
     file: &str,
     options: &ImportOptions,
 ) -> Result<ImportedMesh, ImportError> {
-    let gltf_error = |message: String| ImportError::Gltf {
-        file: file.to_string(),
-        message,
-    };
-    let (json_bytes, blob) = split_glb(bytes).map_err(gltf_error)?;
-    let root = json::Root::from_slice(json_bytes).map_err(|e| gltf_error(e.to_string()))?;
-    let limits = options.limits;
+    let (root, blob) = parse_gltf(bytes, file)?;
     let mesh_index = choose_mesh(&root, options.mesh_name.as_deref(), file)?;
+    import_mesh(&root, blob, folder, file, options, mesh_index)
+}
+
+/// Every mesh of a file as one body (a character whose scalp, face, eyes and clothes are
+/// separate meshes): each read as [`import_slice`] reads one, under the same caps counted
+/// over all of them. Meshes that are not triangles (lines, points: eyelashes drawn as
+/// lines, say) are left out and named in the second result.
+pub fn import_body(
+    path: &Path,
+    options: &ImportOptions,
+) -> Result<(BodyMesh, Vec<String>), ImportError> {
+    let (file, bytes, folder) = read_gltf_file(path, &options.limits)?;
+    let (root, blob) = parse_gltf(&bytes, &file)?;
+    if root.meshes.len() > options.limits.max_primitives {
+        return Err(ImportError::Limit {
+            file: file.clone(),
+            mesh: "(every mesh)".into(),
+            what: "meshes",
+            value: root.meshes.len(),
+            cap: options.limits.max_primitives,
+            raise: "",
+        });
+    }
+    let mut body = BodyMesh::default();
+    let mut skipped = Vec::new();
+    let mut left = options.clone();
+    for index in 0..root.meshes.len() {
+        match import_mesh(&root, blob, Some(&folder), &file, &left, index) {
+            Ok(mesh) => {
+                let part = mesh.to_body();
+                let base = body.positions.len() as u32;
+                body.positions.extend(part.positions);
+                body.triangles
+                    .extend(part.triangles.iter().map(|t| t.map(|v| v + base)));
+                // What the next meshes may still read.
+                left.limits.max_vertices = left
+                    .limits
+                    .max_vertices
+                    .saturating_sub(mesh.source_vertices);
+                left.limits.max_triangles = left
+                    .limits
+                    .max_triangles
+                    .saturating_sub(mesh.source_triangles);
+            }
+            Err(ImportError::Primitive { mesh, message, .. })
+                if message.contains("a scalp must be made of triangles") =>
+            {
+                skipped.push(mesh);
+            }
+            Err(ImportError::Empty { mesh, .. }) => skipped.push(mesh),
+            Err(error) => return Err(error),
+        }
+    }
+    Ok((body, skipped))
+}
+
+/// Reads mesh `mesh_index` of a parsed file (see [`import_slice`]).
+fn import_mesh(
+    root: &json::Root,
+    blob: Option<&[u8]>,
+    folder: Option<&InputFolder>,
+    file: &str,
+    options: &ImportOptions,
+    mesh_index: usize,
+) -> Result<ImportedMesh, ImportError> {
+    let limits = options.limits;
     let mesh = &root.meshes[mesh_index];
     let mesh_name = mesh
         .name
@@ -276,14 +367,14 @@ pub fn import_slice(
             "",
         ));
     }
-    let placement = mesh_node(&root, mesh_index);
+    let placement = mesh_node(root, mesh_index);
     let transform = placement.map_or(DMat4::IDENTITY, |(node, parent)| {
         parent * local_transform(&root.nodes[node])
     }) * DMat4::from_scale(DVec3::splat(options.scale));
     let normal_transform = transform.inverse().transpose();
-    let buffers = Buffers::load(&root, blob, folder, file, limits.max_file_bytes)?;
+    let buffers = Buffers::load(root, blob, folder, file, limits.max_file_bytes)?;
     let mut reader = AccessorReader {
-        root: &root,
+        root,
         buffers: &buffers,
         file,
         mesh: &mesh_name,
@@ -485,6 +576,7 @@ pub fn import_slice(
         positions.extend(world);
     }
     let source_triangles = triangles.len();
+    let source_vertices = positions.len();
     let (positions, welded) = weld(&positions, &triangles, options.weld_tolerance_relative);
     let degenerate = source_triangles - welded.len();
     let corner_uvs: Vec<[DVec2; 3]> = welded.iter().map(|&(t, _)| corner_uvs[t]).collect();
@@ -545,7 +637,7 @@ pub fn import_slice(
             .collect()
     });
     let body_animation = match placement {
-        Some((node, parent)) => body_animation(&root, node, parent, &mut reader)?,
+        Some((node, parent)) => body_animation(root, node, parent, &mut reader)?,
         None => Vec::new(),
     };
     Ok(ImportedMesh {
@@ -555,6 +647,7 @@ pub fn import_slice(
         uvs,
         has_uv,
         source_triangles,
+        source_vertices,
         face_primitives,
         primitive_materials,
         face_colours,
@@ -828,40 +921,45 @@ fn choose_mesh(root: &json::Root, name: Option<&str>, file: &str) -> Result<usiz
             .meshes
             .iter()
             .position(|m| m.name.as_deref() == Some(name))
+            .or_else(|| {
+                // An unnamed mesh by its index, as messages list it.
+                let index: usize = name.strip_prefix('#')?.parse().ok()?;
+                (index < root.meshes.len() && root.meshes[index].name.is_none()).then_some(index)
+            })
             .ok_or_else(|| {
                 no_mesh(format!(
                     "no mesh named \"{name}\" (meshes: {})",
-                    mesh_names(root)
+                    quoted_names(&mesh_name_list(root))
                 ))
             }),
         None => match root.meshes.len() {
             0 => Err(no_mesh("the file contains no mesh".into())),
             1 => Ok(0),
-            _ => Err(no_mesh(format!(
-                "the file has several meshes; choose one by name ({})",
-                mesh_names(root)
-            ))),
+            _ => Err(ImportError::SeveralMeshes {
+                file: file.to_string(),
+                names: mesh_name_list(root),
+            }),
         },
     }
 }
 
-fn mesh_names(root: &json::Root) -> String {
-    let mut names: Vec<String> = root
-        .meshes
+/// Every mesh's name (`#N` for an unnamed one, which `ImportOptions::mesh_name` also takes),
+/// in file order.
+fn mesh_name_list(root: &json::Root) -> Vec<String> {
+    root.meshes
         .iter()
         .enumerate()
-        .take(20)
-        .map(|(i, m)| {
-            m.name
-                .as_ref()
-                .map(|n| format!("\"{n}\""))
-                .unwrap_or_else(|| format!("#{i}"))
-        })
-        .collect();
-    if root.meshes.len() > 20 {
-        names.push(format!("… {} more", root.meshes.len() - 20));
+        .map(|(i, m)| m.name.clone().unwrap_or_else(|| format!("#{i}")))
+        .collect()
+}
+
+/// The first 20 names, quoted, for a message.
+fn quoted_names(names: &[String]) -> String {
+    let mut out: Vec<String> = names.iter().take(20).map(|n| format!("\"{n}\"")).collect();
+    if names.len() > 20 {
+        out.push(format!("… {} more", names.len() - 20));
     }
-    names.join(", ")
+    out.join(", ")
 }
 
 /// The first node (in scene order, depth first) that instances `mesh`, with its parent's

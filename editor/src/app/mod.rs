@@ -173,6 +173,8 @@ pub struct HairloomApp {
     /// File ▸ Import scalp… on a file with several materials or vertex colours: where hair
     /// grows.
     pub scalp_import: Option<scalp_import::ScalpImport>,
+    /// File ▸ Import scalp… on a file of several meshes: which one grows hair.
+    pub mesh_choice: Option<scalp_import::MeshChoice>,
     /// The application the next `.abc` export is for (File ▸ Export groom for ▸).
     pub alembic_target: AlembicTarget,
     /// "Save changes?" is being asked before this action.
@@ -222,6 +224,7 @@ impl HairloomApp {
             export: None,
             groom_import: None,
             scalp_import: None,
+            mesh_choice: None,
             alembic_target: AlembicTarget::default(),
             confirm: None,
             after_save: None,
@@ -324,6 +327,7 @@ impl HairloomApp {
             || self.export.is_some()
             || self.groom_import.is_some()
             || self.scalp_import.is_some()
+            || self.mesh_choice.is_some()
     }
 
     fn shortcuts(&mut self, ui: &mut egui::Ui) {
@@ -595,20 +599,62 @@ impl HairloomApp {
         self.autosaved.1 = self.state.revision;
     }
 
-    /// Reads the scalp file; asks where hair grows when the file offers a choice (several
-    /// materials, vertex colours), else imports every face.
+    /// Reads the scalp file; asks which mesh grows hair when it has several, and where on
+    /// it when it offers a choice (several materials, vertex colours); else imports every
+    /// face.
     fn import_scalp(&mut self, path: &std::path::Path) {
-        let options = hairloom_core::io::import::ImportOptions::default();
-        match hairloom_core::io::import::import_file(path, &options) {
-            Ok(mesh) if scalp_import::ScalpImport::offers_choice(&mesh) => {
-                self.scalp_import = Some(scalp_import::ScalpImport::new(path.to_path_buf(), mesh));
+        use hairloom_core::io::import::{ImportError, ImportOptions, import_file};
+        match import_file(path, &ImportOptions::default()) {
+            Ok(mesh) => self.offer_or_import(path, mesh, None),
+            Err(ImportError::SeveralMeshes { names, .. }) => {
+                self.mesh_choice = Some(scalp_import::MeshChoice::new(path.to_path_buf(), names));
             }
-            Ok(mesh) => self.finish_scalp_import(
+            Err(error) => self.state.message = format!("import failed: {error}"),
+        }
+    }
+
+    /// Reads mesh `name` as the scalp and every mesh of the file as the body.
+    fn import_scalp_mesh(&mut self, path: &std::path::Path, name: String) {
+        use hairloom_core::io::import::{ImportOptions, import_body, import_file};
+        let options = ImportOptions {
+            mesh_name: Some(name),
+            ..ImportOptions::default()
+        };
+        let read = import_file(path, &options)
+            .and_then(|mesh| Ok((mesh, import_body(path, &ImportOptions::default())?)));
+        match read {
+            Ok((mesh, (body, skipped))) => {
+                self.offer_or_import(path, mesh, Some(body));
+                if !skipped.is_empty() {
+                    self.state.message += &format!(
+                        "; left out of the body (not triangles): {}",
+                        skipped.join(", ")
+                    );
+                }
+            }
+            Err(error) => self.state.message = format!("import failed: {error}"),
+        }
+    }
+
+    /// Asks where hair grows on `mesh` when it offers a choice, else imports every face;
+    /// `body` is the file's every mesh when it has several.
+    fn offer_or_import(
+        &mut self,
+        path: &std::path::Path,
+        mesh: hairloom_core::io::import::ImportedMesh,
+        body: Option<hairloom_core::model::document::BodyMesh>,
+    ) {
+        if scalp_import::ScalpImport::offers_choice(&mesh) {
+            let mut import = scalp_import::ScalpImport::new(path.to_path_buf(), mesh);
+            import.body = body;
+            self.scalp_import = Some(import);
+        } else {
+            self.finish_scalp_import(
                 path,
                 &mesh,
+                body,
                 &hairloom_core::io::scalp_region::ScalpRegion::All,
-            ),
-            Err(error) => self.state.message = format!("import failed: {error}"),
+            );
         }
     }
 
@@ -616,14 +662,35 @@ impl HairloomApp {
         &mut self,
         path: &std::path::Path,
         mesh: &hairloom_core::io::import::ImportedMesh,
+        body: Option<hairloom_core::model::document::BodyMesh>,
         region: &hairloom_core::io::scalp_region::ScalpRegion,
     ) {
-        match crate::files::scalp_document_from(path, mesh, region, false) {
+        let body = body.unwrap_or_else(|| mesh.to_body());
+        match crate::files::scalp_document_from(path, mesh, body, region, false) {
             Ok((document, summary)) => {
                 self.state.import_scalp(document, &summary);
                 self.viewport.reframe();
             }
             Err(error) => self.state.message = format!("import failed: {error:#}"),
+        }
+    }
+
+    /// The "which mesh grows hair?" modal of a scalp import.
+    fn mesh_choice_modal(&mut self, ui: &mut egui::Ui) {
+        let Some(choice) = &mut self.mesh_choice else {
+            return;
+        };
+        match choice.ui(ui) {
+            scalp_import::MeshChoiceAction::Waiting => {}
+            scalp_import::MeshChoiceAction::Closed => {
+                self.mesh_choice = None;
+                self.state.message = "import cancelled".into();
+            }
+            scalp_import::MeshChoiceAction::Read(name) => {
+                if let Some(choice) = self.mesh_choice.take() {
+                    self.import_scalp_mesh(&choice.path, name);
+                }
+            }
         }
     }
 
@@ -640,7 +707,7 @@ impl HairloomApp {
             }
             scalp_import::ScalpImportAction::Import(region) => {
                 if let Some(import) = self.scalp_import.take() {
-                    self.finish_scalp_import(&import.path, &import.mesh, &region);
+                    self.finish_scalp_import(&import.path, &import.mesh, import.body, &region);
                 }
             }
         }
@@ -860,6 +927,7 @@ impl HairloomApp {
     fn modals(&mut self, ui: &mut egui::Ui) {
         self.recovery_offer(ui);
         self.groom_import_modal(ui);
+        self.mesh_choice_modal(ui);
         self.scalp_import_modal(ui);
         if let Some(action) = self.confirm.clone() {
             let mut choice = None;

@@ -4,11 +4,15 @@
 //! vertex colours (the count updates as they choose), or imports every face and keeps only
 //! a box-selected region afterwards (Edit ▸ Keep only selected bundles). The whole mesh stays the
 //! body either way. A file with one material and no vertex colours imports at once.
+//!
+//! A file of several meshes (a character whose scalp, face, eyes and clothes are separate)
+//! first asks which mesh hair grows on ([`MeshChoice`]); every mesh then becomes the body.
 
 use std::path::PathBuf;
 
 use hairloom_core::io::import::ImportedMesh;
 use hairloom_core::io::scalp_region::{ColourChannel, ScalpRegion, face_count, material_faces};
+use hairloom_core::model::document::BodyMesh;
 
 /// How the artist names the scalp.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,6 +27,8 @@ pub struct ScalpImport {
     pub path: PathBuf,
     /// Boxed: a mesh is large and this sits in the app.
     pub mesh: Box<ImportedMesh>,
+    /// The body when it is more than `mesh` (every mesh of a file of several).
+    pub body: Option<BodyMesh>,
     choice: Choice,
     /// Each material, its face count and whether it is chosen.
     materials: Vec<(String, usize, bool)>,
@@ -78,6 +84,7 @@ impl ScalpImport {
         Self {
             path,
             mesh: Box::new(mesh),
+            body: None,
             choice,
             materials,
             channel: ColourChannel::Red,
@@ -210,6 +217,65 @@ impl ScalpImport {
         // Escape (or a click outside) closes it, as the other dialogs do.
         if modal.should_close() && matches!(action, ScalpImportAction::Waiting) {
             action = ScalpImportAction::Closed;
+        }
+        action
+    }
+}
+
+/// The first question for a file of several meshes: which one grows hair.
+pub struct MeshChoice {
+    pub path: PathBuf,
+    names: Vec<String>,
+    chosen: usize,
+}
+
+/// What the mesh question asks of the app.
+pub enum MeshChoiceAction {
+    Waiting,
+    Closed,
+    /// Read this mesh as the scalp (and every mesh as the body).
+    Read(String),
+}
+
+impl MeshChoice {
+    /// A mesh whose name says scalp or hair is chosen by default.
+    pub fn new(path: PathBuf, names: Vec<String>) -> Self {
+        let chosen = names.iter().position(|n| looks_like_scalp(n)).unwrap_or(0);
+        Self {
+            path,
+            names,
+            chosen,
+        }
+    }
+
+    pub fn ui(&mut self, ui: &mut egui::Ui) -> MeshChoiceAction {
+        let mut action = MeshChoiceAction::Waiting;
+        let modal =
+            egui::Modal::new(egui::Id::unique("hairloom import scalp mesh")).show(ui.ctx(), |ui| {
+                ui.heading("Import scalp");
+                ui.label(self.path.display().to_string());
+                ui.label(format!(
+                    "The file has {} meshes; hair grows on (all of them stay the body):",
+                    self.names.len()
+                ));
+                egui::ScrollArea::vertical()
+                    .max_height(240.0)
+                    .show(ui, |ui| {
+                        for (i, name) in self.names.iter().enumerate() {
+                            ui.radio_value(&mut self.chosen, i, name);
+                        }
+                    });
+                ui.horizontal(|ui| {
+                    if ui.button("Next").clicked() {
+                        action = MeshChoiceAction::Read(self.names[self.chosen].clone());
+                    }
+                    if ui.button("Cancel").clicked() {
+                        action = MeshChoiceAction::Closed;
+                    }
+                });
+            });
+        if modal.should_close() && matches!(action, MeshChoiceAction::Waiting) {
+            action = MeshChoiceAction::Closed;
         }
         action
     }

@@ -71,6 +71,10 @@ enum Command {
         /// painted into the vertex colours, channel r, g, b or a).
         #[arg(long, default_value = "all")]
         hair_on: hairloom_core::io::scalp_region::ScalpRegion,
+        /// Every mesh of the file becomes the body (a character made of several meshes),
+        /// not only the one hair grows on (`--mesh`).
+        #[arg(long)]
+        whole_body: bool,
         /// Raise the import cap on vertices (default 4,000,000; triangles may be twice as
         /// many). See docs/resource-policy.md.
         #[arg(long)]
@@ -253,13 +257,14 @@ pub fn main() -> ExitCode {
             scale,
             generate_uv,
             hair_on,
+            whole_body,
             max_vertices,
         }) => import(
             &scalp,
             &out,
             mesh,
             scale,
-            &hair_on,
+            (&hair_on, whole_body),
             generate_uv,
             max_vertices,
         ),
@@ -474,7 +479,7 @@ fn import(
     out: &Path,
     mesh: Option<String>,
     scale: f64,
-    hair_on: &hairloom_core::io::scalp_region::ScalpRegion,
+    (hair_on, whole_body): (&hairloom_core::io::scalp_region::ScalpRegion, bool),
     generate_uv: bool,
     max_vertices: Option<usize>,
 ) -> anyhow::Result<()> {
@@ -489,7 +494,21 @@ fn import(
         limits,
         ..hairloom_core::io::import::ImportOptions::default()
     };
-    let (document, summary) = files::scalp_document(scalp, &options, hair_on, generate_uv)?;
+    let (mut document, mut summary) = files::scalp_document(scalp, &options, hair_on, generate_uv)?;
+    if whole_body {
+        let (body, skipped) = hairloom_core::io::import::import_body(
+            scalp,
+            &hairloom_core::io::import::ImportOptions {
+                mesh_name: None,
+                ..options
+            },
+        )?;
+        summary += &format!("; body: every mesh ({} triangles)", body.triangles.len());
+        if !skipped.is_empty() {
+            summary += &format!(", left out (not triangles): {}", skipped.join(", "));
+        }
+        document.body = body;
+    }
     project::save(out, &hairloom_core::Project::new(document))?;
     println!("{summary} → {}", out.display());
     Ok(())
