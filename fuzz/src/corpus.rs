@@ -252,6 +252,8 @@ fn gltf_seeds() -> Vec<(String, Vec<u8>)> {
             "body_materials_colours.glb".to_string(),
             hairloom_tests::body_with_materials_glb(),
         ),
+        // A character of two meshes: every mesh is read as the body.
+        ("two_meshes.glb".to_string(), hairloom_tests::two_mesh_glb()),
     ];
     // The same quad as glTF JSON with its buffer in a data URI.
     let data = {

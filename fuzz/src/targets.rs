@@ -73,6 +73,15 @@ fn project_load(input: &[u8]) {
 }
 
 fn gltf_import(input: &[u8]) {
+    // Every mesh as one body, under caps counted over all of them.
+    if let Ok((body, _)) = hairloom_core::io::import::import_body_slice(
+        input,
+        None,
+        "fuzz.glb",
+        &ImportOptions::default(),
+    ) {
+        let _ = body.validate();
+    }
     if let Ok(imported) = import_slice(input, None, "fuzz.glb", &ImportOptions::default()) {
         let _ = imported.to_body().validate();
         let _ = imported.to_hair_mesh(|_| true).validate();

@@ -291,10 +291,20 @@ pub fn import_body(
     options: &ImportOptions,
 ) -> Result<(BodyMesh, Vec<String>), ImportError> {
     let (file, bytes, folder) = read_gltf_file(path, &options.limits)?;
-    let (root, blob) = parse_gltf(&bytes, &file)?;
+    import_body_slice(&bytes, Some(&folder), &file, options)
+}
+
+/// [`import_body`] from bytes (see [`import_slice`] for `folder` and `file`).
+pub fn import_body_slice(
+    bytes: &[u8],
+    folder: Option<&InputFolder>,
+    file: &str,
+    options: &ImportOptions,
+) -> Result<(BodyMesh, Vec<String>), ImportError> {
+    let (root, blob) = parse_gltf(bytes, file)?;
     if root.meshes.len() > options.limits.max_primitives {
         return Err(ImportError::Limit {
-            file: file.clone(),
+            file: file.to_string(),
             mesh: "(every mesh)".into(),
             what: "meshes",
             value: root.meshes.len(),
@@ -306,7 +316,7 @@ pub fn import_body(
     let mut skipped = Vec::new();
     let mut left = options.clone();
     for index in 0..root.meshes.len() {
-        match import_mesh(&root, blob, Some(&folder), &file, &left, index) {
+        match import_mesh(&root, blob, folder, file, &left, index) {
             Ok(mesh) => {
                 let part = mesh.to_body();
                 let base = body.positions.len() as u32;
