@@ -11,8 +11,10 @@ target on the scalp saying where each strand should end. Every seed is fixed, so
 makes the same strands (the .abc differs only in its write date).
 
 Usage: target/bpy-venv/bin/python tools/blender_groom.py --out DIR [--render]
-(the Python of target/bpy-venv, which has PyPI `bpy` 5.3). Writes, in metres, +Y up,
-facing +Z (the glTF frame, which Hairloom reads):
+(the Python of target/bpy-venv, which has PyPI `bpy` 5.3). Writes, in metres, +Y up
+(the glTF frame, which Hairloom reads), with the head, scalp and groom under a parent
+turned 10° about x and 25° about z and moved, so that each file carries a transform its
+reader must apply (an Alembic Xform, USD xformOps, the glTF node):
 
     DIR/blender_groom.abc   the evaluated curves as Alembic ICurves (Blender's exporter)
     DIR/blender_groom.usda  the same curves as a USD BasisCurves prim (catmullRom, pinned)
@@ -282,12 +284,22 @@ def select_only(obj):
     bpy.context.view_layer.objects.active = obj
 
 
-def export(hair, scalp, out):
+def export(hair, scalp, head, out):
     frame = bpy.context.scene.frame_current
+    # The groom and its scalp go out under a moved and turned parent, as a groom
+    # on a posed or placed character does: every file then carries that transform (an
+    # Alembic Xform, USD xformOps, the glTF node), and Hairloom must apply it to land the
+    # curves on the scalp. The head, scalp and hair move together, so the hair the node
+    # groups grow (shrinkwrapped to the head) is unchanged.
+    pivot = bpy.data.objects.new("groom_pivot", None)
+    bpy.context.scene.collection.objects.link(pivot)
+    pivot.location = (0.04, -0.03, 0.12)
+    pivot.rotation_euler = (math.radians(10.0), 0.0, math.radians(25.0))
+    for obj in (head, scalp, hair):
+        obj.parent = pivot
+    bpy.context.view_layer.update()
     select_only(hair)
-    # Alembic is always written +Y up (Blender converts the points and the transforms);
-    # the hair object's transform is the identity, so the ICurves' points are already in
-    # the glTF frame: Hairloom's Alembic reader does not apply transforms.
+    # Alembic is always written +Y up (Blender converts the points and the transforms).
     bpy.ops.wm.alembic_export(filepath=os.path.join(out, "blender_groom.abc"),
                               selected=True, start=frame, end=frame)
     # USD is written +Z up by default (stage upAxis "Z"), which Hairloom does not read:
@@ -339,7 +351,7 @@ def main():
     append_hair_assets()
     hair = make_groom(head, scalp)
     report(hair)
-    export(hair, scalp, out)
+    export(hair, scalp, head, out)
     print(f"wrote {out}/blender_groom.abc, blender_groom.usda, blender_scalp.glb "
           f"in {time.perf_counter() - started:.1f} s (Blender {bpy.app.version_string})")
     if args.render:

@@ -112,6 +112,8 @@ fn blender_imports_our_grooms_upright_tapered_and_in_place() {
 /// scalp; `hairloom fit` must bring both in within the targets (mean closest-point
 /// distance both ways at most 0.5 % of the groom's size, 95th percentile at most 2 %), on
 /// the given scalp and on one built from the roots, and the two files must give the same fit.
+/// The script exports everything under a turned and moved parent, so the `.abc` agrees with
+/// the `.usda` and its roots land on the scalp only when its Xforms are applied.
 #[test]
 fn a_groom_made_with_blenders_hair_nodes_fits_within_the_targets() {
     let Some(python) = blender_or_skip() else {
