@@ -135,6 +135,10 @@ fn in_chunks<T: Send>(
     crate::parallel::in_chunks(count, CHUNK, threads, work)
 }
 
+/// Strands measured to choose between a curl found only against the strands' own axes and
+/// none (a tenth of `measure`'s default: enough to tell them apart).
+const COMPARE_STRANDS: usize = 2000;
+
 /// Fits a hair mesh and styling to `groom` (see the module comment).
 pub fn fit(
     groom: &InputGroom,
@@ -238,82 +242,109 @@ pub fn fit(
     drop(probe);
     // Locks that coil together (ringlets) leave the mesh's residual nearly curl-free: look
     // for the curl in each strand against its own axis instead.
-    let first_curl = first_curl.or_else(|| styling::curl_from_own_axes(groom, min_curl_radius));
-    let fitted_mesh = match first_curl {
+    let own_axes_curl = match first_curl {
+        Some(_) => None,
+        None => styling::curl_from_own_axes(groom, min_curl_radius),
+    };
+    let first_curl = first_curl.or(own_axes_curl);
+    let (fitted_mesh, uncurled) = match first_curl {
         Some((turns_per_m, radius_m)) => {
-            mesh_of(&styling::strand_axes(groom, turns_per_m, radius_m))?
+            let axes = mesh_of(&styling::strand_axes(groom, turns_per_m, radius_m))?;
+            (axes, own_axes_curl.map(|_| first))
         }
-        None => first,
+        None => (first, None),
     };
     // The curl scan, and where it found a curl, the columns again on the strands' axes.
     lap(&mut timings, "curl");
-    let MeshFit {
-        mut mesh,
-        lengths,
-        reference_lengths,
-        locked,
-    } = fitted_mesh;
-    // Density: root count per area, relative to the densest tenth of the bundles.
-    let areas: Vec<f64> = mesh
-        .bundles
-        .iter()
-        .map(|b| face_area(&mesh, &b.vertices))
-        .collect();
-    let mut densities: Vec<f64> = strands_in
-        .iter()
-        .zip(&areas)
-        .filter(|(n, _)| **n > 0)
-        .map(|(n, a)| *n as f64 / a.max(1e-300))
-        .collect();
-    densities.sort_by(f64::total_cmp);
-    let reference_density = densities
-        .get(((densities.len() as f64) * 0.9) as usize)
-        .or(densities.last())
-        .copied()
-        .unwrap_or(1.0);
-    let mut area_sum = 0.0;
-    let mut growing = 0usize;
-    for ((bundle, &n), &area) in mesh.bundles.iter_mut().zip(&strands_in).zip(&areas) {
-        if n > 0 {
-            bundle.density = (n as f64 / area.max(1e-300) / reference_density).clamp(0.01, 1.0);
-            area_sum += area;
-            growing += 1;
+    let finish = |fitted_mesh: MeshFit, curl: Option<(f64, f64)>| {
+        let MeshFit {
+            mut mesh,
+            lengths,
+            reference_lengths,
+            locked,
+        } = fitted_mesh;
+        // Density: root count per area, relative to the densest tenth of the bundles.
+        let areas: Vec<f64> = mesh
+            .bundles
+            .iter()
+            .map(|b| face_area(&mesh, &b.vertices))
+            .collect();
+        let mut densities: Vec<f64> = strands_in
+            .iter()
+            .zip(&areas)
+            .filter(|(n, _)| **n > 0)
+            .map(|(n, a)| *n as f64 / a.max(1e-300))
+            .collect();
+        densities.sort_by(f64::total_cmp);
+        let reference_density = densities
+            .get(((densities.len() as f64) * 0.9) as usize)
+            .or(densities.last())
+            .copied()
+            .unwrap_or(1.0);
+        let mut area_sum = 0.0;
+        let mut growing = 0usize;
+        for ((bundle, &n), &area) in mesh.bundles.iter_mut().zip(&strands_in).zip(&areas) {
+            if n > 0 {
+                bundle.density = (n as f64 / area.max(1e-300) / reference_density).clamp(0.01, 1.0);
+                area_sum += area;
+                growing += 1;
+            }
+        }
+        // Strands per bundle that give the input's count over the hair at full density.
+        let mean_area = area_sum / growing.max(1) as f64;
+        let strands_per_bundle = (reference_density * mean_area).round().clamp(1.0, 4096.0) as u32;
+        let source = if built {
+            format!("Fitted to {name} (scalp built from its {curves} roots)")
+        } else {
+            format!("Fitted to {name}")
+        };
+        let mut document = Document::new(name.to_string(), mesh);
+        document.source = source;
+        document.body = body.clone();
+        styling::fit_styling(&mut document, &lengths, &reference_lengths);
+        if let Some((turns_per_m, _)) = curl {
+            styling::fit_curl_styling(
+                &mut document,
+                groom,
+                &hits,
+                &reference_lengths,
+                min_curl_radius,
+                Some(turns_per_m),
+            );
+        }
+        document
+            .validate()
+            .map_err(|e| FitError::Invalid(e.to_string()))?;
+        Ok::<_, FitError>(Fitted {
+            document,
+            hits: hits.clone(),
+            strands_per_bundle,
+            locked_interior: locked,
+            timings_s: Vec::new(),
+        })
+    };
+    let mut fitted = finish(fitted_mesh, first_curl)?;
+    // A curl found only against the strands' own axes is right for ringlets, but a groom
+    // whose strands merely wave or frizz about their clumps can show one too (Blender's hair
+    // nodes: a 6 mm curl that cost 0.12 % of the size in distance and 4 % in length): keep
+    // it only where it brings the fitted strands closer to the input than no curl does.
+    if let Some(first) = uncurled {
+        let plain = finish(first, None)?;
+        let sample = measure::MeasureOptions {
+            max_strands: COMPARE_STRANDS,
+            threads,
+            ..measure::MeasureOptions::default()
+        };
+        let with_curl = measure::measure(groom, &fitted, &sample).pooled.mean;
+        let without = measure::measure(groom, &plain, &sample).pooled.mean;
+        if without < with_curl {
+            fitted = plain;
         }
     }
-    // Strands per bundle that give the input's count over the hair at full density.
-    let mean_area = area_sum / growing.max(1) as f64;
-    let strands_per_bundle = (reference_density * mean_area).round().clamp(1.0, 4096.0) as u32;
-    let source = if built {
-        format!("Fitted to {name} (scalp built from its {curves} roots)")
-    } else {
-        format!("Fitted to {name}")
-    };
-    let mut document = Document::new(name.to_string(), mesh);
-    document.source = source;
-    document.body = body;
-    styling::fit_styling(&mut document, &lengths, &reference_lengths);
-    if let Some((turns_per_m, _)) = first_curl {
-        styling::fit_curl_styling(
-            &mut document,
-            groom,
-            &hits,
-            &reference_lengths,
-            min_curl_radius,
-            Some(turns_per_m),
-        );
-    }
     lap(&mut timings, "styling");
-    document
-        .validate()
-        .map_err(|e| FitError::Invalid(e.to_string()))?;
     let _ = progress("styling", 1.0);
-    Ok(Fitted {
-        document,
-        hits,
-        strands_per_bundle,
-        locked_interior: locked,
-        timings_s: timings,
-    })
+    fitted.timings_s = timings;
+    Ok(fitted)
 }
 
 /// The hair mesh fitted to a groom's strands, with what styling needs from the fit.
