@@ -183,13 +183,15 @@ impl ScalpRegion {
                         });
                     }
                 }
+                // Once per primitive, then a lookup per face.
+                let chosen: Vec<bool> = mesh
+                    .primitive_materials
+                    .iter()
+                    .map(|m| m.as_ref().is_some_and(|m| names.contains(m)))
+                    .collect();
                 mesh.face_primitives
                     .iter()
-                    .map(|&p| {
-                        mesh.primitive_materials[p as usize]
-                            .as_ref()
-                            .is_some_and(|m| names.contains(m))
-                    })
+                    .map(|&p| chosen[p as usize])
                     .collect()
             }
             Self::VertexColour {
@@ -244,16 +246,24 @@ impl ScalpRegion {
 /// not listed.
 pub fn material_faces(mesh: &ImportedMesh) -> Vec<(String, usize)> {
     let mut out: Vec<(String, usize)> = Vec::new();
-    for name in mesh.primitive_materials.iter().flatten() {
-        if !out.iter().any(|(n, _)| n == name) {
-            out.push((name.clone(), 0));
-        }
-    }
+    // Each primitive's entry in `out`, found once; then a face is one lookup.
+    let slot: Vec<Option<usize>> = mesh
+        .primitive_materials
+        .iter()
+        .map(|material| {
+            let name = material.as_ref()?;
+            Some(match out.iter().position(|(n, _)| n == name) {
+                Some(at) => at,
+                None => {
+                    out.push((name.clone(), 0));
+                    out.len() - 1
+                }
+            })
+        })
+        .collect();
     for &p in &mesh.face_primitives {
-        if let Some(name) = &mesh.primitive_materials[p as usize]
-            && let Some(entry) = out.iter_mut().find(|(n, _)| n == name)
-        {
-            entry.1 += 1;
+        if let Some(at) = slot[p as usize] {
+            out[at].1 += 1;
         }
     }
     out

@@ -4,10 +4,11 @@
 //! from `width` (or `groom_width`), root uv from `groom_root_uv` (or Blender's `surface_uv_coordinate`),
 //! groups from `groom_group_id`; the first time sample is read.
 //!
-//! `ogawa-rs` trusts the sizes a file states (it allocates what a blob header claims) and has
-//! `todo!()`s for some types, so before it sees a file, [`check_ogawa_tree`] walks the whole
-//! Ogawa tree and refuses any blob or group that does not fit inside the file; a panic left
-//! in the crate becomes a named error ([`without_panics`]).
+//! `ogawa-rs` trusts the sizes a file states (it allocates what a blob header claims) and
+//! panics on types it does not read (wide strings), so before it sees a file,
+//! [`check_ogawa_tree`] walks the whole Ogawa tree and refuses any blob or group that does
+//! not fit inside the file; a panic left in the crate becomes a named error
+//! ([`without_panics`]).
 //!
 //! Transforms: every `IXform` above a curves object applies, as the Alembic library composes
 //! them (`.ops` and `.vals` read here, since `ogawa-rs` 0.4 reads no `IXform` samples; see

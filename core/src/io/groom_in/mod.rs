@@ -341,8 +341,8 @@ fn read_groom_bytes(path: &Path, limits: GroomLimits) -> Result<Vec<u8>, GroomRe
     )?)
 }
 
-/// Runs a third-party reader that may panic on a hostile file (`ogawa-rs` has `todo!()`s
-/// and asserts on malformed input), turning a panic into a named error.
+/// Runs a third-party reader that may panic on a hostile file (`ogawa-rs` panics on types
+/// it does not read and asserts on malformed input), turning a panic into a named error.
 pub(crate) fn without_panics<T>(
     file: &Path,
     reader: &str,
