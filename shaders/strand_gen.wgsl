@@ -33,6 +33,8 @@
 @group(0) @binding(7) var u_texture: texture_3d<f32>;
 @group(0) @binding(8) var v_texture: texture_3d<f32>;
 @group(0) @binding(9) var<storage, read> styling: array<Styling>;
+// The painted maps (density, length, clump) in root-uv space; one white texel when none.
+@group(0) @binding(15) var root_maps: texture_2d<f32>;
 @group(0) @binding(10) var<storage, read> runs: array<StrandRun>;
 // Progressive root samples: `sample_set` for quads (bundle-corner coordinates), then
 // `sample_set` for triangles (barycentric).

@@ -17,8 +17,9 @@
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use hairloom_core::Document;
 use hairloom_core::geometry::curve::{cubic_to_quadratics, curve_segments};
-use hairloom_core::io::runtime_bundle::{Manifest, bundle_files};
+use hairloom_core::io::runtime_bundle::{Manifest, bundle_files, load_runtime_asset_from};
 use hairloom_core::model::mesh::HairMesh;
+use hairloom_core::model::root_maps::RootMapChannel;
 use hairloom_core::model::styling::StylingParams;
 use hairloom_core::runtime::atlas::{Atlas, BundleBlock};
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions, sample_rank, strand_root};
@@ -973,6 +974,38 @@ mod from_the_document {
         pub u: &'a Texture3d,
         pub v: &'a Texture3d,
         pub position_offset: Vec3,
+        /// `root_maps`: `(W, H, RGBA8 bytes)`, or none (every map 1).
+        pub root_maps: Option<(u32, u32, &'a [u8])>,
+    }
+
+    /// "Painted maps": `root_map_values(uv)`, f32, bilinear between texel centres.
+    fn root_map_values(t: &Textures<'_>, uv: Vec2) -> [f32; 3] {
+        let Some((w, h, bytes)) = t.root_maps else {
+            return [1.0; 3];
+        };
+        let size = Vec2::new(w as f32, h as f32);
+        let mut x = (uv * size - 0.5).clamp(Vec2::ZERO, size - 1.0);
+        if x.x.is_nan() {
+            x.x = 0.0;
+        }
+        if x.y.is_nan() {
+            x.y = 0.0;
+        }
+        let i0 = [
+            (x.x.floor() as u32).min(w - 1),
+            (x.y.floor() as u32).min(h - 1),
+        ];
+        let i1 = [(i0[0] + 1).min(w - 1), (i0[1] + 1).min(h - 1)];
+        let f = x - Vec2::new(i0[0] as f32, i0[1] as f32);
+        let texel =
+            |tx: u32, ty: u32, c: usize| bytes[(4 * (ty * w + tx)) as usize + c] as f32 / 255.0;
+        [0, 1, 2].map(|c| {
+            let bottom =
+                texel(i0[0], i0[1], c) + (texel(i1[0], i0[1], c) - texel(i0[0], i0[1], c)) * f.x;
+            let top =
+                texel(i0[0], i1[1], c) + (texel(i1[0], i1[1], c) - texel(i0[0], i1[1], c)) * f.x;
+            bottom + (top - bottom) * f.y
+        })
     }
 
     fn position(t: &Textures<'_>, p: Vec2, layers: u32, tau: f32) -> Vec3 {
@@ -1048,12 +1081,17 @@ mod from_the_document {
                 0.0
             };
         }
+        let [m_d, m_l, m_c] = root_map_values(t, root_uv);
+        let rank = (j as f32 + 0.5) / per_bundle as f32;
+        length *= if rank < m_d { m_l } else { 0.0 };
         let x_c = root_uv * params.clump.clumps_per_uv.max(1.0) as f32;
         let layers = bundle.layers;
         (0..n)
             .map(|k| {
-                let along = k as f32 / (n - 1) as f32;
-                let tau = layers as f32 * length * along;
+                let drawn = k as f32 / (n - 1) as f32;
+                let tau = layers as f32 * length * drawn;
+                // A cut strand's ops read `along · m_l`.
+                let along = drawn * m_l;
                 let mut x = position(t, p, layers, tau);
                 if k == 0 || length <= 0.0 {
                     return x;
@@ -1121,8 +1159,9 @@ mod from_the_document {
                     } else {
                         Vec2::ZERO
                     };
-                    let pull = main * (clump.strength * clump.radius_m) as f32
-                        + sub * (clump.sub_strength * clump.sub_radius_m) as f32;
+                    let pull = (main * (clump.strength * clump.radius_m) as f32
+                        + sub * (clump.sub_strength * clump.sub_radius_m) as f32)
+                        * m_c;
                     offset +=
                         along.powf(clump.tightening.max(0.0) as f32) * (pull.x * u + pull.y * v);
                 }
@@ -1181,6 +1220,7 @@ fn an_implementation_of_the_document_matches_the_cpu_mirror() {
         u: &textures.u,
         v: &textures.v,
         position_offset: Vec3::from_array(manifest.position_offset),
+        root_maps: None,
     };
     let mirror = StrandGen {
         textures,
@@ -1259,6 +1299,75 @@ fn an_implementation_of_the_document_matches_the_cpu_mirror() {
     };
     let worst = compare(&hairline_textures, &ours, &hairline_params);
     eprintln!("with the hairline: {worst:.3e} m");
+    assert!(worst <= 1e-5 * size, "{worst} m");
+    // Painted maps, read as the document says: a density ramp across the bundle's uv, half
+    // length on one side, clump fading out; loaded back from the bundle's own texture.
+    let mut painted = document.clone();
+    let (lo, hi) = painted
+        .hair_mesh
+        .bundles
+        .iter()
+        .flat_map(|b| b.uvs.iter().copied())
+        .fold(
+            (glam::DVec2::splat(1.0), glam::DVec2::ZERO),
+            |(lo, hi), uv| (lo.min(uv), hi.max(uv)),
+        );
+    let side = 16u32;
+    let image = |value: &dyn Fn(f64) -> f64| -> Vec<f64> {
+        (0..side * side)
+            .map(|i| {
+                let u = ((i % side) as f64 + 0.5) / side as f64;
+                value(((u - lo.x) / (hi.x - lo.x).max(1e-9)).clamp(0.0, 1.0))
+            })
+            .collect()
+    };
+    for (channel, values) in [
+        (RootMapChannel::Density, image(&|s| 0.2 + 0.8 * s)),
+        (
+            RootMapChannel::Length,
+            image(&|s| if s < 0.5 { 0.5 } else { 1.0 }),
+        ),
+        (RootMapChannel::Clump, image(&|s| 1.0 - s)),
+    ] {
+        painted
+            .root_maps
+            .set_channel_from_image(channel, side, side, &values)
+            .expect("map");
+    }
+    let painted_hair = example_hair(&painted);
+    let painted_files: std::collections::HashMap<String, Vec<u8>> = bundle_files(&painted_hair)
+        .expect("export")
+        .into_iter()
+        .collect();
+    let loaded = load_runtime_asset_from(&painted_files, "memory")
+        .expect("loads")
+        .hair;
+    let maps = &loaded.textures.root_maps;
+    let bytes = maps.rgba8();
+    let ours_painted = from_the_document::Textures {
+        hair_mesh: &loaded.textures.hair_mesh,
+        uv: &loaded.textures.uv,
+        w: &loaded.textures.w,
+        u: &loaded.textures.u,
+        v: &loaded.textures.v,
+        position_offset: loaded.textures.position_offset,
+        root_maps: Some((maps.width(), maps.height(), &bytes)),
+    };
+    let painted_mirror = StrandGen {
+        textures: &painted_hair.textures,
+        filtering: Filtering::Exact,
+    };
+    let grown: Vec<f64> = hair
+        .strand_roots()
+        .iter()
+        .map(|root| painted_mirror.strand_input(root, &params).length_fraction)
+        .collect();
+    assert!(
+        grown.contains(&0.0) && grown.iter().any(|&l| l > 0.0),
+        "the maps leave some strands out and grow others: {grown:?}"
+    );
+    let worst = compare(&painted_hair.textures, &ours_painted, &params);
+    eprintln!("with painted maps: {worst:.3e} m");
     assert!(worst <= 1e-5 * size, "{worst} m");
     // The strands compared include strays and clumped strands both.
     let strays: Vec<bool> = hair

@@ -750,3 +750,83 @@ fn renders_give_curly_styles_the_vertices_their_turns_need() {
     assert_eq!(export("head_curly"), 6);
     assert_eq!(export("head_long_straight"), 5);
 }
+
+/// Issue 35: `maps` brings a density map painted elsewhere (a grey PNG over the scalp's uv)
+/// into a project as one undo step that `check` accepts and that thins the export; an
+/// oversized image, a file that is not an image and an unknown map are refused by name,
+/// leaving the project as it was.
+#[test]
+fn maps_brings_painted_images_in_as_one_undo_step_and_refuses_bad_ones_by_name() {
+    use hairloom_core::model::root_maps::RootMapChannel;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sample = samples()
+        .into_iter()
+        .find(|p| p.to_string_lossy().contains("short"))
+        .expect("short sample");
+    let project = dir.path().join("maps.hairloom");
+    std::fs::copy(&sample, &project).expect("copy");
+    let before = hairloom_core::io::project::load(&project).expect("load");
+    // 16 × 8: black on the left half (no hair), white on the right.
+    let density = dir.path().join("density.png");
+    image::GrayImage::from_fn(16, 8, |x, _| image::Luma([if x < 8 { 0 } else { 255 }]))
+        .save(&density)
+        .expect("png");
+    let (code, stdout, stderr) = run(hairloom()
+        .arg("maps")
+        .arg(&project)
+        .arg("--density")
+        .arg(&density));
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("density from"), "{stdout}");
+    let after = hairloom_core::io::project::load(&project).expect("load");
+    let maps = &after.document.root_maps;
+    assert_eq!((maps.width(), maps.height()), (16, 8));
+    let density_values = maps.channel_values(RootMapChannel::Density);
+    assert_eq!(density_values[0], 0.0);
+    assert_eq!(density_values[15], 1.0);
+    assert_eq!(after.history.undo.len(), before.history.undo.len() + 1);
+    assert_eq!(
+        after.history.undo.last().expect("a step").label(),
+        "Import maps"
+    );
+    let (code, _, stderr) = run(hairloom().arg("check").arg(&project));
+    assert_eq!(code, 0, "{stderr}");
+    let saved = std::fs::read(&project).expect("read");
+    for (args, names) in [
+        (
+            vec!["--density".to_string(), "huge".to_string()],
+            "larger than 4096",
+        ),
+        (
+            vec!["--length".to_string(), "text".to_string()],
+            "not an image",
+        ),
+        (vec!["--clear".to_string(), "fuzz".to_string()], "not a map"),
+        (vec![], "nothing to do"),
+    ] {
+        let huge = dir.path().join("huge");
+        image::GrayImage::new(4097, 1)
+            .save_with_format(&huge, image::ImageFormat::Png)
+            .expect("png");
+        std::fs::write(dir.path().join("text"), "not a picture").expect("write");
+        let mut command = hairloom();
+        command.arg("maps").arg(&project).current_dir(dir.path());
+        command.args(&args);
+        let (code, _, stderr) = run(&mut command);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(stderr.contains(names), "{args:?}: {stderr}");
+        assert_eq!(
+            std::fs::read(&project).expect("read"),
+            saved,
+            "left as it was"
+        );
+    }
+    // Clearing the only painted map takes the texture away.
+    let (code, _, stderr) = run(hairloom()
+        .arg("maps")
+        .arg(&project)
+        .args(["--clear", "density"]));
+    assert_eq!(code, 0, "{stderr}");
+    let cleared = hairloom_core::io::project::load(&project).expect("load");
+    assert!(cleared.document.root_maps.is_empty());
+}

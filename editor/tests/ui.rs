@@ -79,7 +79,7 @@ fn a_styling_slider_change_is_one_undo_step() {
 fn the_styling_structure_ops_have_sliders() {
     let mut harness = harness();
     type Read = fn(&hairloom_core::model::styling::StylingParams) -> f64;
-    let sliders: [(&str, f64, Read); 8] = [
+    let sliders: [(&str, f64, Read); 9] = [
         ("Ringlets (curl shared by a clump)", 0.7, |p| {
             p.curl.clump_coherence
         }),
@@ -91,6 +91,7 @@ fn the_styling_structure_ops_have_sliders() {
         ("Wave spread between clumps", 0.25, |p| {
             p.wave.lock_phase_spread
         }),
+        ("Strands per cm²", 60.0, |p| p.density.strands_per_cm2),
         ("Wave shared by a clump", 0.35, |p| p.wave.clump_coherence),
     ];
     for (i, (label, value, read)) in sliders.into_iter().enumerate() {
@@ -920,6 +921,36 @@ fn save_as_suggests_a_project_opened_by_a_relative_path_where_it_is() {
 /// A left-button drag from `from` to `to` in steps (a region selection in the viewport).
 fn drag(harness: &mut Harness<'static, HairloomApp>, from: egui::Pos2, to: egui::Pos2) {
     drag_with(harness, from, to, false);
+}
+
+/// A point of the viewport where the brush's circle says it touches (hair, or the scalp for
+/// a map brush), searched over `rows` twentieths of the height, off the head's centre line
+/// so an X-mirrored stroke is a stroke of its own.
+fn brush_start(
+    harness: &mut Harness<'static, HairloomApp>,
+    rows: std::ops::Range<u32>,
+) -> Option<egui::Pos2> {
+    let rect = viewport_rect(harness);
+    for row in rows {
+        for column in [4, 6, 3, 7] {
+            let at = rect.left_top()
+                + egui::vec2(
+                    rect.width() * column as f32 / 10.0,
+                    rect.height() * row as f32 / 20.0,
+                );
+            harness.hover_at(at);
+            harness.run();
+            if harness
+                .state()
+                .viewport
+                .brush_cursor
+                .is_some_and(|c| c.touches_hair && c.radius_px > 2.0)
+            {
+                return Some(at);
+            }
+        }
+    }
+    None
 }
 
 fn viewport_rect(harness: &Harness<'static, HairloomApp>) -> egui::Rect {
@@ -2470,31 +2501,8 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
     let original = harness.state().state.document().clone();
     harness.get_by_label("Groom").click();
     harness.run();
-    let rect = viewport_rect(&harness);
-    // Find a point over the hair: the brush's circle says when it touches.
-    let mut start = None;
-    // Off the head's centre line, so the X-mirror's image is a stroke of its own.
-    'search: for row in 2..12 {
-        for column in [4, 6, 3, 7] {
-            let at = rect.left_top()
-                + egui::vec2(
-                    rect.width() * column as f32 / 10.0,
-                    rect.height() * row as f32 / 20.0,
-                );
-            harness.hover_at(at);
-            harness.run();
-            if harness
-                .state()
-                .viewport
-                .brush_cursor
-                .is_some_and(|c| c.touches_hair && c.radius_px > 2.0)
-            {
-                start = Some(at);
-                break 'search;
-            }
-        }
-    }
-    let start = start.expect("some point of the viewport shows hair under the brush");
+    let start = brush_start(&mut harness, 2..12)
+        .expect("some point of the viewport shows hair under the brush");
     drag(&mut harness, start, start + egui::vec2(70.0, 30.0));
     let combed = harness.state().state.document().clone();
     assert!(
@@ -2593,4 +2601,103 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
         harness.state().state.project.history.undo[0].label(),
         "Grow / cut brush"
     );
+}
+
+/// Issue 35: with Drag ▸ Groom and Paint map ▸ Density map at value 0, a stroke over the head
+/// paints a bald patch into the density map (on both sides with X-mirror) as one undo step
+/// that undo takes back; the strands there stop growing; Clear density map forgets it.
+#[test]
+fn painting_the_density_map_thins_the_hair_as_one_undo_step() {
+    use hairloom_core::model::root_maps::RootMapChannel;
+    let mut harness = harness();
+    harness.set_size(egui::vec2(1100.0, 720.0));
+    harness.run();
+    let original = harness.state().state.document().clone();
+    assert!(original.root_maps.is_empty());
+    harness.get_by_label("Groom").click();
+    harness.run();
+    harness.get_by_label("Density map").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.tool.brush.paint,
+        Some(RootMapChannel::Density)
+    );
+    // Value 0 is the default: paint where hair does not grow.
+    assert_eq!(harness.state().state.tool.brush.paint_value, 0.0);
+    // The field that finds the scalp under the pointer is built off the UI thread: wait.
+    for _ in 0..600 {
+        if harness.state().viewport.brush_field_status() == "ready" {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        harness.run();
+    }
+    let start = brush_start(&mut harness, 3..12)
+        .expect("some point of the viewport shows the scalp under the brush");
+    drag(&mut harness, start, start + egui::vec2(60.0, 20.0));
+    let painted = harness.state().state.document().clone();
+    let message = harness.state().state.message.clone();
+    assert_eq!(
+        painted.hair_mesh, original.hair_mesh,
+        "painting moves no hair"
+    );
+    assert!(!painted.root_maps.is_empty(), "{message}");
+    let bald = painted
+        .root_maps
+        .texels()
+        .iter()
+        .filter(|t| t[0] < 128)
+        .count();
+    assert!(bald > 20, "{bald} texels painted bald: {message}");
+    assert!(
+        painted
+            .root_maps
+            .texels()
+            .iter()
+            .all(|t| t[1] == 255 && t[2] == 255),
+        "only the density map changed"
+    );
+    let history = &harness.state().state.project.history;
+    assert_eq!(history.undo.len(), 1, "{message}");
+    assert_eq!(history.undo[0].label(), "Paint density");
+    // Strands there no longer grow: fewer reference strands than before.
+    let grown = |document: &hairloom_core::model::document::Document| {
+        let runtime = hairloom_core::runtime::hair::RuntimeHair::from_document(
+            document,
+            &hairloom_core::runtime::hair::RuntimeOptions {
+                strands_per_bundle: 4,
+                ..Default::default()
+            },
+        );
+        let generator = hairloom_core::runtime::strand_gen::StrandGen {
+            textures: &runtime.textures,
+            filtering: hairloom_core::runtime::strand_gen::Filtering::Exact,
+        };
+        runtime
+            .strand_roots()
+            .iter()
+            .filter(|root| {
+                generator
+                    .strand_input(root, &document.styling.global)
+                    .length_fraction
+                    > 0.0
+            })
+            .count()
+    };
+    assert!(grown(&painted) < grown(&original));
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert!(harness.state().state.document().root_maps.is_empty());
+    harness.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().root_maps,
+        painted.root_maps
+    );
+    harness.get_by_label("Clear density map").click();
+    harness.run();
+    assert!(harness.state().state.document().root_maps.is_empty());
 }

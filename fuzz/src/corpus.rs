@@ -181,6 +181,17 @@ fn strand_export_seeds() -> Vec<(String, Vec<u8>)> {
     ]
 }
 
+/// 4 × 2 painted maps: density, length and clump each falling across u.
+fn painted_maps() -> hairloom_core::model::root_maps::RootMaps {
+    use hairloom_core::model::root_maps::{RootMapChannel, RootMaps};
+    let mut maps = RootMaps::blank(4, 2).expect("maps");
+    for channel in RootMapChannel::ALL {
+        maps.set_channel_from_image(channel, 2, 1, &[0.2, 0.9])
+            .expect("map");
+    }
+    maps
+}
+
 fn project_seeds() -> Vec<(String, Vec<u8>)> {
     use hairloom_core::edit::{ExtrudeDirection, extrude};
     let mut project = Project::new(Document::new(
@@ -204,6 +215,12 @@ fn project_seeds() -> Vec<(String, Vec<u8>)> {
         .history
         .commit(&mut project.document, "Curl", curled);
     let _ = project.history.undo(&mut project.document);
+    // Painted maps, in the document and in a history step.
+    let mut painted = project.document.clone();
+    painted.root_maps = painted_maps();
+    project
+        .history
+        .commit(&mut project.document, "Paint density", painted);
     let valid = hairloom_core::io::project::to_bytes(&project);
     let mut deep: Value = serde_json::from_slice(&valid).expect("json");
     deep["document"]["hair_mesh"]["bundles"][0]["layers"] = json!(20_000);
@@ -214,6 +231,10 @@ fn project_seeds() -> Vec<(String, Vec<u8>)> {
     scene["document"]["scene"]["lights"][0]["source"]["directional"]["to_light"] = json!([0, 0, 0]);
     scene["document"]["scene"]["effects"]["shadow_resolution"] = json!(4_294_967_295u64);
     scene["document"]["scene"]["material"]["longitudinal_roughness"] = json!(1e39);
+    // Painted maps claiming 4096² texels with 8 bytes of them.
+    let mut maps: Value = serde_json::from_slice(&valid).expect("json");
+    maps["document"]["root_maps"] =
+        json!({"width": 4096, "height": 4096, "rgba8_base64": "AAAAAAAAAAA="});
     vec![
         ("grid_with_history.hairloom".into(), valid),
         (
@@ -227,6 +248,10 @@ fn project_seeds() -> Vec<(String, Vec<u8>)> {
         (
             "crafted_scene_zero_light_huge_shadow_map.hairloom".into(),
             serde_json::to_vec(&scene).expect("json"),
+        ),
+        (
+            "crafted_root_maps_4096_short.hairloom".into(),
+            serde_json::to_vec(&maps).expect("json"),
         ),
     ]
 }
@@ -307,9 +332,10 @@ fn gltf_seeds() -> Vec<(String, Vec<u8>)> {
     seeds
 }
 
-/// A small valid bundle with a body, so every file kind is present.
+/// A small valid bundle with a body and painted maps, so every file kind is present.
 pub fn bundle_with_body_files() -> Vec<(String, Vec<u8>)> {
     let mut document = hairloom_tests::bundle_variant(0);
+    document.root_maps = painted_maps();
     document.body = BodyMesh {
         positions: vec![[0.0, 0.0, -0.1], [3.0, 0.0, -0.1], [0.0, 3.0, -0.1]],
         triangles: vec![[0, 1, 2]],

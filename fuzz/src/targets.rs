@@ -139,6 +139,10 @@ fn runtime_bundle(input: &[u8]) {
     for block in 0..hair.textures.atlas.blocks.len().min(64) {
         let _ = generator.position(block, 0.3, 0.6, 0.7);
     }
+    // Each root's set-up reads the painted maps at its root uv.
+    for root in hair.strand_roots().iter().take(256) {
+        let _ = generator.strand_input(root, &hair.styling.global);
+    }
 }
 
 fn ktx2(input: &[u8]) {
@@ -157,6 +161,7 @@ fn ktx2(input: &[u8]) {
         TexelFormat::Rgba16Float,
         TexelFormat::Rg16Float,
         TexelFormat::R16Float,
+        TexelFormat::Rgba8Unorm,
     ]
     .into_iter()
     .find(|f| f.vk_number() == word(12))

@@ -15,6 +15,7 @@ use glam::Vec3;
 use hairloom_core::fur::base::FurBase;
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::document::Document;
+use hairloom_core::model::root_maps::RootMaps;
 use hairloom_core::model::scene::FurShells;
 use hairloom_core::model::styling::StylingSet;
 use hairloom_core::runtime::frame_plan::LodSettings;
@@ -44,10 +45,26 @@ pub enum HairAssetError {
     FarHair(#[from] hairloom_core::runtime::thick_hair::ThickHairError),
 }
 
+/// What a restyle carries: the styling parameters and the painted maps (both read per
+/// strand; neither moves the hair mesh).
+pub struct Restyling {
+    pub styling: StylingSet,
+    pub root_maps: RootMaps,
+}
+
+impl Restyling {
+    pub fn of(document: &Document) -> Self {
+        Self {
+            styling: document.styling.clone(),
+            root_maps: document.root_maps.clone(),
+        }
+    }
+}
+
 /// The CPU side of a change, ready for the GPU.
 pub enum AssetChange {
-    /// New styling for the asset on the GPU.
-    Restyle(Box<StylingSet>),
+    /// New styling and painted maps for the asset on the GPU.
+    Restyle(Box<Restyling>),
     /// The runtime data made again: taken in place when only positions moved
     /// ([`ChangeKind::Reshape`]), uploaded afresh otherwise.
     Hair {
@@ -63,7 +80,7 @@ impl AssetChange {
     pub fn build(document: &Document, kind: ChangeKind, options: &RuntimeOptions) -> Option<Self> {
         match kind {
             ChangeKind::Scene => None,
-            ChangeKind::Restyle => Some(AssetChange::Restyle(Box::new(document.styling.clone()))),
+            ChangeKind::Restyle => Some(AssetChange::Restyle(Box::new(Restyling::of(document)))),
             ChangeKind::Reshape | ChangeKind::Rebuild => Some(AssetChange::Hair {
                 hair: Box::new(RuntimeHair::from_document(document, options)),
                 kind,
@@ -84,7 +101,8 @@ impl AssetChange {
         match (self, later) {
             (_, AssetChange::Hair { hair, .. }) => AssetChange::Hair { hair, kind },
             (AssetChange::Hair { mut hair, .. }, AssetChange::Restyle(styling)) => {
-                hair.set_styling(&styling);
+                hair.set_styling(&styling.styling);
+                hair.textures.root_maps = styling.root_maps;
                 AssetChange::Hair { hair, kind }
             }
             (AssetChange::Restyle(_), restyle) => restyle,
@@ -160,7 +178,8 @@ impl HairAsset {
     ) -> Result<ChangeKind, HairAssetError> {
         match change {
             AssetChange::Restyle(styling) => {
-                self.hair.set_styling(&styling);
+                self.hair.set_styling(&styling.styling);
+                self.hair.textures.root_maps = styling.root_maps;
                 generator.update_styling(context, &mut self.gpu, &self.hair);
                 self.vertices_log2 = self.hair.strand_vertices_log2();
                 Ok(ChangeKind::Restyle)

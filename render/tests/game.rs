@@ -11,7 +11,7 @@ use hairloom_render::device::headless_for_test;
 use hairloom_render::game::{
     GameCamera, GameFrameStats, GameHair, GameHairError, HairId, game_scene,
 };
-use hairloom_render::hair_asset::AssetChange;
+use hairloom_render::hair_asset::{AssetChange, Restyling};
 use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
 use hairloom_render::renderer::Targets;
 use hairloom_render::renderer::preview_body::GpuBody;
@@ -287,7 +287,7 @@ fn a_restyle_reaches_the_game_in_place_and_matches_a_fresh_bundle() {
     let curl = &mut document.styling.global.curl;
     curl.radius_m = 0.01;
     curl.turns_per_m = 60.0;
-    game.apply(AssetChange::Restyle(Box::new(document.styling.clone())))
+    game.apply(AssetChange::Restyle(Box::new(Restyling::of(&document))))
         .expect("a restyle");
     let (_, curled) = draw(&context, &mut game, &view, &game_camera, background);
     assert_eq!(game.resident_bytes(), resident, "a restyle allocated");

@@ -628,3 +628,160 @@ fn gpu_far_levels_match_the_cpu_mirror_and_settle() {
         "{mean_levels:?}"
     );
 }
+
+/// Painted maps in root-uv space (density, length, clump): the GPU thins, shortens and
+/// unclumps the strands exactly as the CPU mirror does, on the compute and the
+/// vertex-shader paths, and a repaint taken in place (a new map size included) generates
+/// what a fresh upload does.
+#[test]
+fn painted_maps_thin_shorten_and_unclump_on_the_gpu_as_on_the_cpu() {
+    use hairloom_core::model::root_maps::{RootMapChannel, RootMaps};
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let renderers = compute_renderers(&context);
+    let mut document = common::sample("head_curly");
+    document.styling.global.clump.strength = 0.8;
+    // 64² maps over uv [0, 1]²: no hair left of u = 0.5; half length above v = 0.5; no
+    // clumping right of u = 0.6 (the scalp spans u 0.26 … 0.75).
+    let side = 64u32;
+    let image = |value: &dyn Fn(f64, f64) -> f64| -> Vec<f64> {
+        (0..side * side)
+            .map(|i| {
+                let (x, y) = (i % side, i / side);
+                value(
+                    (x as f64 + 0.5) / side as f64,
+                    (y as f64 + 0.5) / side as f64,
+                )
+            })
+            .collect()
+    };
+    let mut maps = RootMaps::default();
+    for (channel, values) in [
+        (
+            RootMapChannel::Density,
+            image(&|u, _| if u < 0.5 { 0.0 } else { 1.0 }),
+        ),
+        (
+            RootMapChannel::Length,
+            image(&|_, v| if v < 0.5 { 0.5 } else { 1.0 }),
+        ),
+        (
+            RootMapChannel::Clump,
+            image(&|u, _| if u > 0.6 { 0.0 } else { 1.0 }),
+        ),
+    ] {
+        maps.set_channel_from_image(channel, side, side, &values)
+            .expect("map");
+    }
+    document.root_maps = maps;
+    let options = RuntimeOptions {
+        strands_per_bundle: 8,
+        sample_seed: 5,
+        ..RuntimeOptions::default()
+    };
+    let runtime = RuntimeHair::from_document(&document, &options);
+    let roots = runtime.strand_roots();
+    let mirror = StrandGen {
+        textures: &runtime.textures,
+        filtering: Filtering::Exact,
+    };
+    let params = [&document.styling.global];
+    // The mirror itself obeys the maps.
+    let (mut bare, mut halved, mut grown) = (0, 0, 0);
+    let unpainted = RuntimeHair::from_document(
+        &hairloom_core::model::document::Document {
+            root_maps: RootMaps::default(),
+            ..document.clone()
+        },
+        &options,
+    );
+    let plain = StrandGen {
+        textures: &unpainted.textures,
+        filtering: Filtering::Exact,
+    };
+    for root in &roots {
+        let input = mirror.strand_input(root, params[0]);
+        let full = plain.strand_input(root, params[0]);
+        let (u, v) = (input.root_uv.x, input.root_uv.y);
+        // Bilinear reads blend across one texel (1/64) at each edge: judged outside it.
+        if u < 0.48 {
+            assert_eq!(input.length_fraction, 0.0, "no hair left of u = 0.5");
+            bare += 1;
+        } else if u > 0.52 {
+            grown += 1;
+            let expected = if v < 0.48 {
+                0.5
+            } else if v > 0.52 {
+                1.0
+            } else {
+                continue;
+            };
+            assert!(
+                (input.length_fraction - expected * full.length_fraction).abs() < 0.01,
+                "length map at {u:.3}, {v:.3}: {} of {}",
+                input.length_fraction,
+                full.length_fraction
+            );
+            if expected == 0.5 {
+                halved += 1;
+            }
+            if u > 0.62 {
+                assert_eq!(input.styling.clump_pull, glam::DVec2::ZERO);
+            } else if u < 0.58 {
+                assert_eq!(input.styling.clump_pull, full.styling.clump_pull);
+            }
+        }
+    }
+    assert!(
+        bare > 100 && grown > 100 && halved > 50,
+        "{bare} {grown} {halved}"
+    );
+    let vertex_count = 9u32;
+    let plan = full_detail_plan(roots.len(), vertex_count);
+    let expected = mirror.main(&roots, &plan.batches[0], &params);
+    let size = document.hair_mesh.size() as f32;
+    let worst_of = |positions: &[[f32; 4]]| {
+        positions
+            .iter()
+            .zip(&expected)
+            .map(|(g, e)| glam::Vec3::new(g[0], g[1], g[2]).distance(*e))
+            .fold(0.0f32, f32::max)
+    };
+    let mut gpu = renderers[0].upload(&context, &runtime).expect("upload");
+    let painted = renderers[0]
+        .generate_positions(&context, &gpu, &plan, Filtering::Exact)
+        .expect("positions");
+    for renderer in &renderers {
+        let positions = renderer
+            .generate_positions(&context, &gpu, &plan, Filtering::Exact)
+            .expect("positions");
+        let worst = worst_of(&positions);
+        eprintln!(
+            "painted maps, {:?}: max |GPU − CPU mirror| = {worst:.3e}",
+            renderer.path()
+        );
+        assert!(worst <= 1e-5 * size, "{worst}");
+    }
+    // Repainted in place at another size: what a fresh upload of the new maps generates.
+    let mut repainted = document.clone();
+    let mut small = RootMaps::blank(8, 8).expect("maps");
+    small
+        .set_channel_from_image(RootMapChannel::Density, 1, 1, &[0.3])
+        .expect("map");
+    repainted.root_maps = small;
+    let mut runtime = runtime;
+    runtime.textures.root_maps = repainted.root_maps.clone();
+    renderers[0].update_styling(&context, &mut gpu, &runtime);
+    let fresh = renderers[0]
+        .upload(&context, &RuntimeHair::from_document(&repainted, &options))
+        .expect("upload");
+    let in_place = renderers[0]
+        .generate_positions(&context, &gpu, &plan, Filtering::Exact)
+        .expect("in place");
+    let uploaded = renderers[0]
+        .generate_positions(&context, &fresh, &plan, Filtering::Exact)
+        .expect("fresh");
+    assert_eq!(in_place, uploaded);
+    assert_ne!(in_place, painted, "the repaint took");
+}

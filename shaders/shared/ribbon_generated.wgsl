@@ -19,6 +19,7 @@
 @group(0) @binding(23) var u_texture: texture_3d<f32>;
 @group(0) @binding(24) var v_texture: texture_3d<f32>;
 @group(0) @binding(25) var<storage, read> styling: array<Styling>;
+@group(0) @binding(31) var root_maps: texture_2d<f32>;
 @group(0) @binding(27) var<storage, read> samples: array<vec2<f32>>;
 
 fn ribbon_centre(vertex_index: u32, instance_index: u32) -> RibbonCentre {

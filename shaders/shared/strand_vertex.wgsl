@@ -3,7 +3,7 @@
 // vertex shader (shared/ribbon_generated.wgsl). WGSL has no #include: render/src/ prepends
 // this file; the including shader declares the globals it reads — `params`, `bundles`,
 // `samples`, `styling`, `hair_mesh`, `uv_texture`, `u_texture`, `v_texture`, `w_texture`,
-// `linear_clamp` — at its own bindings.
+// `root_maps`, `linear_clamp` — at its own bindings.
 // CPU mirror: core/src/runtime/strand_gen.rs (`fetch`, `StrandGen::strand_position`,
 // `strand_root`, `StrandGen::strand_input`, `StrandGen::styled_vertex`).
 // Structs: keep in sync with core/src/runtime/gpu_types.rs.
@@ -119,6 +119,32 @@ fn fetch_exact(texture: texture_3d<f32>, coord: vec3<f32>) -> vec4<f32> {
     let top1 = c011 + (c111 - c011) * f.x;
     let plane1 = bottom1 + (top1 - bottom1) * f.y;
     return plane0 + (plane1 - plane0) * f.z;
+}
+
+// The painted maps at root uv `uv`: (density, length, clump, _) shares, bilinear between
+// texel centres, clamped at the edges (mirror: RootMaps::sample). With nothing painted the
+// texture is one white texel: 1 everywhere.
+fn root_map_values(uv: vec2<f32>) -> vec4<f32> {
+    let size = vec2<i32>(textureDimensions(root_maps));
+    var x = clamp(uv * vec2<f32>(size) - vec2<f32>(0.5), vec2<f32>(0.0), vec2<f32>(size - vec2<i32>(1)));
+    // A NaN uv reads texel (0, 0), as the mirror does.
+    x = select(x, vec2<f32>(0.0), x != x);
+    let i0 = min(vec2<i32>(floor(x)), size - vec2<i32>(1));
+    let f = x - vec2<f32>(i0);
+    let i1 = min(i0 + vec2<i32>(1), size - vec2<i32>(1));
+    let c00 = textureLoad(root_maps, vec2<i32>(i0.x, i0.y), 0);
+    let c10 = textureLoad(root_maps, vec2<i32>(i1.x, i0.y), 0);
+    let c01 = textureLoad(root_maps, vec2<i32>(i0.x, i1.y), 0);
+    let c11 = textureLoad(root_maps, vec2<i32>(i1.x, i1.y), 0);
+    let bottom = c00 + (c10 - c00) * f.x;
+    let top = c01 + (c11 - c01) * f.x;
+    return bottom + (top - bottom) * f.y;
+}
+
+// The share of its length a strand of rank `rank` keeps under the maps: 0 where the density
+// map does not grow it (mirror: RootMapValues::length_scale).
+fn root_map_length_scale(maps: vec4<f32>, rank: f32) -> f32 {
+    return select(0.0, maps.y, rank < maps.x);
 }
 
 // The filtering switch: exact (manual, f32 weights) or the texture unit's (8-bit weights).
@@ -508,6 +534,9 @@ struct StrandInput {
     root_uv: vec2<f32>,
     length_fraction: f32,
     constants: StrandConstants,
+    // The painted length map's share (1 without maps): a cut strand's styling reads
+    // along · cut, the first part of the strand it would be.
+    cut: f32,
 }
 
 // What every vertex of root `root_index`'s strand shares (mirror: StrandGen::strand_input).
@@ -525,9 +554,15 @@ fn strand_input(root_index: u32) -> StrandInput {
     // The root slice's fourth channel: the root's distance to the border of the hair
     // (always exact: it decides whether the strand grows).
     let hairline_distance = fetch_exact(hair_mesh, vec3<f32>(root.texel, 0.5)).w;
+    // The painted maps at the root (exact too: density decides whether it grows).
+    let maps = root_map_values(input.root_uv);
     input.length_fraction = strand_length_fraction(input.style, input.root_uv)
-        * hairline_length_scale(input.style, hairline_distance, root.rank);
+        * hairline_length_scale(input.style, hairline_distance, root.rank)
+        * root_map_length_scale(maps, root.rank);
     input.constants = strand_constants(input.style, input.root_uv);
+    input.constants.clump_pull *= maps.z;
+    input.constants.sub_clump_pull *= maps.z;
+    input.cut = maps.y;
     return input;
 }
 
@@ -551,7 +586,7 @@ fn styled_vertex(input: StrandInput, k: u32, n: u32) -> vec3<f32> {
         let centre = strand_position(root.centre_texel, root.layers, tau);
         p = twist(s, p, centre, w_axis, w);
     }
-    return p + styling_offset(s, input.constants, u, v, w, along);
+    return p + styling_offset(s, input.constants, u, v, w, along * input.cut);
 }
 
 fn along_of(k: u32, n: u32) -> f32 {

@@ -14,6 +14,7 @@
 
 pub mod brush;
 pub mod coordinates;
+pub mod paint_maps;
 pub mod pick;
 pub mod select;
 pub mod split_merge;

@@ -267,7 +267,7 @@ pub fn fit(
         let areas: Vec<f64> = mesh
             .bundles
             .iter()
-            .map(|b| face_area(&mesh, &b.vertices))
+            .map(|b| mesh.root_face_area(&b.vertices))
             .collect();
         let mut densities: Vec<f64> = strands_in
             .iter()
@@ -610,16 +610,6 @@ fn scalp_point(mesh: &HairMesh, hit: &RootHit) -> DVec3 {
         .enumerate()
         .map(|(a, &c)| mesh.columns[c as usize].positions[0] * w[a])
         .sum()
-}
-
-fn face_area(mesh: &HairMesh, vertices: &[u32]) -> f64 {
-    let p = |i: usize| mesh.columns[vertices[i] as usize].positions[0];
-    let tri = |a: DVec3, b: DVec3, c: DVec3| 0.5 * (b - a).cross(c - a).length();
-    if vertices.len() == 3 {
-        tri(p(0), p(1), p(2))
-    } else {
-        tri(p(0), p(1), p(2)) + tri(p(0), p(2), p(3))
-    }
 }
 
 /// A hair mesh's root layer alone: every face bare, every column one vertex.

@@ -17,6 +17,8 @@ pub enum TexelFormat {
     Rgba16Float,
     Rg16Float,
     R16Float,
+    /// The painted maps (`root_maps`): bytes, read as byte / 255.
+    Rgba8Unorm,
 }
 
 impl TexelFormat {
@@ -28,6 +30,7 @@ impl TexelFormat {
             Self::Rgba16Float => "R16G16B16A16_SFLOAT",
             Self::Rg16Float => "R16G16_SFLOAT",
             Self::R16Float => "R16_SFLOAT",
+            Self::Rgba8Unorm => "R8G8B8A8_UNORM",
         }
     }
 
@@ -44,12 +47,13 @@ impl TexelFormat {
             Self::Rgba16Float => ktx2::Format::R16G16B16A16_SFLOAT,
             Self::Rg16Float => ktx2::Format::R16G16_SFLOAT,
             Self::R16Float => ktx2::Format::R16_SFLOAT,
+            Self::Rgba8Unorm => ktx2::Format::R8G8B8A8_UNORM,
         }
     }
 
     pub fn channels(self) -> usize {
         match self {
-            Self::Rgba32Float | Self::Rgba16Float => 4,
+            Self::Rgba32Float | Self::Rgba16Float | Self::Rgba8Unorm => 4,
             Self::Rg32Float | Self::Rg16Float => 2,
             Self::R32Float | Self::R16Float => 1,
         }
@@ -58,6 +62,7 @@ impl TexelFormat {
     pub fn bytes_per_channel(self) -> usize {
         match self {
             Self::Rgba32Float | Self::Rg32Float | Self::R32Float => 4,
+            Self::Rgba8Unorm => 1,
             _ => 2,
         }
     }
@@ -85,6 +90,8 @@ pub fn texel_bytes(texels: &[Vec4], format: TexelFormat) -> Vec<u8> {
         for c in 0..channels {
             if format.bytes_per_channel() == 4 {
                 out.extend_from_slice(&texel[c].to_le_bytes());
+            } else if format.bytes_per_channel() == 1 {
+                out.push((texel[c].clamp(0.0, 1.0) * 255.0).round() as u8);
             } else {
                 out.extend_from_slice(&f16_bits(texel[c]).to_le_bytes());
             }
@@ -272,7 +279,9 @@ pub fn read_texture(
     for chunk in data.chunks_exact(texel_bytes) {
         let mut texel = Vec4::ZERO;
         for c in 0..channels {
-            let value = if format.bytes_per_channel() == 4 {
+            let value = if format.bytes_per_channel() == 1 {
+                chunk[c] as f32 / 255.0
+            } else if format.bytes_per_channel() == 4 {
                 f32::from_le_bytes([
                     chunk[4 * c],
                     chunk[4 * c + 1],

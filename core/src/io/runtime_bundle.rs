@@ -15,7 +15,9 @@ pub use crate::runtime::hair::LodEntry;
 use crate::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 
-/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 7
+/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 8
+/// adds painted maps (`manifest.root_maps`: density, length and clump in root-uv space; a
+/// version 7 reader would grow every strand where the maps thin or shorten them). Version 7
 /// adds `wave.lock_phase_spread` (how far apart the locks' wave phases lie; absent means 1,
 /// the phases older bundles had; a version 6 reader would draw other waves). Version 6
 /// adds the hairline op: the `hairline` styling keys and each root's distance to the border
@@ -27,7 +29,7 @@ use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, T
 /// segment (`p_k, q0, q1`); version 1 stored the quadratics' joint `m` too (4 slices). All
 /// are read (version 1's `m` slices are dropped on load: `m` is exactly `(q0 + q1) / 2`;
 /// bundles before version 3 have no far hair).
-pub const RUNTIME_FORMAT_VERSION: u32 = 7;
+pub const RUNTIME_FORMAT_VERSION: u32 = 8;
 /// Hair-mesh slices per segment in format version 1 bundles.
 const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
@@ -140,6 +142,10 @@ pub struct Manifest {
     /// Scalp faces without hair whose corners weigh in on layer 0's frames (version 4).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub bare_faces: Vec<crate::runtime::textures::BareFace>,
+    /// Density, length and clump painted in root-uv space (format version 8): a 2D
+    /// `R8G8B8A8_UNORM` texture; absent where nothing is painted (1 everywhere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub root_maps: Option<TextureEntry>,
 }
 
 /// File name of the manifest, the bundle's single commit point (see [`write_bundle_folder`]).
@@ -159,7 +165,16 @@ pub(crate) fn content_addressed_name(stem: &str, extension: &str, bytes: &[u8]) 
 /// Whether `name` is a data file a runtime bundle export writes (content-addressed, or
 /// the fixed names of bundles written before content addressing).
 fn is_bundle_data_file(name: &str) -> bool {
-    const STEMS: [&str; 7] = ["hair_mesh", "uv", "w", "u", "v", "body", "far_hair"];
+    const STEMS: [&str; 8] = [
+        "hair_mesh",
+        "uv",
+        "w",
+        "u",
+        "v",
+        "body",
+        "far_hair",
+        "root_maps",
+    ];
     let Some((stem, rest)) = name.split_once('.') else {
         return false;
     };
@@ -526,6 +541,21 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         false,
         "unit styling direction v per layer slice (xyz)",
     )?;
+    let root_maps = if textures.root_maps.is_empty() {
+        None
+    } else {
+        let maps = &textures.root_maps;
+        let format = TexelFormat::Rgba8Unorm;
+        let bytes = ktx2_bytes(format, maps.width(), maps.height(), 0, &maps.rgba8())?;
+        let file = content_addressed_name("root_maps", "ktx2", &bytes);
+        files.push((file.clone(), bytes));
+        Some(TextureEntry {
+            file,
+            vk_format: format.vk_name().to_string(),
+            size: [maps.width(), maps.height(), 0],
+            contents: "painted maps in root-uv space: r density, g length, b clump (shares, byte / 255); a unused".into(),
+        })
+    };
     let body_glb = (!hair.body.triangles.is_empty()).then(|| glb_body(&hair.body));
     let manifest = Manifest {
         format: "hairloom-runtime".into(),
@@ -569,6 +599,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         far_hair: None,
         column_layers: textures.topology.column_layers.clone(),
         bare_faces: textures.topology.bare_faces.clone(),
+        root_maps,
     };
     if let (Some(name), Some(bytes)) = (&manifest.body, body_glb) {
         files.push((name.clone(), bytes));
@@ -774,6 +805,45 @@ pub fn load_runtime_asset_from(
     };
     let hair_mesh = load(&manifest.hair_mesh, 4)?;
     let uv = load(&manifest.uv, 2)?;
+    let root_maps = match &manifest.root_maps {
+        None => crate::model::root_maps::RootMaps::default(),
+        Some(entry) => {
+            let format = TexelFormat::Rgba8Unorm;
+            if entry.vk_format != format.vk_name() {
+                return Err(error(
+                    &entry.file,
+                    format!(
+                        "manifest says {}, expected {} for root_maps",
+                        entry.vk_format,
+                        format.vk_name()
+                    ),
+                ));
+            }
+            let [width, height, depth] = entry.size;
+            if depth != 0 {
+                return Err(error(
+                    MANIFEST_FILE,
+                    format!("root_maps is a 2D texture: its size's depth is {depth}, not 0"),
+                ));
+            }
+            // Checked before the file is read: a hostile size names the problem.
+            crate::model::root_maps::RootMaps::blank(width, height)
+                .map_err(|e| error(MANIFEST_FILE, format!("root_maps: {e}")))?;
+            check_file_name(&entry.file).map_err(|message| error(MANIFEST_FILE, message))?;
+            let bytes = files
+                .read(&entry.file, limits::FILE_BYTES)
+                .map_err(|e| error(&entry.file, e))?;
+            let texture = read_texture(&bytes, format, entry.size)
+                .map_err(|message| error(&entry.file, message))?;
+            let rgba8: Vec<u8> = texture
+                .texels
+                .iter()
+                .flat_map(|t| t.to_array().map(|c| (c * 255.0).round() as u8))
+                .collect();
+            crate::model::root_maps::RootMaps::from_rgba8(width, height, &rgba8)
+                .map_err(|e| error(&entry.file, e.to_string()))?
+        }
+    };
     let w = load(&manifest.w, 1)?;
     let u = load(&manifest.u, 4)?;
     let v = load(&manifest.v, 4)?;
@@ -914,6 +984,7 @@ pub fn load_runtime_asset_from(
         u,
         v,
         topology,
+        root_maps,
     };
     let body = match &manifest.body {
         None => crate::model::document::BodyMesh::default(),
@@ -947,6 +1018,8 @@ pub fn load_runtime_asset_from(
             .map(|b| (b.styling_group + 1) as u32)
             .collect(),
         block_density: manifest.bundles.iter().map(|b| b.density).collect(),
+        block_bundle_density: Vec::new(),
+        block_root_area: Vec::new(),
         styling: manifest.styling,
         scene: manifest.scene,
         lod: manifest.lod,
@@ -1271,6 +1344,65 @@ mod tests {
         assert!(load_runtime_asset_from(&outside, "memory").is_err());
     }
 
+    #[test]
+    fn painted_maps_travel_as_a_texture_and_hostile_entries_are_named() {
+        use crate::model::root_maps::{RootMapChannel, RootMaps};
+        let mut mesh = grid(3, 2, 2, 0.5);
+        crate::geometry::interior::place_interior(&mut mesh, None);
+        let mut document = Document::new("grid", mesh);
+        let plain = runtime_bundle(&document, &RuntimeOptions::default()).expect("export");
+        let plain_manifest: serde_json::Value = serde_json::from_slice(
+            &plain
+                .iter()
+                .find(|(n, _)| n == MANIFEST_FILE)
+                .expect("manifest")
+                .1,
+        )
+        .expect("json");
+        assert!(
+            plain_manifest.get("root_maps").is_none(),
+            "nothing painted, no texture"
+        );
+        let mut maps = RootMaps::blank(5, 3).expect("maps");
+        maps.set_channel_from_image(RootMapChannel::Density, 2, 1, &[0.2, 0.9])
+            .expect("density");
+        maps.texels_mut()[7] = [1, 2, 3, 255];
+        document.root_maps = maps.clone();
+        let files: HashMap<String, Vec<u8>> = runtime_bundle(&document, &RuntimeOptions::default())
+            .expect("export")
+            .into_iter()
+            .collect();
+        assert_eq!(textures_of(&files).root_maps, maps);
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&files[MANIFEST_FILE]).expect("json");
+        assert_eq!(manifest["root_maps"]["vk_format"], "R8G8B8A8_UNORM");
+        assert_eq!(manifest["root_maps"]["size"], serde_json::json!([5, 3, 0]));
+        for (key, replacement, names) in [
+            ("size", serde_json::json!([5000, 3, 0]), "larger than 4096"),
+            ("size", serde_json::json!([5, 3, 1]), "2D texture"),
+            ("size", serde_json::json!([6, 3, 0]), "does not match"),
+            (
+                "vk_format",
+                "R32G32B32A32_SFLOAT".into(),
+                "expected R8G8B8A8_UNORM",
+            ),
+            ("file", "../root_maps.ktx2".into(), "root_maps.ktx2"),
+        ] {
+            let mut value = manifest.clone();
+            value["root_maps"][key] = replacement;
+            let mut hostile = files.clone();
+            hostile.insert(
+                MANIFEST_FILE.into(),
+                serde_json::to_vec(&value).expect("json"),
+            );
+            let Err(error) = load_runtime_asset_from(&hostile, "memory") else {
+                panic!("{key}: refused");
+            };
+            let error = error.to_string();
+            assert!(error.contains(names), "{key}: {error}");
+        }
+    }
+
     fn textures_of(files: &HashMap<String, Vec<u8>>) -> crate::runtime::textures::RuntimeTextures {
         load_runtime_asset_from(files, "memory")
             .expect("loads")
@@ -1451,12 +1583,15 @@ mod tests {
             ..RuntimeOptions::default()
         };
         let files = runtime_bundle(&document, &options).expect("export");
-        let text = String::from_utf8(files[files.len() - 1].1.clone()).expect("utf-8");
-        assert_eq!(
-            text.matches("\"density\"").count(),
-            1,
-            "only the thinned one"
-        );
+        let manifest: serde_json::Value =
+            serde_json::from_slice(&files[files.len() - 1].1).expect("json");
+        let with_density = manifest["bundles"]
+            .as_array()
+            .expect("bundles")
+            .iter()
+            .filter(|b| b.get("density").is_some())
+            .count();
+        assert_eq!(with_density, 1, "only the thinned one");
         let loaded =
             load_runtime_bundle_from(&files.into_iter().collect::<HashMap<_, _>>(), "memory")
                 .expect("loads");
@@ -1607,7 +1742,7 @@ mod tests {
                         .expect("a bundle")
                         .remove("columns");
                 }),
-                "bundles[0] has no columns (format_version 7 needs them)",
+                "bundles[0] has no columns (format_version 8 needs them)",
             ),
             (
                 Box::new(|m| {

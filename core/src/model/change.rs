@@ -15,7 +15,8 @@ pub enum ChangeKind {
     /// The hair asset is unchanged: the scene (lights, material, effects, motion), the
     /// name, the source or the locked vertices; frames read these every frame.
     Scene,
-    /// Only styling (parameters or group assignments): the styling buffers.
+    /// Only styling (parameters or group assignments) or the painted maps: the styling
+    /// buffers and the maps texture.
     Restyle,
     /// Positions moved (the hair mesh's vertices, w, uv, density, or the body) with the same
     /// bundles, layers and columns: the textures are rewritten in place where their layout
@@ -74,7 +75,8 @@ impl DocumentDiff {
     /// same both ways).
     pub fn change_kind(&self) -> ChangeKind {
         let mut kind = ChangeKind::Scene;
-        if self.styling.is_some() {
+        // Painted maps are read per strand like styling: the maps texture is rewritten.
+        if self.styling.is_some() || self.root_maps.is_some() {
             kind = kind.and(ChangeKind::Restyle);
         }
         if self.w_mode.is_some() || self.body.is_some() {

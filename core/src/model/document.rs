@@ -6,6 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::model::mesh::{HairMesh, InvalidMesh};
+use crate::model::root_maps::RootMaps;
 use crate::model::scene::Scene;
 use crate::model::styling::StylingSet;
 
@@ -133,6 +134,10 @@ pub struct Document {
     /// before scenes existed (format version 1) get the default scene.
     #[serde(default)]
     pub scene: Scene,
+    /// Density, length and clump painted over the scalp in root-uv space (none: 1
+    /// everywhere). Files from before painted maps have none.
+    #[serde(default, skip_serializing_if = "RootMaps::is_empty")]
+    pub root_maps: RootMaps,
 }
 
 /// A validation problem anywhere in a document, with the JSON path of the value.
@@ -178,6 +183,7 @@ impl Document {
             body: BodyMesh::default(),
             styling: StylingSet::default(),
             scene: Scene::default(),
+            root_maps: RootMaps::default(),
         }
     }
 

@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 use crate::model::change::ChangeKind;
 use crate::model::document::{BodyMesh, Document};
 use crate::model::mesh::{Bundle, Column, VertexRef, WMode};
+use crate::model::root_maps::RootMaps;
 use crate::model::scene::Scene;
 use crate::model::styling::StylingSet;
 
@@ -206,6 +207,9 @@ pub struct DocumentDiff {
     /// Boxed: only scene edits change it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scene: Option<Box<Swap<Scene>>>,
+    /// Boxed: only map painting changes them.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub root_maps: Option<Box<Swap<RootMaps>>>,
 }
 
 impl DocumentDiff {
@@ -220,6 +224,7 @@ impl DocumentDiff {
             body: Swap::between(&before.body, &after.body).map(Box::new),
             styling: Swap::between(&before.styling, &after.styling).map(Box::new),
             scene: Swap::between(&before.scene, &after.scene).map(Box::new),
+            root_maps: Swap::between(&before.root_maps, &after.root_maps).map(Box::new),
         }
     }
 
@@ -233,6 +238,7 @@ impl DocumentDiff {
             && self.body.is_none()
             && self.styling.is_none()
             && self.scene.is_none()
+            && self.root_maps.is_none()
     }
 
     fn write(&self, document: &mut Document, forward: bool) -> Result<(), HistoryMismatch> {
@@ -259,6 +265,9 @@ impl DocumentDiff {
         }
         if let Some(swap) = &self.scene {
             swap.check(&document.scene, forward, "scene")?;
+        }
+        if let Some(swap) = &self.root_maps {
+            swap.check(&document.root_maps, forward, "root_maps")?;
         }
         let mut bundles = document.hair_mesh.bundles.clone();
         self.bundles
@@ -289,6 +298,9 @@ impl DocumentDiff {
         }
         if let Some(swap) = &self.scene {
             swap.write(&mut document.scene, forward);
+        }
+        if let Some(swap) = &self.root_maps {
+            swap.write(&mut document.root_maps, forward);
         }
         Ok(())
     }

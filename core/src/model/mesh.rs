@@ -236,6 +236,29 @@ impl HairMesh {
     }
 
     /// Axis-aligned bounds `(min, max)` of every vertex; `None` for an empty mesh.
+    /// The area of the root face of the bundle with corners `vertices` (its root positions;
+    /// a quad as two triangles split along 0-2), model units squared; 0 where a corner's
+    /// column is missing or empty.
+    pub fn root_face_area(&self, vertices: &[u32]) -> f64 {
+        let root = |i: usize| {
+            self.columns
+                .get(*vertices.get(i)? as usize)?
+                .positions
+                .first()
+                .copied()
+        };
+        let triangle = |a: usize, b: usize, c: usize| -> Option<f64> {
+            let (a, b, c) = (root(a)?, root(b)?, root(c)?);
+            Some(0.5 * (b - a).cross(c - a).length())
+        };
+        let area = match vertices.len() {
+            3 => triangle(0, 1, 2),
+            4 => triangle(0, 1, 2).zip(triangle(0, 2, 3)).map(|(a, b)| a + b),
+            _ => None,
+        };
+        area.filter(|a| a.is_finite()).unwrap_or(0.0)
+    }
+
     pub fn bounds(&self) -> Option<(DVec3, DVec3)> {
         let mut points = self
             .columns

@@ -6,5 +6,6 @@ pub mod document;
 pub mod history;
 pub mod mesh;
 pub mod motion;
+pub mod root_maps;
 pub mod scene;
 pub mod styling;

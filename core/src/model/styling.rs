@@ -228,6 +228,18 @@ impl Default for Hairline {
     }
 }
 
+/// Strand density over the scalp. Off at 0: every bundle grows its N strands (times its own
+/// `density`) whatever the size of its root face, so large faces look sparse and small ones
+/// dense. With `strands_per_cm2 > 0` a bundle grows `strands_per_cm2 · area` strands (its
+/// root face's area in cm², model units taken as metres), at most its N, times its own
+/// `density` ([`crate::strands::lod::grown_share`]): the same cover over the whole scalp.
+/// Its progressive samples keep the cover even, and the painted density map thins it further.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Density {
+    pub strands_per_cm2: f64,
+}
+
 /// Length variation: a strand ends at `1 − fraction · ξ₅` of its bundle's length.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -248,6 +260,7 @@ pub struct StylingParams {
     pub length: LengthVariation,
     pub stray: Stray,
     pub hairline: Hairline,
+    pub density: Density,
     /// Cells per uv unit of the per-strand random fields ξ.
     pub variation_per_uv: f64,
     pub seed: u32,
@@ -265,6 +278,7 @@ impl Default for StylingParams {
             length: LengthVariation::default(),
             stray: Stray::default(),
             hairline: Hairline::default(),
+            density: Density::default(),
             variation_per_uv: 200.0,
             seed: 1,
         }
@@ -395,6 +409,7 @@ impl StylingSet {
                 ("hairline.width_m", p.hairline.width_m),
                 ("hairline.edge_density", p.hairline.edge_density),
                 ("hairline.edge_length", p.hairline.edge_length),
+                ("density.strands_per_cm2", p.density.strands_per_cm2),
                 ("variation_per_uv", p.variation_per_uv),
             ];
             for (name, value) in values {
@@ -474,6 +489,8 @@ pub const HARD_RANGES: &[(&str, f64, f64)] = &[
     ("hairline.width_m", 0.0, 1.0),
     ("hairline.edge_density", 0.0, 1.0),
     ("hairline.edge_length", 0.0, 1.0),
+    // Real scalps grow about 150-300 a cm²; ten times that is already fur.
+    ("density.strands_per_cm2", 0.0, 10_000.0),
     ("variation_per_uv", 1.0, 10_000.0),
 ];
 

@@ -73,8 +73,14 @@ pub struct RuntimeHair {
     pub strands_per_bundle: u32,
     /// Per atlas block: 0 = global styling, `g + 1` = group `g` of [`Self::styling`].
     pub block_styling: Vec<u32>,
-    /// Per atlas block: the fraction of its strands that grow (`Bundle::density`).
+    /// Per atlas block: the fraction of its strands that grow (`Bundle::density`, times the
+    /// styling's per-area share at `strands_per_bundle`: [`crate::strands::lod::grown_share`]).
     pub block_density: Vec<f32>,
+    /// Per atlas block: the artist's `Bundle::density` and its root face's area (model units
+    /// squared), from which `block_density` is worked out again when the strand count or the
+    /// styling changes. Empty for a loaded bundle, whose densities already hold the share.
+    pub block_bundle_density: Vec<f32>,
+    pub block_root_area: Vec<f64>,
     pub styling: StylingSet,
     /// Lights, material and effects: how the hair is meant to be seen.
     pub scene: Scene,
@@ -115,16 +121,23 @@ impl RuntimeHair {
 
     /// What exporting `document` with `options` produces.
     pub fn from_document(document: &Document, options: &RuntimeOptions) -> Self {
-        let textures = RuntimeTextures::build(&document.hair_mesh, options.precision);
+        let mut textures = RuntimeTextures::build(&document.hair_mesh, options.precision);
+        textures.root_maps = document.root_maps.clone();
+        let blocks = &textures.atlas.blocks;
+        let bundle_of = |block: &crate::runtime::atlas::BundleBlock| {
+            document.hair_mesh.bundles.get(block.bundle as usize)
+        };
         let mut hair = Self {
             block_styling: block_styling(&textures, &document.styling),
-            block_density: textures
-                .atlas
-                .blocks
+            block_density: Vec::new(),
+            block_bundle_density: blocks
+                .iter()
+                .map(|block| bundle_of(block).map_or(1.0, |b| b.density as f32))
+                .collect(),
+            block_root_area: blocks
                 .iter()
                 .map(|block| {
-                    let bundle = document.hair_mesh.bundles.get(block.bundle as usize);
-                    bundle.map_or(1.0, |b| b.density as f32)
+                    bundle_of(block).map_or(0.0, |b| document.hair_mesh.root_face_area(&b.vertices))
                 })
                 .collect(),
             textures,
@@ -146,6 +159,31 @@ impl RuntimeHair {
     fn draw_samples(&mut self, strands_per_bundle: u32, seed: u64) {
         self.samples = RootSamples::progressive(sample_set_size(strands_per_bundle), seed);
         self.strands_per_bundle = strands_per_bundle;
+        self.update_block_density();
+    }
+
+    /// Works each block's grown share out again from the artist's density, the root face's
+    /// area and the styling's per-area target at the current strand count (a loaded bundle,
+    /// with no areas, keeps the shares it was written with).
+    fn update_block_density(&mut self) {
+        if self.block_root_area.len() != self.block_bundle_density.len()
+            || self.block_root_area.len() != self.textures.atlas.blocks.len()
+        {
+            return;
+        }
+        self.block_density = (0..self.block_root_area.len())
+            .map(|block| {
+                let params = self
+                    .styling
+                    .params_for(self.textures.atlas.blocks[block].bundle);
+                crate::strands::lod::grown_share(
+                    self.block_bundle_density[block] as f64,
+                    params.density.strands_per_cm2,
+                    self.block_root_area[block],
+                    self.strands_per_bundle,
+                ) as f32
+            })
+            .collect();
     }
 
     /// Draws `strands_per_bundle` strands per bundle: from the sample set an export of that
@@ -166,6 +204,7 @@ impl RuntimeHair {
                     });
                 }
                 self.strands_per_bundle = strands_per_bundle;
+                self.update_block_density();
             }
         }
         Ok(())
@@ -176,6 +215,8 @@ impl RuntimeHair {
     pub fn set_styling(&mut self, styling: &StylingSet) {
         self.block_styling = block_styling(&self.textures, styling);
         self.styling = styling.clone();
+        // A group's per-area target may have changed how many strands a bundle grows.
+        self.update_block_density();
     }
 
     /// Where each block's hair is (culling and LOD inputs) and how densely it grows: what a
@@ -267,5 +308,88 @@ impl RootSamples {
             quad: samples(SampleDomain::Square),
             triangle: samples(SampleDomain::Triangle),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::samples::grid_scalp;
+    use glam::DVec3;
+
+    /// Issue 35: with a per-area target, strand counts follow root-face area (a face four
+    /// times as large grows four times the strands, up to N), through a group's parameters
+    /// too; a restyle and another strand count work the shares out again; off, every bundle
+    /// grows N.
+    #[test]
+    fn strand_counts_follow_face_area_with_a_per_area_target() {
+        // Two columns of 1 cm faces, then two of 2 cm: x spacing 1, 1, 2, 2 cm; y 1 cm.
+        let xs = [0.0, 0.01, 0.02, 0.04, 0.06];
+        let mut mesh = grid_scalp(4, 1, |s, t| {
+            let i = (s * 4.0).round() as usize;
+            DVec3::new(xs[i], 0.0, 0.01 * t)
+        });
+        for bundle in &mut mesh.bundles {
+            bundle.layers = 1;
+        }
+        for column in &mut mesh.columns {
+            let root = column.positions[0];
+            column.positions.push(root + DVec3::Y * 0.05);
+            column.w.push(0.05);
+        }
+        let mut document = Document::new("grid", mesh);
+        let options = RuntimeOptions {
+            strands_per_bundle: 64,
+            ..RuntimeOptions::default()
+        };
+        let counts = |hair: &RuntimeHair| -> Vec<u32> {
+            let mut by_bundle: Vec<(u32, u32)> = (0..hair.textures.atlas.blocks.len())
+                .map(|b| {
+                    (
+                        hair.textures.atlas.blocks[b].bundle,
+                        hair.block_strand_count(b),
+                    )
+                })
+                .collect();
+            by_bundle.sort();
+            by_bundle.into_iter().map(|(_, n)| n).collect()
+        };
+        assert_eq!(
+            counts(&RuntimeHair::from_document(&document, &options)),
+            [64; 4]
+        );
+        document.styling.global.density.strands_per_cm2 = 20.0;
+        let mut hair = RuntimeHair::from_document(&document, &options);
+        assert_eq!(counts(&hair), [20, 20, 40, 40]);
+        // Fewer strands a bundle: the large faces are capped at N.
+        hair.set_strands_per_bundle(32).expect("samples");
+        assert_eq!(counts(&hair), [20, 20, 32, 32]);
+        hair.set_strands_per_bundle(64).expect("samples");
+        // A group with its own target, taken by a restyle.
+        let mut styling = document.styling.clone();
+        let mut params = styling.global.clone();
+        params.density.strands_per_cm2 = 10.0;
+        styling.groups.push(crate::model::styling::StylingGroup {
+            name: "sparse".into(),
+            bundles: vec![0, 3],
+            params,
+        });
+        hair.set_styling(&styling);
+        assert_eq!(counts(&hair), [10, 20, 40, 20]);
+        // The reference strands (exports) grow the same counts.
+        document.styling = styling;
+        let strands = crate::strands::reference::generate(
+            &document,
+            &crate::strands::reference::StrandOptions {
+                strands_per_bundle: 64,
+                vertices_log2: 2,
+                ..Default::default()
+            },
+        );
+        let mut per_bundle = [0u32; 4];
+        for strand in &strands {
+            per_bundle[strand.bundle as usize] += 1;
+        }
+        assert_eq!(per_bundle, [10, 20, 40, 20]);
     }
 }

@@ -29,6 +29,9 @@ pub struct StrandInput<'p> {
     pub length_fraction: f64,
     /// The styling ops' per-strand values (random phases and keys, clump pull).
     pub styling: StrandStyling,
+    /// The painted length map's share at the root (1 without maps): a cut strand is the
+    /// first `cut` of the strand it would be, so its styling reads `along · cut`.
+    pub cut: f64,
 }
 
 /// Texture filtering as the texture-path mirror performs it.
@@ -182,13 +185,17 @@ impl StrandGen<'_> {
             Filtering::Exact,
         )
         .w as f64;
+        // The painted maps at the root (exact too: density decides whether it grows).
+        let maps = self.textures.root_maps.sample(root_uv);
         StrandInput {
             root: *root,
             params,
             root_uv,
             length_fraction: strand_length_fraction(params, root_uv)
-                * hairline_length_scale(params, hairline_distance, root.rank as f64),
-            styling: StrandStyling::new(params, root_uv),
+                * hairline_length_scale(params, hairline_distance, root.rank as f64)
+                * maps.length_scale(root.rank as f64),
+            styling: StrandStyling::new(params, root_uv).with_clump_share(maps.clump),
+            cut: maps.length,
         }
     }
 
@@ -235,7 +242,7 @@ impl StrandGen<'_> {
             w_axis,
             root_uv: input.root_uv,
             w,
-            along,
+            along: along * input.cut,
         };
         (p + styling_offset_of(params, &input.styling, &styling)).as_vec3()
     }

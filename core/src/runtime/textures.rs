@@ -27,6 +27,7 @@ use glam::{DVec3, Vec3, Vec4};
 use crate::geometry::curve::{cubic_to_quadratics, curve_segments};
 use crate::geometry::frames::layer_frames;
 use crate::model::mesh::HairMesh;
+use crate::model::root_maps::RootMaps;
 use crate::runtime::atlas::{Atlas, BundleBlock, build_atlas};
 use crate::runtime::hair::{RootSamples, sample_rank, strand_root};
 use crate::runtime::half::round_to_f16;
@@ -175,6 +176,10 @@ pub struct RuntimeTextures {
     pub v: Texture3d,
     /// Column layer counts and bare faces (empty for bundles before format version 4).
     pub topology: MeshTopology,
+    /// Density, length and clump painted in root-uv space (the document's; none: 1
+    /// everywhere). Not built from the hair mesh: [`crate::runtime::hair::RuntimeHair`]
+    /// takes them from the document.
+    pub root_maps: RootMaps,
 }
 
 fn quantize(v: Vec4, precision: Precision) -> Vec4 {
@@ -283,6 +288,7 @@ impl RuntimeTextures {
             u,
             v,
             topology: MeshTopology::of(mesh),
+            root_maps: RootMaps::default(),
         }
     }
 

@@ -70,9 +70,60 @@ pub fn density_count(density: f64, strands: u32) -> u32 {
     ((density * strands as f64).ceil() as u32).min(strands)
 }
 
+/// The share of its `per_bundle` strands a bundle grows: its own `density` (the share the
+/// artist set; NaN grows nothing), times, where its styling asks for `strands_per_cm2 > 0`,
+/// the share that gives that many strands per cm² of its root face (`root_area_m2`, model
+/// units taken as metres), at most all of them ([`crate::model::styling::Density`]).
+/// A non-finite or negative area or target leaves the density alone.
+pub fn grown_share(density: f64, strands_per_cm2: f64, root_area_m2: f64, per_bundle: u32) -> f64 {
+    let density = if density.is_nan() {
+        0.0
+    } else {
+        density.clamp(0.0, 1.0)
+    };
+    let wanted = strands_per_cm2 * root_area_m2 * 1.0e4;
+    if strands_per_cm2.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        || !wanted.is_finite()
+        || wanted < 0.0
+        || per_bundle == 0
+    {
+        return density;
+    }
+    density * (wanted / per_bundle as f64).min(1.0)
+}
+
 #[cfg(test)]
 mod density_tests {
-    use super::density_count;
+    use super::{density_count, grown_share};
+
+    #[test]
+    fn a_per_area_target_makes_strand_counts_follow_face_area() {
+        // Off: the artist's share alone.
+        assert_eq!(grown_share(0.5, 0.0, 1.0e-4, 64), 0.5);
+        // 40 a cm² over faces of 1 cm² and 0.25 cm², 64 strands a bundle: 40 and 10.
+        let big = density_count(grown_share(1.0, 40.0, 1.0e-4, 64), 64);
+        let small = density_count(grown_share(1.0, 40.0, 0.25e-4, 64), 64);
+        assert_eq!((big, small), (40, 10));
+        // Capped at all of them; the artist's share still thins.
+        assert_eq!(grown_share(1.0, 400.0, 1.0e-4, 64), 1.0);
+        assert_eq!(grown_share(0.5, 400.0, 1.0e-4, 64), 0.5);
+        // Degenerate inputs leave the share alone or grow nothing, never NaN.
+        for (density, target, area, n) in [
+            (1.0, f64::NAN, 1.0e-4, 64),
+            (1.0, 40.0, f64::NAN, 64),
+            (1.0, 40.0, -1.0, 64),
+            (1.0, f64::INFINITY, 1.0e-4, 64),
+            (1.0, 40.0, 1.0e-4, 0),
+        ] {
+            assert_eq!(grown_share(density, target, area, n), 1.0);
+        }
+        assert_eq!(grown_share(f64::NAN, 40.0, 1.0e-4, 64), 0.0);
+        assert_eq!(
+            grown_share(1.0, 40.0, 0.0, 64),
+            0.0,
+            "a face of no area grows none"
+        );
+    }
 
     #[test]
     fn density_count_rounds_up_and_stays_in_range() {

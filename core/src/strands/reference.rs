@@ -190,14 +190,17 @@ impl<'a> StrandContext<'a> {
                 .map(|(&c, weight)| weight * self.hairline.get(c as usize).copied().unwrap_or(0.0))
                 .sum()
         };
+        let maps = self.document.root_maps.sample(reference.root_uv);
         let length_fraction = strand_length_fraction(params, reference.root_uv)
-            * hairline_length_scale(params, hairline_distance, rank);
+            * hairline_length_scale(params, hairline_distance, rank)
+            * maps.length_scale(rank);
         if length_fraction <= 0.0 {
             return None;
         }
         let tau_max = b.layers as f64 * length_fraction;
         // What styling needs of this strand at every vertex, computed once.
-        let strand_styling = StrandStyling::new(params, reference.root_uv);
+        let strand_styling =
+            StrandStyling::new(params, reference.root_uv).with_clump_share(maps.clump);
         let vertex_count = vertex_count.max(2);
         let points = (0..vertex_count)
             .map(|k| {
@@ -218,7 +221,8 @@ impl<'a> StrandContext<'a> {
                     w_axis,
                     root_uv: reference.root_uv,
                     w,
-                    along,
+                    // A strand the length map cuts is the first part of the one it would be.
+                    along: along * maps.length,
                 };
                 p + styling_offset_of(params, &strand_styling, &input)
             })
@@ -276,8 +280,21 @@ impl StrandPlan {
         } else {
             &self.quad_samples
         };
-        // A thinned bundle (hairline) grows the first ⌈density · N⌉ of its samples.
-        let count = crate::strands::lod::density_count(bundle.density, self.count as u32);
+        // A thinned bundle grows the first ⌈share · N⌉ of its samples: its own density, and
+        // the styling's per-area target over its root face.
+        let mesh = &context.document.hair_mesh;
+        let share = crate::strands::lod::grown_share(
+            bundle.density,
+            context
+                .document
+                .styling
+                .params_for(index as u32)
+                .density
+                .strands_per_cm2,
+            mesh.root_face_area(&bundle.vertices),
+            self.count as u32,
+        );
+        let count = crate::strands::lod::density_count(share, self.count as u32);
         samples[..count as usize]
             .iter()
             .enumerate()

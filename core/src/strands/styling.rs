@@ -158,6 +158,14 @@ pub struct StrandStyling {
 }
 
 impl StrandStyling {
+    /// This strand feeling `share` of its clump and sub-clump pulls (the painted clump map
+    /// at its root, [`crate::model::root_maps`]).
+    pub fn with_clump_share(mut self, share: f64) -> Self {
+        self.clump_pull *= share;
+        self.sub_clump_pull *= share;
+        self
+    }
+
     pub fn new(params: &StylingParams, root_uv: DVec2) -> Self {
         let mut strand = Self::default();
         let xi = |channel| strand_random(params, root_uv, channel);

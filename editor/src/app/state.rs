@@ -57,6 +57,20 @@ pub struct BrushSettings {
     pub mirror_x: bool,
     /// Leave hair whose scalp faces away from the view (never brush through the head).
     pub front_only: bool,
+    /// Paint this map over the scalp instead of shaping the hair (`kind` is then unused).
+    pub paint: Option<hairloom_core::model::root_maps::RootMapChannel>,
+    /// The share the map brush paints toward (Ctrl: 1, the unpainted value).
+    pub paint_value: f64,
+}
+
+impl BrushSettings {
+    /// What the brush is called in messages and the history.
+    pub fn label(&self) -> String {
+        match self.paint {
+            Some(channel) => format!("Paint {}", channel.label().to_lowercase()),
+            None => self.kind.label().to_string(),
+        }
+    }
 }
 
 impl Default for BrushSettings {
@@ -67,6 +81,8 @@ impl Default for BrushSettings {
             strength: 0.5,
             mirror_x: true,
             front_only: true,
+            paint: None,
+            paint_value: 0.0,
         }
     }
 }

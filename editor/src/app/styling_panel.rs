@@ -221,6 +221,15 @@ const OPS: &[(&str, &[SliderSpec])] = &[
         ],
     ),
     (
+        "Density",
+        &[(
+            "Strands per cm²",
+            |p| &mut p.density.strands_per_cm2,
+            (0.0, 400.0),
+            " /cm²",
+        )],
+    ),
+    (
         "Length",
         &[(
             "Length variation",

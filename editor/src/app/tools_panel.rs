@@ -7,6 +7,7 @@ use hairloom_core::model::change::ChangeKind;
 use super::gizmo::GizmoKind;
 use super::state::{BrushSettings, DragTool, EditorState, SelectMode};
 use hairloom_core::edit::BrushKind;
+use hairloom_core::model::root_maps::RootMapChannel;
 
 pub struct ToolsPanel {
     /// Extrusion distance along the top layer's normals (model units).
@@ -36,17 +37,43 @@ fn brush_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
     ui.horizontal_wrapped(|ui| {
         ui.label("Brush:");
         for kind in BrushKind::ALL {
-            ui.selectable_value(&mut brush.kind, kind, kind.label())
-                .on_hover_text(match kind {
-                    BrushKind::Comb => "Drag hair along the stroke; lengths stay",
-                    BrushKind::Length => "Grow the hair under the brush (Ctrl: cut)",
-                    BrushKind::Puff => "Lift hair off the scalp (Ctrl: flatten)",
-                    BrushKind::Smooth => "Relax kinks along and across the hair",
-                    BrushKind::Clump => "Gather the hair under the brush (Ctrl: spread)",
-                    BrushKind::Part => {
-                        "Part the hair along the stroke (a stroke along the centre: a middle part)"
-                    }
-                });
+            let chosen = brush.paint.is_none() && brush.kind == kind;
+            let response = ui.selectable_label(chosen, kind.label());
+            if response.clicked() {
+                brush.kind = kind;
+                brush.paint = None;
+            }
+            response.on_hover_text(match kind {
+                BrushKind::Comb => "Drag hair along the stroke; lengths stay",
+                BrushKind::Length => "Grow the hair under the brush (Ctrl: cut)",
+                BrushKind::Puff => "Lift hair off the scalp (Ctrl: flatten)",
+                BrushKind::Smooth => "Relax kinks along and across the hair",
+                BrushKind::Clump => "Gather the hair under the brush (Ctrl: spread)",
+                BrushKind::Part => {
+                    "Part the hair along the stroke (a stroke along the centre: a middle part)"
+                }
+            });
+        }
+    });
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Paint map:");
+        for channel in RootMapChannel::ALL {
+            let response = ui.selectable_label(
+                brush.paint == Some(channel),
+                format!("{} map", channel.label()),
+            );
+            if response.clicked() {
+                brush.paint = Some(channel);
+            }
+            response.on_hover_text(match channel {
+                RootMapChannel::Density => {
+                    "Paint where hair grows over the scalp: the share of strands that grow"
+                }
+                RootMapChannel::Length => "Paint the share of its length the hair keeps",
+                RootMapChannel::Clump => {
+                    "Paint how strongly the hair clumps (the Clump op's share)"
+                }
+            });
         }
     });
     // Label first, a short slider after: the Tools panel is narrow, and a slider's own text
@@ -70,6 +97,13 @@ fn brush_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
         "Strength",
         egui::Slider::new(&mut brush.strength, 0.0..=1.0),
     );
+    if brush.paint.is_some() {
+        labelled_slider(
+            ui,
+            "Paint value",
+            egui::Slider::new(&mut brush.paint_value, 0.0..=1.0),
+        );
+    }
     ui.horizontal(|ui| {
         ui.checkbox(&mut brush.mirror_x, "X mirror")
             .on_hover_text("Stroke both sides of the head at once (across its centre, x)");
@@ -117,6 +151,28 @@ impl ToolsPanel {
         }
         if state.tool.drag == DragTool::Groom {
             brush_ui(ui, &mut state.tool.brush);
+            if let Some(channel) = state.tool.brush.paint {
+                let painted = !state.document().root_maps.is_empty()
+                    && state
+                        .document()
+                        .root_maps
+                        .texels()
+                        .iter()
+                        .any(|t| t[channel.index()] != 255);
+                let label = format!("Clear {} map", channel.label().to_lowercase());
+                if ui
+                    .add_enabled(painted, egui::Button::new(&label))
+                    .on_hover_text("Forget this painted map: 1 everywhere again")
+                    .clicked()
+                {
+                    state.commit_edit();
+                    state
+                        .edit(ChangeKind::Restyle, &label)
+                        .root_maps
+                        .clear_channel(channel);
+                    state.commit_edit();
+                }
+            }
         }
         ui.horizontal(|ui| {
             if ui.button("Grow").on_hover_text("Ctrl +").clicked() {

@@ -21,6 +21,7 @@ mod bench_shading;
 mod bench_sim;
 mod bench_switches;
 mod fit;
+mod maps;
 mod render;
 mod simulate;
 
@@ -51,6 +52,9 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Bring density, length and clump maps painted in another tool (grey images over the
+    /// scalp's uv layout) into a project, as one undo step.
+    Maps(maps::MapsArgs),
     /// Create a project from a glTF/GLB scalp (every face becomes a bare bundle).
     Import {
         scalp: PathBuf,
@@ -269,6 +273,7 @@ pub fn main() -> ExitCode {
             max_vertices,
         ),
         Some(Command::Fit(args)) => fit::run(args),
+        Some(Command::Maps(args)) => maps::run(args),
         Some(Command::Export {
             project,
             runtime,

@@ -12,9 +12,11 @@ use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
 use glam::DVec3;
+use hairloom_core::edit::paint_maps::{MapDab, RootMapRaster, paint_dab};
 use hairloom_core::edit::{BrushDab, apply_brush, pick::pick_bundle};
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::document::BodyMesh;
+use hairloom_core::model::root_maps::{DEFAULT_ROOT_MAP_SIDE, RootMaps};
 use hairloom_core::simulate::BodySdf;
 
 use super::camera::Projector;
@@ -55,6 +57,8 @@ pub(super) struct Stroke {
     field: Arc<BodySdf>,
     dabs: usize,
     held_back: usize,
+    /// Map painting: where each map texel's root lies (built once per stroke).
+    raster: Option<Arc<RootMapRaster>>,
 }
 
 /// The brush under the pointer, for the overlay: its centre on screen and its radius in
@@ -73,6 +77,9 @@ const MAX_DABS_PER_FRAME: usize = 16;
 /// Hair this far behind the body's surface along the pointer's ray still counts as in
 /// front (the hair mesh's root layer lies on the scalp).
 const IN_FRONT_TOLERANCE_M: f64 = 0.003;
+
+/// How far along the pointer's ray a map brush looks for the scalp (model units).
+const MAP_RAY_MAX_M: f64 = 1.0e3;
 
 /// A cheap identity of a body mesh, so its distance field is built once per body.
 fn body_fingerprint(body: &BodyMesh) -> u64 {
@@ -97,6 +104,12 @@ impl Viewport {
         fallback: Option<DVec3>,
     ) -> Option<(DVec3, bool)> {
         let (origin, direction) = projector.ray(pointer);
+        // A map brush paints the scalp under the hair: it aims at the body where there is one.
+        if state.tool.brush.paint.is_some()
+            && let Some(body_m) = field.and_then(|f| f.ray_hit_m(origin, direction, MAP_RAY_MAX_M))
+        {
+            return Some((origin + direction.normalize() * body_m, true));
+        }
         let hit = pick_bundle(&state.document().hair_mesh, origin, direction)
             .map(|(_, t)| origin + direction * t)
             .filter(|&at| {
@@ -252,11 +265,17 @@ impl Viewport {
             return;
         };
         state.commit_edit();
-        let kind = state.tool.brush.kind.label();
+        let kind = state.tool.brush.label();
         state.message = format!(
             "{kind}: {} dabs{}{why}",
             stroke.dabs,
-            if stroke.held_back > 0 {
+            if stroke.held_back > 0 && state.tool.brush.paint.is_some() {
+                format!(
+                    ", {} changed nothing (no scalp under the brush, or the map there already \
+                     holds the value)",
+                    stroke.held_back
+                )
+            } else if stroke.held_back > 0 {
                 format!(
                     ", {} left the hair as it was (no hair under the brush, or the step would \
                      have turned a layer over, crowded it or reached into the head)",
@@ -292,7 +311,7 @@ impl Viewport {
             self.stroke = None;
             state.message = format!(
                 "{}: the stroke ended (the document changed under it)",
-                state.tool.brush.kind.label()
+                state.tool.brush.label()
             );
         }
         let brush = state.tool.brush;
@@ -332,6 +351,20 @@ impl Viewport {
                     Self::brush_centre(state, &projector, Some(&field), p, None)?,
                 ))
             });
+            // A map stroke finds each texel's root once, at the maps' size.
+            let raster = brush.paint.map(|_| {
+                let maps = &state.document().root_maps;
+                let (width, height) = if maps.is_empty() {
+                    (DEFAULT_ROOT_MAP_SIDE, DEFAULT_ROOT_MAP_SIDE)
+                } else {
+                    (maps.width(), maps.height())
+                };
+                Arc::new(RootMapRaster::new(
+                    &state.document().hair_mesh,
+                    width,
+                    height,
+                ))
+            });
             self.stroke = start.map(|(p, (centre, _))| Stroke {
                 last_pointer: p,
                 last_centre: centre,
@@ -339,9 +372,10 @@ impl Viewport {
                 field,
                 dabs: 0,
                 held_back: 0,
+                raster,
             });
             if self.stroke.is_none() {
-                state.message = format!("{}: start the stroke on the hair", brush.kind.label());
+                state.message = format!("{}: start the stroke on the hair", brush.label());
             }
         }
         if self.stroke.is_none() {
@@ -393,6 +427,39 @@ impl Viewport {
             ) else {
                 continue;
             };
+            if let (Some(channel), Some(raster)) = (brush.paint, stroke.raster.clone()) {
+                let mut maps = state.document().root_maps.clone();
+                if maps.is_empty() {
+                    maps = RootMaps::blank(DEFAULT_ROOT_MAP_SIDE, DEFAULT_ROOT_MAP_SIDE)
+                        .expect("the default side is within the limit");
+                }
+                let dab = MapDab {
+                    channel,
+                    centre_m: centre.to_array(),
+                    radius_m: brush.radius_m,
+                    value: if invert { 1.0 } else { brush.paint_value },
+                    strength: brush.strength * pressure.unwrap_or(1.0),
+                    view_direction: brush.front_only.then(|| projector.ray(point).1.to_array()),
+                    mirror_x: brush.mirror_x,
+                    mirror_plane_x: plane_x,
+                };
+                let changed = paint_dab(&mut maps, &raster, &dab);
+                let Some(stroke) = self.stroke.as_mut() else {
+                    break;
+                };
+                stroke.last_pointer = point;
+                stroke.last_centre = centre;
+                if changed == 0 {
+                    stroke.held_back += 1;
+                } else {
+                    stroke.dabs += 1;
+                    state.edit(ChangeKind::Restyle, &brush.label()).root_maps = maps;
+                    if let Some(stroke) = self.stroke.as_mut() {
+                        stroke.revision = state.revision;
+                    }
+                }
+                continue;
+            }
             let motion = projector.unproject(point, stroke.last_centre)
                 - projector.unproject(stroke.last_pointer, stroke.last_centre);
             let dab = BrushDab {

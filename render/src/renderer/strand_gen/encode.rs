@@ -17,7 +17,7 @@ use crate::resources::Tracked;
 pub const GENERATED_BINDING_OFFSET: u32 = 16;
 
 /// strand_gen's bindings other than its output (4) and runs (10).
-const SOURCE_BINDINGS: [u32; 10] = [0, 1, 2, 3, 5, 6, 7, 8, 9, 11];
+const SOURCE_BINDINGS: [u32; 11] = [0, 1, 2, 3, 5, 6, 7, 8, 9, 11, 15];
 
 /// The layout entries of strand_gen's resources other than its output and runs (params,
 /// bundles, the five textures and their sampler, styling, samples) at their compute bindings
@@ -64,6 +64,12 @@ pub fn source_layout_entries(
                 }),
                 9 => storage(size_of::<StylingGpu>() as u64),
                 11 => storage(8),
+                // The painted maps: read with textureLoad, never filtered.
+                15 => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
                 _ => texture,
             },
             count: None,
@@ -210,6 +216,7 @@ impl StrandGenRenderer {
             view(8, &hair.v),
             buffer(9, &hair.styling),
             buffer(11, &hair.samples),
+            view(15, &hair.root_maps_view),
         ]
     }
 

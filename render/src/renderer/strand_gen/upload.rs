@@ -2,6 +2,7 @@
 //! by a reshape and its styling buffers by a restyle.
 
 use hairloom_core::io::ktx2::TexelFormat;
+use hairloom_core::model::root_maps::RootMaps;
 use hairloom_core::runtime::frame_plan::BundleBounds;
 use hairloom_core::runtime::gpu_types::{BundleGpu, BundleLodGpu, StylingGpu, styling_array};
 use hairloom_core::runtime::hair::RuntimeHair;
@@ -24,6 +25,9 @@ pub struct GpuHair {
     pub(super) w: wgpu::TextureView,
     pub(super) u: wgpu::TextureView,
     pub(super) v: wgpu::TextureView,
+    /// The painted maps (one white texel when none), replaced when their size changes.
+    pub(super) root_maps: Tracked<wgpu::Texture>,
+    pub(super) root_maps_view: wgpu::TextureView,
     pub(super) bundle_buffer: Tracked<wgpu::Buffer>,
     /// Each bundle's bounds and sizes for LOD, for the mesh path's task shaders.
     pub(super) bundle_lods: Tracked<wgpu::Buffer>,
@@ -41,6 +45,49 @@ pub struct GpuHair {
     layout: TextureLayout,
 }
 
+/// The painted maps' texture: RGBA8 in root-uv space, or one white texel when nothing is
+/// painted (the shader then reads 1 everywhere and needs no switch).
+fn upload_root_maps(
+    context: &GpuContext,
+    maps: &RootMaps,
+) -> (Tracked<wgpu::Texture>, wgpu::TextureView) {
+    let (width, height, bytes) = if maps.is_empty() {
+        (1, 1, vec![255; 4])
+    } else {
+        (maps.width(), maps.height(), maps.rgba8())
+    };
+    let texture = context.resources.texture(
+        &context.device,
+        &wgpu::TextureDescriptor {
+            label: Some("root_maps"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+    );
+    write_root_maps(context, &texture, width, height, &bytes);
+    let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+    (texture, view)
+}
+
+fn write_root_maps(
+    context: &GpuContext,
+    texture: &wgpu::Texture,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) {
+    write_level(context, texture, [width, height, 1], 4, bytes);
+}
+
 fn upload_texture(
     context: &GpuContext,
     label: &str,
@@ -56,6 +103,7 @@ fn upload_texture(
         TexelFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
         TexelFormat::Rg16Float => wgpu::TextureFormat::Rg16Float,
         TexelFormat::R16Float => wgpu::TextureFormat::R16Float,
+        TexelFormat::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
     };
     let bytes = hairloom_core::io::ktx2::texel_bytes(&texture.texels, export_format);
     let size = wgpu::Extent3d {
@@ -98,9 +146,22 @@ fn write_texels(
     format: TexelFormat,
 ) {
     let texel_size = (channels * format.bytes_per_channel()) as u32;
+    let size = [texture.width, texture.height, texture.depth];
+    write_level(context, gpu_texture, size, texel_size, bytes);
+}
+
+/// Writes the whole of a texture's one level, `[width, height, depth]` texels of
+/// `texel_size` bytes each.
+fn write_level(
+    context: &GpuContext,
+    texture: &wgpu::Texture,
+    [width, height, depth]: [u32; 3],
+    texel_size: u32,
+    bytes: &[u8],
+) {
     context.queue.write_texture(
         wgpu::TexelCopyTextureInfo {
-            texture: gpu_texture,
+            texture,
             mip_level: 0,
             origin: wgpu::Origin3d::ZERO,
             aspect: wgpu::TextureAspect::All,
@@ -108,13 +169,13 @@ fn write_texels(
         bytes,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
-            bytes_per_row: Some(texture.width * texel_size),
-            rows_per_image: Some(texture.height),
+            bytes_per_row: Some(width * texel_size),
+            rows_per_image: Some(height),
         },
         wgpu::Extent3d {
-            width: texture.width,
-            height: texture.height,
-            depth_or_array_layers: texture.depth,
+            width,
+            height,
+            depth_or_array_layers: depth,
         },
     );
 }
@@ -191,6 +252,30 @@ impl GpuHair {
 }
 
 impl StrandGenRenderer {
+    /// Takes the painted maps into `gpu`: written in place at the same size, a new texture
+    /// otherwise (bind groups are made per frame, so the next frame reads it).
+    pub fn update_root_maps(&self, context: &GpuContext, gpu: &mut GpuHair, maps: &RootMaps) {
+        let size = if maps.is_empty() {
+            (1, 1)
+        } else {
+            (maps.width(), maps.height())
+        };
+        if (gpu.root_maps.width(), gpu.root_maps.height()) == size {
+            let bytes = if maps.is_empty() {
+                vec![255; 4]
+            } else {
+                maps.rgba8()
+            };
+            write_root_maps(context, &gpu.root_maps, size.0, size.1, &bytes);
+        } else {
+            let before = 4 * u64::from(gpu.root_maps.width()) * u64::from(gpu.root_maps.height());
+            let (texture, view) = upload_root_maps(context, maps);
+            gpu.bytes = gpu.bytes - before + 4 * u64::from(size.0) * u64::from(size.1);
+            gpu.root_maps = texture;
+            gpu.root_maps_view = view;
+        }
+    }
+
     /// Uploads a runtime asset: the five textures (f32 or f16 as built), every bundle's block
     /// placement with its styling index, the first `strands_per_bundle` root samples of each
     /// domain and the styling array. Root `i` is then sample `i % strands_per_bundle` of
@@ -242,6 +327,8 @@ impl StrandGenRenderer {
         }
         let styling = styling_or_default(styling_array(&hair.styling));
         let styling_bytes: &[u8] = bytemuck::cast_slice(&styling);
+        let (root_maps, root_maps_view) = upload_root_maps(context, &textures.root_maps);
+        let root_maps_bytes = 4 * u64::from(root_maps.width()) * u64::from(root_maps.height());
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
         let bounds = hair.bundle_bounds();
@@ -255,6 +342,8 @@ impl StrandGenRenderer {
             w,
             u,
             v,
+            root_maps,
+            root_maps_view,
             bundle_buffer: buffer("strand_gen_bundles", bundle_bytes),
             bundle_lods: buffer("strand_mesh_bundle_lods", lod_bytes),
             samples: buffer("strand_gen_samples", sample_bytes),
@@ -269,6 +358,7 @@ impl StrandGenRenderer {
                 + c
                 + d
                 + e
+                + root_maps_bytes
                 + (bundle_bytes.len() + lod_bytes.len() + sample_bytes.len() + styling_bytes.len())
                     as u64,
         })
@@ -319,6 +409,17 @@ impl StrandGenRenderer {
     /// styling buffer is replaced only when groups were added). What a styling-only edit
     /// costs; `hair` must be the asset `gpu` was uploaded from, restyled.
     pub fn update_styling(&self, context: &GpuContext, gpu: &mut GpuHair, hair: &RuntimeHair) {
+        self.update_root_maps(context, gpu, &hair.textures.root_maps);
+        // A group's per-area density target changes how many strands each bundle grows.
+        let bounds = hair.bundle_bounds();
+        if bounds.len() == gpu.bundles.len() && bounds != gpu.bundles {
+            gpu.bundles = bounds;
+            context.queue.write_buffer(
+                &gpu.bundle_lods,
+                0,
+                bytemuck::cast_slice(&bundle_lods(&gpu.bundles, gpu.per_bundle)),
+            );
+        }
         let bundles = bundle_placements(&hair.textures, &hair.block_styling);
         context
             .queue

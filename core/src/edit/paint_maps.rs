@@ -1,0 +1,310 @@
+//! Painting the maps of [`crate::model::root_maps`] on the scalp: a dab is a sphere around a
+//! point of the scalp, and it changes every map texel whose root lies inside it. Each texel's
+//! root is found once per stroke by rasterising the hair mesh's root faces into the maps in
+//! uv space ([`RootMapRaster`]), so the brush's radius is a distance on the head whatever the
+//! uv layout stretches, and texels no root face covers are left alone.
+
+use glam::{DVec2, DVec3};
+
+use crate::edit::falloff_weight;
+use crate::model::mesh::HairMesh;
+use crate::model::root_maps::{RootMapChannel, RootMaps};
+
+/// Where on the scalp each map texel's centre lies: the root face covering it in uv space,
+/// interpolated. `None` for texels no face covers.
+pub struct RootMapRaster {
+    width: u32,
+    height: u32,
+    /// Per texel: the root position and the root face's unit normal.
+    texels: Vec<Option<(DVec3, DVec3)>>,
+}
+
+impl RootMapRaster {
+    /// Rasterises every root face of `mesh` that grows hair (and the bare ones: a map may be
+    /// painted before hair grows there) into a `width × height` grid over uv `[0, 1]²`.
+    /// Quads are split along their 0-2 diagonal; faces of no uv area are skipped.
+    pub fn new(mesh: &HairMesh, width: u32, height: u32) -> Self {
+        let mut texels = vec![None; width as usize * height as usize];
+        for bundle in &mesh.bundles {
+            if bundle.removed
+                || bundle.vertices.len() < 3
+                || bundle.uvs.len() != bundle.vertices.len()
+            {
+                continue;
+            }
+            let roots: Option<Vec<DVec3>> = bundle
+                .vertices
+                .iter()
+                .map(|&v| mesh.columns.get(v as usize)?.positions.first().copied())
+                .collect();
+            let Some(roots) = roots else {
+                continue;
+            };
+            let corners = bundle.vertices.len();
+            for fan in 1..corners - 1 {
+                let ids = [0, fan, fan + 1];
+                let uv = ids.map(|i| bundle.uvs[i]);
+                let p = ids.map(|i| roots[i]);
+                let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+                rasterise_triangle(width, height, uv, |index, weights| {
+                    let position = p[0] * weights[0] + p[1] * weights[1] + p[2] * weights[2];
+                    if position.is_finite() {
+                        texels[index] = Some((position, normal));
+                    }
+                });
+            }
+        }
+        Self {
+            width,
+            height,
+            texels,
+        }
+    }
+
+    /// Texels some root face covers.
+    pub fn covered(&self) -> usize {
+        self.texels.iter().filter(|t| t.is_some()).count()
+    }
+
+    /// The scalp point of texel `(x, y)`, if a root face covers it.
+    pub fn root_of(&self, x: u32, y: u32) -> Option<DVec3> {
+        self.texels
+            .get((y * self.width + x) as usize)
+            .copied()
+            .flatten()
+            .map(|(p, _)| p)
+    }
+}
+
+/// Calls `texel(index, barycentric weights)` for every texel whose centre lies in the uv
+/// triangle `uv` (edges shared by two triangles count for one of them only by the top-left
+/// rule's spirit: a centre exactly on an edge may be written twice, with the same value).
+fn rasterise_triangle(
+    width: u32,
+    height: u32,
+    uv: [DVec2; 3],
+    mut texel: impl FnMut(usize, [f64; 3]),
+) {
+    let area = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]);
+    if !area.is_finite() || area.abs() < 1e-14 {
+        return;
+    }
+    let size = DVec2::new(width as f64, height as f64);
+    let lo = uv[0].min(uv[1]).min(uv[2]) * size;
+    let hi = uv[0].max(uv[1]).max(uv[2]) * size;
+    let x0 = (lo.x - 0.5).ceil().clamp(0.0, width as f64) as u32;
+    let x1 = ((hi.x - 0.5).floor() + 1.0).clamp(0.0, width as f64) as u32;
+    let y0 = (lo.y - 0.5).ceil().clamp(0.0, height as f64) as u32;
+    let y1 = ((hi.y - 0.5).floor() + 1.0).clamp(0.0, height as f64) as u32;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let c = DVec2::new((x as f64 + 0.5) / size.x, (y as f64 + 0.5) / size.y);
+            let w1 = (c - uv[0]).perp_dot(uv[2] - uv[0]) / area;
+            let w2 = (uv[1] - uv[0]).perp_dot(c - uv[0]) / area;
+            let w0 = 1.0 - w1 - w2;
+            const EDGE: f64 = -1e-9;
+            if w0 >= EDGE && w1 >= EDGE && w2 >= EDGE {
+                texel((y * width + x) as usize, [w0, w1, w2]);
+            }
+        }
+    }
+}
+
+/// One dab of a map brush.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapDab {
+    pub channel: RootMapChannel,
+    /// A point on the scalp (model units).
+    pub centre_m: [f64; 3],
+    pub radius_m: f64,
+    /// The value painted toward, a share in `[0, 1]`.
+    pub value: f64,
+    /// How far toward it one dab goes at the centre (`0 … 1`), falling off to the rim.
+    pub strength: f64,
+    /// Only texels whose root face looks toward the viewer (`None`: all).
+    pub view_direction: Option<[f64; 3]>,
+    /// Also paint the mirror image across `x = mirror_plane_x`.
+    pub mirror_x: bool,
+    pub mirror_plane_x: f64,
+}
+
+/// Applies `dab` to `maps` (which must be `raster`'s size: made blank at
+/// [`crate::model::root_maps::DEFAULT_ROOT_MAP_SIDE`] first when nothing is painted yet).
+/// Returns how many texels changed. Each changes by at least one step of 1/255 toward the
+/// value where the dab reaches it, so repeated light dabs always arrive.
+pub fn paint_dab(maps: &mut RootMaps, raster: &RootMapRaster, dab: &MapDab) -> usize {
+    if (maps.width(), maps.height()) != (raster.width, raster.height)
+        || dab.radius_m.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        || !dab.strength.is_finite()
+        || !dab.value.is_finite()
+    {
+        return 0;
+    }
+    let centre = DVec3::from_array(dab.centre_m);
+    if !centre.is_finite() {
+        return 0;
+    }
+    let mirrored = DVec3::new(2.0 * dab.mirror_plane_x - centre.x, centre.y, centre.z);
+    let target = (dab.value.clamp(0.0, 1.0) * 255.0).round();
+    let strength = dab.strength.clamp(0.0, 1.0);
+    let view = dab.view_direction.map(DVec3::from_array);
+    let channel = dab.channel.index();
+    let mut changed = 0;
+    for (texel, root) in maps.texels_mut().iter_mut().zip(&raster.texels) {
+        let Some((position, normal)) = root else {
+            continue;
+        };
+        if let Some(view) = view
+            && normal.dot(view) > 0.0
+        {
+            continue;
+        }
+        let mut weight = falloff_weight(position.distance(centre), dab.radius_m);
+        if dab.mirror_x {
+            weight = weight.max(falloff_weight(position.distance(mirrored), dab.radius_m));
+        }
+        let weight = weight * strength;
+        if weight <= 0.0 {
+            continue;
+        }
+        let old = texel[channel] as f64;
+        let mut new = (old + (target - old) * weight).round();
+        if new == old && old != target {
+            new = old + (target - old).signum();
+        }
+        if new != old {
+            texel[channel] = new as u8;
+            changed += 1;
+        }
+    }
+    changed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::root_maps::DEFAULT_ROOT_MAP_SIDE;
+    use crate::samples::grid_scalp;
+
+    fn scalp() -> HairMesh {
+        // A 4 × 4 grid of quads over x, z ∈ [0, 0.4] (y = 0) with uvs over [0, 1]².
+        grid_scalp(4, 4, |s, t| DVec3::new(0.4 * s, 0.0, 0.4 * t))
+    }
+
+    #[test]
+    fn the_raster_covers_the_scalp_faces_once_with_their_roots() {
+        let mesh = scalp();
+        let raster = RootMapRaster::new(&mesh, 32, 32);
+        let (lo, hi) = mesh.bounds().expect("a scalp");
+        assert!(raster.covered() > 0);
+        for y in 0..32 {
+            for x in 0..32 {
+                if let Some(p) = raster.root_of(x, y) {
+                    assert!(p.is_finite());
+                    assert!(p.cmpge(lo - 1e-9).all() && p.cmple(hi + 1e-9).all(), "{p}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_dab_paints_near_its_centre_only_mirrored_and_front_facing() {
+        let mesh = scalp();
+        let side = DEFAULT_ROOT_MAP_SIDE;
+        let raster = RootMapRaster::new(&mesh, side, side);
+        assert!(raster.covered() > 1000, "{}", raster.covered());
+        let mut maps = RootMaps::blank(side, side).expect("maps");
+        let (lo, hi) = mesh.bounds().expect("a scalp");
+        let corner = DVec3::new(lo.x + 0.05, lo.y, lo.z + 0.05);
+        let dab = MapDab {
+            channel: RootMapChannel::Density,
+            centre_m: corner.to_array(),
+            radius_m: 0.04,
+            value: 0.0,
+            strength: 1.0,
+            view_direction: None,
+            mirror_x: false,
+            mirror_plane_x: 0.5 * (lo.x + hi.x),
+        };
+        let changed = paint_dab(&mut maps, &raster, &dab);
+        assert!(changed > 0);
+        let texel = |maps: &RootMaps, p: DVec3| -> u8 {
+            let mut best = (f64::INFINITY, 255);
+            for y in 0..side {
+                for x in 0..side {
+                    if let Some(root) = raster.root_of(x, y) {
+                        let d = root.distance(p);
+                        if d < best.0 {
+                            best = (d, maps.texels()[(y * side + x) as usize][0]);
+                        }
+                    }
+                }
+            }
+            best.1
+        };
+        assert_eq!(texel(&maps, corner), 0, "painted at the centre");
+        let far = DVec3::new(hi.x - 0.05, lo.y, hi.z - 0.05);
+        assert_eq!(texel(&maps, far), 255, "untouched far away");
+        // Only density changed.
+        assert!(maps.texels().iter().all(|t| t[1] == 255 && t[2] == 255));
+        // Mirrored: the other side too.
+        let mirror = DVec3::new(hi.x - 0.05, lo.y, lo.z + 0.05);
+        assert_eq!(texel(&maps, mirror), 255);
+        paint_dab(
+            &mut maps,
+            &raster,
+            &MapDab {
+                mirror_x: true,
+                ..dab
+            },
+        );
+        assert_eq!(texel(&maps, mirror), 0, "the mirror image is painted");
+        // Seen from the side its normal points to (the roots face +y or −y): a view looking
+        // along the normal is behind the scalp, and paints nothing.
+        let normal = raster.texels.iter().flatten().next().expect("a texel").1;
+        let mut fresh = RootMaps::blank(side, side).expect("maps");
+        let behind = MapDab {
+            view_direction: Some(normal.to_array()),
+            ..dab
+        };
+        assert_eq!(paint_dab(&mut fresh, &raster, &behind), 0);
+        let front = MapDab {
+            view_direction: Some((-normal).to_array()),
+            ..dab
+        };
+        assert!(paint_dab(&mut fresh, &raster, &front) > 0);
+        // Light dabs still arrive: strength 0.001 moves each reached texel a step.
+        let mut light = RootMaps::blank(side, side).expect("maps");
+        let before = light.clone();
+        paint_dab(
+            &mut light,
+            &raster,
+            &MapDab {
+                strength: 0.001,
+                ..dab
+            },
+        );
+        assert_ne!(light, before);
+        // Degenerate dabs change nothing.
+        for bad in [
+            MapDab {
+                radius_m: f64::NAN,
+                ..dab
+            },
+            MapDab {
+                centre_m: [f64::NAN, 0.0, 0.0],
+                ..dab
+            },
+            MapDab {
+                value: f64::INFINITY,
+                ..dab
+            },
+        ] {
+            let mut maps = RootMaps::blank(side, side).expect("maps");
+            assert_eq!(paint_dab(&mut maps, &raster, &bad), 0);
+        }
+        // Maps of another size than the raster's: nothing.
+        let mut other = RootMaps::blank(8, 8).expect("maps");
+        assert_eq!(paint_dab(&mut other, &raster, &dab), 0);
+    }
+}
