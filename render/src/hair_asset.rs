@@ -28,7 +28,7 @@ use crate::preview::default_strand_width_m;
 use crate::renderer::fur::{FurStrands, GpuFur};
 use crate::renderer::preview_body::GpuBody;
 use crate::renderer::strand_gen::{GpuFarHair, GpuHair, StrandGenError, StrandGenRenderer};
-use hairloom_core::runtime::thick_hair::FarHair;
+use hairloom_core::runtime::thick_hair::{FarHair, ThickHairError};
 
 /// Why an asset could not be put on the GPU.
 #[derive(Debug, thiserror::Error)]
@@ -43,6 +43,8 @@ pub enum HairAssetError {
     FurFailed(String),
     #[error("far hair's hierarchy: {0}")]
     FarHair(#[from] hairloom_core::runtime::thick_hair::ThickHairError),
+    #[error("far hair's hierarchy: {0}")]
+    FarHairFailed(String),
 }
 
 /// What a restyle carries: the styling parameters and the painted maps (both read per
@@ -125,6 +127,12 @@ pub struct HairAsset {
     /// Kept through a restyle or a reshape (its thick hairs are generated from the textures
     /// every frame, so they follow); made again after a rebuild.
     far: Option<GpuFarHair>,
+    /// Far hair's hierarchy being built on a worker thread for the viewport
+    /// ([`Self::prepare_far_hair`]): frames draw strands until it is ready. A rebuild makes a
+    /// new asset, which drops the handle (the worker's result is then discarded).
+    far_build: Option<FarBuild>,
+    /// Why the last build failed: not tried again every frame.
+    far_failure: Option<String>,
     /// Fur's textures and patches (seed 002), once a scene asked for them; made again when
     /// the hair's root faces or the scene's fur settings change.
     fur: Option<GpuFur>,
@@ -148,6 +156,8 @@ impl HairAsset {
             gpu,
             bounds,
             far: None,
+            far_build: None,
+            far_failure: None,
             fur: None,
             fur_failure: None,
         })
@@ -196,6 +206,8 @@ impl HairAsset {
                     self.hair = *hair;
                     self.bounds = bounds;
                     self.vertices_log2 = self.hair.strand_vertices_log2();
+                    // Other hair: a build that failed may succeed now.
+                    self.far_failure = None;
                     return Ok(ChangeKind::Reshape);
                 }
                 *self = HairAsset::upload(context, generator, *hair)?;
@@ -240,17 +252,67 @@ impl HairAsset {
     /// Far hair's hierarchy as a bundle carries it (`LoadedBundle::far_hair`).
     pub fn set_far_hair(&mut self, context: &GpuContext, table: FarHair) {
         self.far = Some(GpuFarHair::upload(context, table));
+        self.far_build = None;
     }
 
     /// Builds far hair's hierarchy from the strands at full detail where the asset has none
     /// yet (as an export does: the costly part, seconds on a large groom), and uploads it.
+    /// Blocks: for renders, benches and games that need it in their first frame. The
+    /// viewport uses [`Self::prepare_far_hair`].
     pub fn ensure_far_hair(&mut self, context: &GpuContext) -> Result<(), HairAssetError> {
         if self.far.is_none() {
-            let vertex_count = (1usize << self.hair.lod.max_vertices_log2.min(8)) + 1;
-            let table = FarHair::build(&self.hair, vertex_count)?;
+            let table = match self.far_build.take() {
+                // A build already under way: wait for it rather than start another.
+                Some(build) => build.join()?,
+                None => FarHair::build(&self.hair, far_vertex_count(&self.hair))?,
+            };
             self.far = Some(GpuFarHair::upload(context, table));
         }
         Ok(())
+    }
+
+    /// Far hair's hierarchy without stalling the caller (the editor's paint callback, where a
+    /// build of seconds froze the viewport when far hair was switched on): starts the build on
+    /// a worker thread, and on a later call uploads what it made. `Ok(true)` once far hair
+    /// is on the GPU; `Ok(false)` while it is building (draw strands meanwhile, and call
+    /// again); a failed build's error, at once and without building again, until the hair is
+    /// reshaped.
+    pub fn prepare_far_hair(&mut self, context: &GpuContext) -> Result<bool, HairAssetError> {
+        if self.far.is_some() {
+            return Ok(true);
+        }
+        if let Some(message) = &self.far_failure {
+            return Err(HairAssetError::FarHairFailed(message.clone()));
+        }
+        match self.far_build.take() {
+            Some(build) if build.is_finished() => match build.join() {
+                Ok(table) => {
+                    self.far = Some(GpuFarHair::upload(context, table));
+                    Ok(true)
+                }
+                Err(error) => {
+                    self.far_failure = Some(error.to_string());
+                    Err(error)
+                }
+            },
+            Some(build) => {
+                self.far_build = Some(build);
+                Ok(false)
+            }
+            None => match FarBuild::start(&self.hair) {
+                Some(build) => {
+                    self.far_build = Some(build);
+                    Ok(false)
+                }
+                // No thread to be had: build it here.
+                None => self.ensure_far_hair(context).map(|()| true),
+            },
+        }
+    }
+
+    /// Whether far hair's hierarchy is being built on a worker.
+    pub fn far_hair_building(&self) -> bool {
+        self.far_build.is_some()
     }
 
     /// Makes fur's textures and patches for `settings` where they are missing or were made
@@ -339,6 +401,41 @@ impl HairAsset {
             lod,
             far: self.far.as_ref(),
             fur: self.fur.as_ref(),
+        }
+    }
+}
+
+/// Strand vertices far hair's hierarchy is fitted to.
+fn far_vertex_count(hair: &RuntimeHair) -> usize {
+    (1usize << hair.lod.max_vertices_log2.min(8)) + 1
+}
+
+/// Far hair's hierarchy being built on a worker thread from a copy of the runtime data.
+struct FarBuild(std::thread::JoinHandle<Result<FarHair, ThickHairError>>);
+
+impl FarBuild {
+    /// `None` when no thread could be started.
+    fn start(hair: &RuntimeHair) -> Option<Self> {
+        let hair = hair.clone();
+        std::thread::Builder::new()
+            .name("far hair hierarchy".into())
+            .spawn(move || FarHair::build(&hair, far_vertex_count(&hair)))
+            .ok()
+            .map(Self)
+    }
+
+    fn is_finished(&self) -> bool {
+        self.0.is_finished()
+    }
+
+    /// Waits for the build; a worker that panicked (a bug) is an error that says so.
+    fn join(self) -> Result<FarHair, HairAssetError> {
+        match self.0.join() {
+            Ok(built) => Ok(built?),
+            Err(_) => Err(HairAssetError::FarHairFailed(
+                "the worker building it stopped (a bug); switch far hair off and on to try again"
+                    .into(),
+            )),
         }
     }
 }

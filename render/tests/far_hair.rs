@@ -187,3 +187,55 @@ fn far_hair_is_refused_by_name_where_it_is_not_drawn() {
         "{error}"
     );
 }
+
+/// Issue 33: the viewport's far hair does not stall its frame. `prepare_far_hair` starts the
+/// hierarchy's build on a worker and returns at once (the frame draws strands meanwhile);
+/// a later call uploads what the worker made, the same table `ensure_far_hair` builds in
+/// place; a rebuild of the asset drops a build under way.
+#[test]
+fn far_hair_builds_on_a_worker_without_stalling_the_frame() {
+    use hairloom_render::hair_asset::HairAsset;
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let generator = StrandGenRenderer::with_path(&context, GenerationPath::ComputePerStrand);
+    let document = common::sample("head_long_wavy");
+    let options = RuntimeOptions {
+        strands_per_bundle: 16,
+        ..RuntimeOptions::default()
+    };
+    let mut asset =
+        HairAsset::from_document(&context, &generator, &document, &options).expect("asset");
+    assert!(!asset.prepare_far_hair(&context).expect("started"));
+    assert!(asset.far_hair_building() && asset.far_hair().is_none());
+    let started = std::time::Instant::now();
+    let ready = loop {
+        if asset.prepare_far_hair(&context).expect("builds") {
+            break true;
+        }
+        if started.elapsed() > std::time::Duration::from_secs(600) {
+            break false;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert!(ready, "the worker finished");
+    assert!(!asset.far_hair_building());
+    let mut in_place =
+        HairAsset::from_document(&context, &generator, &document, &options).expect("asset");
+    in_place.ensure_far_hair(&context).expect("built in place");
+    let (worker, here) = (
+        &asset.far_hair().expect("uploaded").table,
+        &in_place.far_hair().expect("uploaded").table,
+    );
+    assert_eq!(worker, here, "the worker builds what a build in place does");
+    // Once ready, it stays: no second build.
+    assert!(asset.prepare_far_hair(&context).expect("ready"));
+    assert!(!asset.far_hair_building());
+    // ensure_far_hair joins a build under way rather than starting another.
+    let mut joined =
+        HairAsset::from_document(&context, &generator, &document, &options).expect("asset");
+    assert!(!joined.prepare_far_hair(&context).expect("started"));
+    joined.ensure_far_hair(&context).expect("joined");
+    assert!(!joined.far_hair_building());
+    assert_eq!(&joined.far_hair().expect("uploaded").table, here);
+}

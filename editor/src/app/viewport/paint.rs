@@ -13,6 +13,10 @@ use hairloom_render::renderer::preview_body::GpuBody;
 use hairloom_render::renderer::strand_gen::GenerationPath;
 use hairloom_render::renderer::viewport_blit::ViewportBlitRenderer;
 
+/// How often a viewport waiting for far hair's hierarchy (built on a worker) draws again to
+/// pick it up.
+const FAR_HAIR_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
 /// The viewport's GPU side, kept in egui_wgpu's callback resources.
 pub(super) struct ViewportGpu {
     pub(super) context: GpuContext,
@@ -100,11 +104,17 @@ impl ViewportGpu {
             self.draw_bare_body(frame, shared, ctx);
             return;
         };
-        if frame.lighting.effects.far_hair == hairloom_core::model::scene::FarHair::Aggregated
-            && let Err(error) = hair.ensure_far_hair(&self.context)
-        {
-            let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
-            report.upload_error = Some(format!("cannot draw far hair: {error}"));
+        // Far hair's hierarchy is built on a worker (seconds on a long groom): strands are
+        // drawn until it is ready, and the viewport asks to be drawn again to pick it up.
+        if frame.lighting.effects.far_hair == hairloom_core::model::scene::FarHair::Aggregated {
+            match hair.prepare_far_hair(&self.context) {
+                Ok(true) => {}
+                Ok(false) => ctx.request_repaint_after(FAR_HAIR_POLL),
+                Err(error) => {
+                    let mut report = shared.report.lock().unwrap_or_else(|e| e.into_inner());
+                    report.upload_error = Some(format!("cannot draw far hair: {error}"));
+                }
+            }
         }
         if frame.lighting.effects.fur == hairloom_core::model::scene::Fur::ShellsFins
             && let Err(error) = hair.ensure_fur(&self.context, &frame.lighting.effects.fur_shells)
