@@ -830,3 +830,74 @@ fn maps_brings_painted_images_in_as_one_undo_step_and_refuses_bad_ones_by_name()
     let cleared = hairloom_core::io::project::load(&project).expect("load");
     assert!(cleared.document.root_maps.is_empty());
 }
+
+/// Issue 35 (look-dev): `render --turntable N` writes N pictures going once round the hair,
+/// the camera and the lights turning together: frame 0 is the plain picture from --view,
+/// the others differ; frame 2 of 4 (half a turn) matches neither the front picture nor a
+/// plain render from behind (the lights came round too). Too many frames are refused.
+#[test]
+fn render_turntable_goes_round_the_hair_with_its_lights() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let sample = samples()
+        .into_iter()
+        .find(|p| p.to_string_lossy().contains("short"))
+        .expect("short sample");
+    let render = |out: &Path, extra: &[&str]| {
+        run(hairloom()
+            .arg("render")
+            .arg(&sample)
+            .arg("--out")
+            .arg(out)
+            .args([
+                "--size",
+                "96x96",
+                "--strands-per-bundle",
+                "4",
+                "--effects",
+                "none",
+            ])
+            .args(extra))
+    };
+    let out = dir.path().join("turn.png");
+    let (code, stdout, stderr) = render(&out, &["--view", "front", "--turntable", "4"]);
+    if code != 0
+        && stderr.contains("no GPU adapter")
+        && hairloom_render::device::skip_test_without_gpu("render", &stderr)
+    {
+        return;
+    }
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("(180°)"), "{stdout}");
+    let frames: Vec<Vec<u8>> = (0..4)
+        .map(|i| {
+            let path = dir.path().join(format!("turn_{i:03}.png"));
+            image::open(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .to_rgba8()
+                .into_raw()
+        })
+        .collect();
+    assert!(!dir.path().join("turn.png").exists(), "frames only");
+    let plain = |view: &str| {
+        let path = dir.path().join(format!("{view}.png"));
+        let (code, _, stderr) = render(&path, &["--view", view]);
+        assert_eq!(code, 0, "{stderr}");
+        image::open(&path).expect("png").to_rgba8().into_raw()
+    };
+    assert_eq!(
+        frames[0],
+        plain("front"),
+        "frame 0 is the picture from --view"
+    );
+    for i in 1..4 {
+        assert_ne!(frames[i], frames[0], "frame {i} turned");
+    }
+    assert_ne!(
+        frames[2],
+        plain("0,0.1,-1"),
+        "the lights turned with the camera"
+    );
+    let (code, _, stderr) = render(&out, &["--turntable", "361"]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("at most 360"), "{stderr}");
+}

@@ -777,11 +777,79 @@ impl Scene {
     pub fn camera(&self, name: &str) -> Option<&CameraPreset> {
         self.cameras.iter().find(|c| c.name == name)
     }
+
+    /// This scene with its lights turned by `angle_rad` about the vertical (y) axis through
+    /// `centre`: with the camera turned as much, the model seems to turn on a turntable
+    /// under studio lights that stay where they were relative to the camera.
+    pub fn lights_turned(&self, angle_rad: f64, centre: glam::DVec3) -> Scene {
+        let turn = glam::DQuat::from_rotation_y(angle_rad);
+        let mut scene = self.clone();
+        for light in &mut scene.lights {
+            light.source = match light.source {
+                LightSource::Directional { to_light } => LightSource::Directional {
+                    to_light: (turn * glam::Vec3::from(to_light).as_dvec3())
+                        .as_vec3()
+                        .to_array(),
+                },
+                LightSource::Point { position_m } => LightSource::Point {
+                    position_m: (centre
+                        + turn * (glam::Vec3::from(position_m).as_dvec3() - centre))
+                        .as_vec3()
+                        .to_array(),
+                },
+            };
+        }
+        scene
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn turned_lights_keep_their_place_relative_to_a_turned_camera() {
+        let mut scene = Scene::default();
+        scene.lights.push(Light {
+            name: "bulb".into(),
+            source: LightSource::Point {
+                position_m: [1.0, 2.0, 0.0],
+            },
+            color: [1.0; 3],
+            intensity: 1.0,
+            casts_shadows: false,
+        });
+        let centre = glam::DVec3::new(1.0, 0.0, -1.0);
+        let quarter = scene.lights_turned(std::f64::consts::FRAC_PI_2, centre);
+        for (before, after) in scene.lights.iter().zip(&quarter.lights) {
+            // A quarter turn about y takes x to −z and z to x, heights kept.
+            match (&before.source, &after.source) {
+                (
+                    LightSource::Directional { to_light: a },
+                    LightSource::Directional { to_light: b },
+                ) => {
+                    let expected = [a[2], a[1], -a[0]];
+                    for (got, want) in b.iter().zip(expected) {
+                        assert!((got - want).abs() < 1e-6, "{a:?} → {b:?}");
+                    }
+                }
+                (LightSource::Point { position_m: a }, LightSource::Point { position_m: b }) => {
+                    // (1, 2, 0) is (0, 2, 1) from the centre: a quarter turn makes it (1, 2, 0)
+                    // from the centre, (2, 2, −1) in the scene.
+                    assert_eq!(*a, [1.0, 2.0, 0.0]);
+                    for (got, want) in b.iter().zip([2.0, 2.0, -1.0]) {
+                        assert!((got - want).abs() < 1e-6, "{b:?}");
+                    }
+                }
+                _ => panic!("a light changed its kind"),
+            }
+        }
+        // A whole turn is no turn; nothing else of the scene changes.
+        let whole = scene.lights_turned(std::f64::consts::TAU, centre);
+        assert_eq!(whole.effects, scene.effects);
+        assert_eq!(whole.cameras, scene.cameras);
+        assert_eq!(scene.lights_turned(0.0, centre), scene);
+    }
 
     #[test]
     fn the_default_scene_is_valid_and_round_trips_through_json() {

@@ -182,6 +182,11 @@ enum Command {
         /// (a scene without motion renders as modelled).
         #[arg(long, default_value_t = 0.0)]
         time: f64,
+        /// A turntable: N pictures (OUT_000.png …) with the camera and the lights going once
+        /// round the hair from --view, as if the model turned under studio lights (at most
+        /// 360).
+        #[arg(long, default_value_t = 0)]
+        turntable: u32,
     },
     /// Simulate a project's motion and write the frames as a PNG sequence (and, with
     /// --usda / --abc, the strands animated over time).
@@ -323,6 +328,7 @@ pub fn main() -> ExitCode {
             alpha_vertices,
             lambda,
             time,
+            turntable,
         }) => {
             if !(distance.is_finite() && (0.1..=1000.0).contains(&distance)) {
                 eprintln!("error: --distance {distance} must be between 0.1 and 1000");
@@ -360,6 +366,8 @@ pub fn main() -> ExitCode {
                     strand_keep: 1.0,
                 },
                 time_s: time,
+                turntable,
+                turn_rad: 0.0,
             };
             render::run(&input, &out, &settings)
         }

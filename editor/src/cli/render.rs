@@ -50,6 +50,11 @@ pub struct RenderSettings {
     pub lod: LodSettings,
     /// `--time`: simulate the scene's motion to this time first (projects only).
     pub time_s: f64,
+    /// `--turntable N`: N pictures around the hair (0: one picture).
+    pub turntable: u32,
+    /// How far the camera and the lights are turned about the vertical through the hair's
+    /// centre (a turntable's frame).
+    pub turn_rad: f64,
 }
 
 impl Default for RenderSettings {
@@ -66,8 +71,26 @@ impl Default for RenderSettings {
             generation: GenerationPath::default(),
             lod: LodSettings::default(),
             time_s: 0.0,
+            turntable: 0,
+            turn_rad: 0.0,
         }
     }
+}
+
+/// The most frames `--turntable` makes (one a degree).
+pub const MAX_TURNTABLE_FRAMES: u32 = 360;
+
+/// Frame `index` of a turntable of `out`: `NAME_007.png` beside `NAME.png`.
+pub fn turntable_frame_path(out: &Path, index: u32) -> std::path::PathBuf {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "turntable".into());
+    let name = match out.extension() {
+        Some(extension) => format!("{stem}_{index:03}.{}", extension.to_string_lossy()),
+        None => format!("{stem}_{index:03}"),
+    };
+    out.with_file_name(name)
 }
 
 pub fn parse_size(size: &str) -> anyhow::Result<(u32, u32)> {
@@ -293,9 +316,16 @@ pub fn write_png(out: &Path, pixels: &[u8], width: u32, height: u32) -> anyhow::
         .with_context(|| format!("writing {}", out.display()))
 }
 
-/// The asset's scene with `--effects` applied.
+/// The asset's scene with `--effects` applied, its lights turned with a turntable's camera.
 pub fn scene_for(hair: &RuntimeHair, settings: &RenderSettings) -> anyhow::Result<Scene> {
     let mut scene = hair.scene.clone();
+    if settings.turn_rad != 0.0 {
+        let centre = hair
+            .textures
+            .hair_bounds()
+            .map_or(glam::DVec3::ZERO, |(lo, hi)| ((lo + hi) * 0.5).as_dvec3());
+        scene = scene.lights_turned(settings.turn_rad, centre);
+    }
     if let Some(list) = &settings.effects {
         scene.effects = scene.effects.parse_list(list).map_err(anyhow::Error::msg)?;
     }
@@ -313,9 +343,39 @@ pub fn run(input: &Path, out: &Path, settings: &RenderSettings) -> anyhow::Resul
     let hair = load_hair(input, settings)?;
     let direction = parse_view(&settings.view, &hair.scene)?;
     scene_for(&hair, settings)?;
+    if settings.turntable > MAX_TURNTABLE_FRAMES {
+        bail!(
+            "--turntable {}: at most {MAX_TURNTABLE_FRAMES} frames",
+            settings.turntable
+        );
+    }
     let context = GpuContext::new_headless()?;
-    let (pixels, summary) = render_pixels(&context, hair, width, height, direction, settings)?;
-    write_png(out, &pixels, width, height)?;
-    println!("{}: {summary}", out.display());
+    if settings.turntable == 0 {
+        let (pixels, summary) = render_pixels(&context, hair, width, height, direction, settings)?;
+        write_png(out, &pixels, width, height)?;
+        println!("{}: {summary}", out.display());
+        return Ok(());
+    }
+    // A turntable: the camera and the lights go round the hair together, the asset made once.
+    let frame = still_frame(&hair)?;
+    let mut renderer = HeadlessRenderer::new(&context, settings.generation);
+    renderer.show(&context, hair, ChangeKind::Rebuild)?;
+    for index in 0..settings.turntable {
+        let turn_rad = std::f64::consts::TAU * index as f64 / settings.turntable as f64;
+        let turned = RenderSettings {
+            turn_rad,
+            ..settings.clone()
+        };
+        let view = glam::DQuat::from_rotation_y(turn_rad) * direction.as_dvec3();
+        let (pixels, summary) =
+            renderer.draw(&context, (width, height), frame, view.as_vec3(), &turned)?;
+        let path = turntable_frame_path(out, index);
+        write_png(&path, &pixels, width, height)?;
+        println!(
+            "{} ({:.0}°): {summary}",
+            path.display(),
+            turn_rad.to_degrees()
+        );
+    }
     Ok(())
 }
