@@ -953,6 +953,30 @@ fn brush_start(
     None
 }
 
+/// The summed length of every column's segments.
+fn hair_length(mesh: &hairloom_core::HairMesh) -> f64 {
+    mesh.columns
+        .iter()
+        .map(|c| {
+            c.positions
+                .windows(2)
+                .map(|s| s[0].distance(s[1]))
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+/// Waits (at most 6 s) for the brushes' body field, built on a worker once Groom is chosen.
+fn wait_for_brush_field(harness: &mut Harness<'static, HairloomApp>) {
+    for _ in 0..600 {
+        if harness.state().viewport.brush_field_status() == "ready" {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        harness.run();
+    }
+}
+
 fn viewport_rect(harness: &Harness<'static, HairloomApp>) -> egui::Rect {
     harness.state().viewport.rect.expect("viewport drawn")
 }
@@ -2581,19 +2605,8 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
     harness.run();
     drag(&mut harness, start, start + egui::vec2(40.0, 0.0));
     let grown = harness.state().state.document().clone();
-    let length = |mesh: &hairloom_core::HairMesh| -> f64 {
-        mesh.columns
-            .iter()
-            .map(|c| {
-                c.positions
-                    .windows(2)
-                    .map(|s| s[0].distance(s[1]))
-                    .sum::<f64>()
-            })
-            .sum()
-    };
     assert!(
-        length(&grown.hair_mesh) > length(&original.hair_mesh),
+        hair_length(&grown.hair_mesh) > hair_length(&original.hair_mesh),
         "{}",
         harness.state().state.message
     );
@@ -2625,13 +2638,7 @@ fn painting_the_density_map_thins_the_hair_as_one_undo_step() {
     // Value 0 is the default: paint where hair does not grow.
     assert_eq!(harness.state().state.tool.brush.paint_value, 0.0);
     // The field that finds the scalp under the pointer is built off the UI thread: wait.
-    for _ in 0..600 {
-        if harness.state().viewport.brush_field_status() == "ready" {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-        harness.run();
-    }
+    wait_for_brush_field(&mut harness);
     let start = brush_start(&mut harness, 3..12)
         .expect("some point of the viewport shows the scalp under the brush");
     drag(&mut harness, start, start + egui::vec2(60.0, 20.0));
@@ -2700,4 +2707,145 @@ fn painting_the_density_map_thins_the_hair_as_one_undo_step() {
     harness.get_by_label("Clear density map").click();
     harness.run();
     assert!(harness.state().state.document().root_maps.is_empty());
+}
+
+/// Issue 35's walkthrough (README, "A hairstyle from scratch"), step by step on the head
+/// scan with the selection, extrude, the brushes and the maps alone: import the scan, keep
+/// the crown seen from the top, extrude it into bundles, grow and comb them with the
+/// brushes, paint a thinner patch into the density map, export the runtime bundle, which
+/// loads and grows strands. Every step is one undo step.
+#[test]
+fn a_hairstyle_from_import_to_export_with_the_brushes_and_maps_alone() {
+    let glb =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/head/LeePerrySmith.glb");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let runtime = dir.path().join("runtime");
+    // 1. The scan is about 4.9 units from chin to crown: `hairloom import --scale 0.045`
+    // makes it a 22 cm head in metres, the units the tools' sizes are in. Every face of
+    // the scan comes in bare.
+    let project = dir.path().join("head.hairloom");
+    let imported = std::process::Command::new(env!("CARGO_BIN_EXE_hairloom"))
+        .arg("import")
+        .arg(&glb)
+        .args(["--scale", "0.045", "--out"])
+        .arg(&project)
+        .output()
+        .expect("hairloom import");
+    assert!(
+        imported.status.success(),
+        "{}",
+        String::from_utf8_lossy(&imported.stderr)
+    );
+    let mut harness = harness_with(
+        &fresh_recovery_dir(),
+        ScriptedDialogs::new([
+            DialogAnswer::Chosen(project),
+            DialogAnswer::Chosen(runtime.clone()),
+        ]),
+    );
+    harness.set_size(egui::vec2(1100.0, 720.0));
+    harness.run();
+    file_menu(&mut harness, "Open…");
+    let imported = harness.state().state.document().hair_mesh.bundles.len();
+    assert!(imported > 1000, "{}", harness.state().state.message);
+    // 2. The top view (7), a box over the crown, Edit ▸ Keep only selected bundles.
+    let rect = viewport_rect(&harness);
+    harness.hover_at(rect.center());
+    harness.run();
+    harness.key_press(egui::Key::Num7);
+    harness.run();
+    drag(
+        &mut harness,
+        rect.left_top() + egui::vec2(rect.width() * 0.4, rect.height() * 0.3),
+        rect.left_top() + egui::vec2(rect.width() * 0.6, rect.height() * 0.55),
+    );
+    let selected = harness.state().state.selection.len();
+    assert!(
+        (20..imported / 2).contains(&selected),
+        "{selected} of {imported}: {}",
+        harness.state().state.message
+    );
+    edit_menu(&mut harness, "Keep only selected bundles");
+    assert_eq!(
+        harness.state().state.document().hair_mesh.bundles.len(),
+        selected
+    );
+    // 3. A (all), Extrude three times: three layers of hair mesh over the crown.
+    harness.hover_at(rect.center());
+    harness.run();
+    harness.key_press(egui::Key::A);
+    harness.run();
+    for _ in 0..3 {
+        // The Tools panel's button (the History panel lists "Extrude" steps too, after it).
+        harness
+            .query_all_by_role_and_label(Role::Button, "Extrude")
+            .next()
+            .expect("the Extrude button")
+            .click();
+        harness.run();
+    }
+    let extruded = harness.state().state.document().clone();
+    assert!(
+        extruded.hair_mesh.bundles.iter().all(|b| b.layers == 3),
+        "{}",
+        harness.state().state.message
+    );
+    // 4. Drag: Groom, the Grow / cut brush over the crown: longer hair.
+    harness.get_by_label("Groom").click();
+    harness.run();
+    wait_for_brush_field(&mut harness);
+    harness.get_by_label("Grow / cut").click();
+    harness.run();
+    let start = brush_start(&mut harness, 8..12).expect("the crown's hair under the brush");
+    drag(&mut harness, start, start + egui::vec2(60.0, 10.0));
+    let grown = harness.state().state.document().clone();
+    assert!(
+        hair_length(&grown.hair_mesh) > hair_length(&extruded.hair_mesh),
+        "{}",
+        harness.state().state.message
+    );
+    // 5. The Comb brush across it: the hair moves, lengths kept.
+    harness.get_by_label("Comb").click();
+    harness.run();
+    drag(&mut harness, start, start + egui::vec2(-50.0, 30.0));
+    let combed = harness.state().state.document().clone();
+    assert_ne!(
+        combed.hair_mesh,
+        grown.hair_mesh,
+        "{}",
+        harness.state().state.message
+    );
+    // 6. Paint map: Density map at 0.3 over part of it: fewer strands there.
+    harness.get_by_label("Density map").click();
+    harness.run();
+    harness
+        .get_by_role_and_label(Role::Slider, "Paint value")
+        .set_value_accesskit(0.3);
+    harness.run();
+    let paint_start = brush_start(&mut harness, 8..12).expect("the scalp under the brush");
+    drag(
+        &mut harness,
+        paint_start,
+        paint_start + egui::vec2(40.0, 0.0),
+    );
+    let painted = harness.state().state.document().clone();
+    assert!(
+        painted.root_maps.texels().iter().any(|t| t[0] < 200),
+        "{}",
+        harness.state().state.message
+    );
+    // 7. File ▸ Export runtime bundle…: it loads, and grows strands.
+    file_menu(&mut harness, "Export runtime bundle…");
+    wait_for_export(&mut harness);
+    let bundle = hairloom_core::io::runtime_bundle::load_runtime_bundle(&runtime).expect("loads");
+    assert_eq!(bundle.textures.root_maps, painted.root_maps);
+    let grown_strands: u32 = (0..bundle.textures.atlas.blocks.len())
+        .map(|b| bundle.block_strand_count(b))
+        .sum();
+    assert!(grown_strands > 1000, "{grown_strands}");
+    // One undo step each: keep, three extrusions, grow, comb, paint.
+    let history = &harness.state().state.project.history;
+    let labels: Vec<&str> = history.undo.iter().map(|c| c.label()).collect();
+    assert_eq!(labels.len(), 7, "{labels:?}");
+    painted.validate().expect("a valid document");
 }
