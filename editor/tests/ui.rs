@@ -589,6 +589,9 @@ fn after_new_and_import_scalp_the_title_names_the_scalp_not_the_sample() {
     assert!(harness.state().state.title().contains("(sample)"));
     file_menu(&mut harness, "New");
     file_menu(&mut harness, "Import scalp…");
+    // The scan's size asks for its units first.
+    harness.get_by_label("Import").click();
+    harness.run();
     let title = harness.state().state.title();
     assert!(!title.contains("sample"), "{title}");
     assert!(title.contains("LeePerrySmith"), "{title}");
@@ -613,8 +616,24 @@ fn importing_a_scalp_is_one_undo_step() {
     assert_eq!(harness.state().state.document(), &original);
 
     file_menu(&mut harness, "Import scalp…");
+    // The scan is 8.6 units across (a 4.9 m head in metres): its units are asked for, and
+    // the scale the artist gives makes it the size it is.
+    harness
+        .get_by_role_and_label(Role::SpinButton, "Scale")
+        .set_value_accesskit(0.045);
+    harness.run();
+    harness.get_by_label("Import").click();
+    harness.run();
     let imported = harness.state().state.document().clone();
     assert_eq!(imported.name, "LeePerrySmith");
+    let (lo, hi) = imported.body.bounds().expect("a body");
+    let across = (hi - lo).max_element();
+    assert!((0.35..0.42).contains(&across), "{across} m across");
+    let (lo, hi) = imported.hair_mesh.bounds().expect("a scalp");
+    assert!(
+        ((hi - lo).max_element() - across as f64).abs() < 1e-3,
+        "the scalp scaled too"
+    );
     assert!(imported.hair_mesh.bundles.len() > original.hair_mesh.bundles.len());
     assert!(imported.hair_mesh.bundles.iter().all(|b| b.layers == 0));
     assert_eq!(imported.styling, original.styling, "the styling is kept");

@@ -705,8 +705,18 @@ impl HairloomApp {
                 self.scalp_import = None;
                 self.state.message = "import cancelled".into();
             }
-            scalp_import::ScalpImportAction::Import(region) => {
-                if let Some(import) = self.scalp_import.take() {
+            scalp_import::ScalpImportAction::Import(region, scale) => {
+                if let Some(mut import) = self.scalp_import.take() {
+                    if scale != 1.0 {
+                        for p in &mut import.mesh.positions {
+                            *p *= scale;
+                        }
+                        if let Some(body) = &mut import.body {
+                            for p in &mut body.positions {
+                                *p = p.map(|c| (c as f64 * scale) as f32);
+                            }
+                        }
+                    }
                     self.finish_scalp_import(&import.path, &import.mesh, import.body, &region);
                 }
             }

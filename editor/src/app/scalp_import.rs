@@ -7,6 +7,11 @@
 //!
 //! A file of several meshes (a character whose scalp, face, eyes and clothes are separate)
 //! first asks which mesh hair grows on ([`MeshChoice`]); every mesh then becomes the body.
+//!
+//! glTF counts in metres, and so do the tools (a 3 cm brush, a 2 cm extrusion). A file
+//! whose size is implausible in metres (the bundled head scan is 8.6 units across: a 4.9 m
+//! head) is asked about too: the modal offers a scale (metres, centimetres, millimetres,
+//! inches or any factor) and shows the size it gives, so the brushes fit the head.
 
 use std::path::PathBuf;
 
@@ -38,6 +43,31 @@ pub struct ScalpImport {
     /// The region last counted and its count (or why it is no region): counted again only
     /// when the choice changes, not every frame.
     counted: Option<(ScalpRegion, Result<usize, String>)>,
+    /// Model units (metres) per file unit, applied to the scalp and the body.
+    scale: f64,
+    /// The largest side of the file's box, in file units.
+    extent: f64,
+}
+
+/// Sizes of a head or a body in metres: outside them, the file is asked about its units.
+pub const PLAUSIBLE_EXTENT_M: std::ops::RangeInclusive<f64> = 0.05..=3.0;
+
+/// Units offered for a file's size, with their scale to metres.
+const UNITS: [(&str, f64); 4] = [
+    ("metres", 1.0),
+    ("centimetres", 0.01),
+    ("millimetres", 0.001),
+    ("inches", 0.0254),
+];
+
+/// The largest side of the box around `mesh`'s finite positions (0 without one).
+pub fn extent(mesh: &ImportedMesh) -> f64 {
+    let mut finite = mesh.positions.iter().filter(|p| p.is_finite());
+    let Some(first) = finite.next() else {
+        return 0.0;
+    };
+    let (lo, hi) = finite.fold((*first, *first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    (hi - lo).max_element()
 }
 
 /// What the modal asks of the app.
@@ -45,8 +75,8 @@ pub enum ScalpImportAction {
     Waiting,
     /// Cancel: nothing is imported.
     Closed,
-    /// Import with hair on this region.
-    Import(ScalpRegion),
+    /// Import with hair on this region, scaled by this much (model units per file unit).
+    Import(ScalpRegion, f64),
 }
 
 /// Material names that suggest where hair grows: chosen by default.
@@ -66,6 +96,12 @@ impl ScalpImport {
         materials.len() > 1
             || (materials.len() == 1 && with_material < mesh.faces.len())
             || mesh.face_colours.is_some()
+            || !Self::plausible_in_metres(mesh)
+    }
+
+    /// Whether the file's size reads as a head or a body in metres.
+    pub fn plausible_in_metres(mesh: &ImportedMesh) -> bool {
+        PLAUSIBLE_EXTENT_M.contains(&extent(mesh))
     }
 
     pub fn new(path: PathBuf, mesh: ImportedMesh) -> Self {
@@ -81,6 +117,7 @@ impl ScalpImport {
         } else {
             Choice::Everything
         };
+        let extent = extent(&mesh);
         Self {
             path,
             mesh: Box::new(mesh),
@@ -91,7 +128,50 @@ impl ScalpImport {
             above: true,
             threshold: 0.5,
             counted: None,
+            scale: 1.0,
+            extent,
         }
+    }
+
+    /// The file's units: a factor and the size it gives, when the size is implausible in
+    /// metres (else one line saying the size).
+    fn size_ui(&mut self, ui: &mut egui::Ui) {
+        let size_m = self.extent * self.scale;
+        if self.scale == 1.0 && PLAUSIBLE_EXTENT_M.contains(&self.extent) {
+            ui.label(format!("{size_m:.2} m across (glTF counts in metres)"));
+            return;
+        }
+        ui.label(format!(
+            "The file is {:.3} units across. glTF counts in metres, and so do the brushes and \
+             extrusions: give its units, or a scale that makes it the size it is.",
+            self.extent
+        ));
+        ui.horizontal_wrapped(|ui| {
+            for (name, factor) in UNITS {
+                ui.selectable_value(&mut self.scale, factor, name);
+            }
+        });
+        ui.horizontal(|ui| {
+            let label = ui.label("Scale");
+            ui.add(
+                egui::DragValue::new(&mut self.scale)
+                    .range(1e-6..=1e6)
+                    .speed(0.001)
+                    .max_decimals(6),
+            )
+            .labelled_by(label.id);
+            let size = if size_m >= 1.0 {
+                format!("{size_m:.2} m")
+            } else {
+                format!("{:.1} cm", size_m * 100.0)
+            };
+            let note = if PLAUSIBLE_EXTENT_M.contains(&size_m) {
+                ""
+            } else {
+                " (still not a head's or a body's size)"
+            };
+            ui.label(format!("gives {size} across{note}"));
+        });
     }
 
     /// The region as chosen now.
@@ -119,6 +199,8 @@ impl ScalpImport {
         let modal = egui::Modal::new(egui::Id::unique("hairloom import scalp")).show(ui.ctx(), |ui| {
             ui.heading("Import scalp");
             ui.label(self.path.display().to_string());
+            self.size_ui(ui);
+            ui.separator();
             ui.label(format!(
                 "Hair grows on (all {total} faces of \"{}\" stay the body):",
                 self.mesh.mesh_name
@@ -206,8 +288,12 @@ impl ScalpImport {
                 "Or import every face, box-select the scalp and use Edit > Keep only selected bundles.",
             );
             ui.horizontal(|ui| {
-                if ui.add_enabled(ready, egui::Button::new("Import")).clicked() {
-                    action = ScalpImportAction::Import(self.region());
+                let scaled = self.scale.is_finite() && self.scale > 0.0;
+                if ui
+                    .add_enabled(ready && scaled, egui::Button::new("Import"))
+                    .clicked()
+                {
+                    action = ScalpImportAction::Import(self.region(), self.scale);
                 }
                 if ui.button("Cancel").clicked() {
                     action = ScalpImportAction::Closed;
@@ -334,5 +420,27 @@ mod tests {
             import.region(),
             ScalpRegion::Materials(vec!["Scalp".into()])
         );
+    }
+
+    #[test]
+    fn a_file_of_implausible_size_in_metres_is_asked_about() {
+        let scan = std::fs::read(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../assets/head/LeePerrySmith.glb"),
+        )
+        .expect("the head scan");
+        let mut mesh = import_slice(&scan, None, "LeePerrySmith.glb", &ImportOptions::default())
+            .expect("valid");
+        // One material, no colours: only its size (8.6 units, a 4.9 m head) asks.
+        assert!((8.0..9.0).contains(&extent(&mesh)), "{}", extent(&mesh));
+        assert!(!ScalpImport::plausible_in_metres(&mesh));
+        assert!(ScalpImport::offers_choice(&mesh));
+        for p in &mut mesh.positions {
+            *p *= 0.045;
+        }
+        assert!(ScalpImport::plausible_in_metres(&mesh), "a 39 cm bust");
+        assert!(!ScalpImport::offers_choice(&mesh), "nothing left to ask");
+        mesh.positions.clear();
+        assert_eq!(extent(&mesh), 0.0);
     }
 }

@@ -522,6 +522,16 @@ fn import(
         }
         document.body = body;
     }
+    if let Some((lo, hi)) = document.body.bounds() {
+        let across_m = (hi - lo).max_element() as f64;
+        if !hairloom_editor::app::scalp_import::PLAUSIBLE_EXTENT_M.contains(&across_m) {
+            eprintln!(
+                "note: the body is {across_m:.3} units across; glTF counts in metres, and so do \
+                 the editor's brushes and extrusions: if that is not its size, import it again \
+                 with --scale (e.g. 0.01 for centimetres)"
+            );
+        }
+    }
     project::save(out, &hairloom_core::Project::new(document))?;
     println!("{summary} → {}", out.display());
     Ok(())
