@@ -2868,3 +2868,42 @@ fn a_hairstyle_from_import_to_export_with_the_brushes_and_maps_alone() {
     assert_eq!(labels.len(), 7, "{labels:?}");
     painted.validate().expect("a valid document");
 }
+
+/// Issue 35 (look-dev): View ▸ Turntable turns the camera round the hair, frame by frame,
+/// with the lights (how far they turned is kept and read by the frame); off, it stops and
+/// the lights are the scene's again. The document is untouched (view state).
+#[test]
+fn the_viewport_turntable_turns_the_camera_and_the_lights() {
+    let mut harness = harness();
+    let original = harness.state().state.document().clone();
+    let yaw = harness.state().viewport.orbit.yaw_rad;
+    harness.get_by_label("View").click();
+    harness.run();
+    harness.get_by_label("Turntable (look-dev)").click();
+    // It keeps asking to be drawn: step, never run to a settled frame.
+    harness.step();
+    assert!(harness.state().viewport.settings.turntable);
+    for _ in 0..10 {
+        harness.step();
+    }
+    let turned = harness.state().viewport.turntable_turned_rad();
+    assert!(turned > 0.0, "{turned}");
+    let moved = harness.state().viewport.orbit.yaw_rad;
+    let travelled = (moved - yaw).rem_euclid(std::f32::consts::TAU);
+    assert!(
+        (travelled - turned).abs() < 1e-4,
+        "the camera turned as far as the lights: {travelled} vs {turned}"
+    );
+    assert_eq!(harness.state().state.document(), &original);
+    // Off again (the same checkbox; set here, as the menu may have closed).
+    harness.state_mut().viewport.settings.turntable = false;
+    harness.step();
+    harness.run();
+    assert!(!harness.state().viewport.settings.turntable);
+    assert_eq!(harness.state().viewport.turntable_turned_rad(), 0.0);
+    let stopped = harness.state().viewport.orbit.yaw_rad;
+    for _ in 0..5 {
+        harness.step();
+    }
+    assert_eq!(harness.state().viewport.orbit.yaw_rad, stopped);
+}

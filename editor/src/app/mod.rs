@@ -919,6 +919,11 @@ impl HairloomApp {
                     &mut settings.frame_glyphs,
                     "Styling frames (u red, v green, w blue)",
                 );
+                ui.checkbox(&mut settings.turntable, "Turntable (look-dev)")
+                    .on_hover_text(
+                        "The camera goes round the hair once in 12 s, the lights turning with \
+                         it, as if the head turned under studio lights",
+                    );
                 ui.label(
                     egui::RichText::new("Strands, LOD and accuracy: the Strands & accuracy panel")
                         .weak(),

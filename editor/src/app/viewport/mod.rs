@@ -66,6 +66,9 @@ const MIN_STORAGE_BUFFERS_PER_STAGE: u32 = 8;
 /// The Strands & accuracy panel's largest strand count per bundle.
 pub const MAX_STRANDS_PER_BUNDLE: u32 = 256;
 
+/// How fast View ▸ Turntable turns: once round in 12 s.
+const TURNTABLE_RAD_PER_S: f32 = std::f32::consts::TAU / 12.0;
+
 /// What the viewport shows and how it generates strands.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
@@ -78,6 +81,9 @@ pub struct ViewSettings {
     /// Show the styling-direction gizmo (wave, twist, curl) at the selected bundles'
     /// roots instead of the move gizmo.
     pub styling_gizmo: bool,
+    /// Look-dev: the camera goes round the hair, the scene's lights turning with it (the
+    /// head seems to turn under studio lights), as `hairloom render --turntable` does.
+    pub turntable: bool,
     pub strands_per_bundle: u32,
     pub precision: Precision,
     pub filtering: Filtering,
@@ -91,6 +97,7 @@ impl Default for ViewSettings {
             frame_glyphs: false,
             gizmo: true,
             styling_gizmo: false,
+            turntable: false,
             strands_per_bundle: 32,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -240,6 +247,9 @@ pub struct Viewport {
     interior: Option<(u64, Vec<Vec<bool>>)>,
     /// The body's depth for the overlay, with what it was rasterised for.
     body_depth: Option<(BodyDepthKey, Arc<select::DepthMap>)>,
+    /// How far View ▸ Turntable has turned the camera and the lights since it was switched
+    /// on.
+    turntable_rad: f32,
     /// The grooming brush's stroke in progress.
     stroke: Option<groom_brush::Stroke>,
     /// The grooming brush under the pointer, as drawn last (tests aim with it).
@@ -350,6 +360,7 @@ impl Viewport {
             body_depth: None,
             stroke: None,
             brush_cursor: None,
+            turntable_rad: 0.0,
             body_field: None,
             body_key: None,
             frames: None,
@@ -405,8 +416,30 @@ impl Viewport {
                 self.keys(ui, state, &response);
             }
         }
+        self.turn_table(ui);
         self.draw(ui, state, rect);
         self.paint_overlay(ui, state, rect);
+    }
+
+    /// View ▸ Turntable: turns the camera about the vertical at [`TURNTABLE_RAD_PER_S`] and
+    /// keeps how far it has turned, by which the lights turn too (see `draw`). Off, the
+    /// lights are the scene's again.
+    fn turn_table(&mut self, ui: &egui::Ui) {
+        if !self.settings.turntable {
+            self.turntable_rad = 0.0;
+            return;
+        }
+        // A slow frame turns no further than a tenth of a second's worth.
+        let dt = ui.input(|i| i.stable_dt).clamp(0.0, 0.1);
+        let step = TURNTABLE_RAD_PER_S * dt;
+        self.orbit.yaw_rad = (self.orbit.yaw_rad + step).rem_euclid(std::f32::consts::TAU);
+        self.turntable_rad = (self.turntable_rad + step).rem_euclid(std::f32::consts::TAU);
+        ui.ctx().request_repaint();
+    }
+
+    /// How far the turntable has turned the camera and the lights (radians, 0 when off).
+    pub fn turntable_turned_rad(&self) -> f32 {
+        self.turntable_rad
     }
 
     /// The wgpu device the viewport draws with (tests provoke device errors on it).

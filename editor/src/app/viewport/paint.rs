@@ -447,6 +447,15 @@ impl Viewport {
                 }
                 let (lo, hi) = self.camera_bounds.unwrap_or(bounds);
                 let document_scene = &state.document().scene;
+                // The turntable's lights turn with its camera, about the hair's vertical.
+                let turned;
+                let document_scene = if self.turntable_rad != 0.0 {
+                    let centre = ((lo + hi) * 0.5).as_dvec3();
+                    turned = document_scene.lights_turned(self.turntable_rad as f64, centre);
+                    &turned
+                } else {
+                    document_scene
+                };
                 let lighting = match quality {
                     FrameQuality::Full => document_scene.clone(),
                     FrameQuality::Interactive { .. } => Scene {
