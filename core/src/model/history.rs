@@ -209,7 +209,112 @@ pub struct DocumentDiff {
     pub scene: Option<Box<Swap<Scene>>>,
     /// Boxed: only map painting changes them.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub root_maps: Option<Box<Swap<RootMaps>>>,
+    pub root_maps: Option<Box<RootMapsChange>>,
+}
+
+/// A change of the painted maps. A stroke keeps their size, and only the texels it changed
+/// are kept (a few thousand of a 256² map's 65,536): a history of 200 strokes holding both
+/// whole maps each was up to 100 MB in memory and in the project file. A change of size
+/// (the first stroke, clearing the last map, an import) keeps both whole.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RootMapsChange {
+    Texels {
+        width: u32,
+        height: u32,
+        changes: Vec<TexelChange>,
+    },
+    Whole(Swap<RootMaps>),
+}
+
+/// One texel of the painted maps, before and after.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TexelChange {
+    pub index: u32,
+    pub before: [u8; 4],
+    pub after: [u8; 4],
+}
+
+impl RootMapsChange {
+    fn between(before: &RootMaps, after: &RootMaps) -> Option<Self> {
+        if before == after {
+            return None;
+        }
+        let same_size = (before.width(), before.height()) == (after.width(), after.height());
+        if !same_size || before.is_empty() {
+            return Some(Self::Whole(Swap {
+                before: before.clone(),
+                after: after.clone(),
+            }));
+        }
+        let changes = before
+            .texels()
+            .iter()
+            .zip(after.texels())
+            .enumerate()
+            .filter(|(_, (b, a))| b != a)
+            .map(|(index, (b, a))| TexelChange {
+                index: index as u32,
+                before: *b,
+                after: *a,
+            })
+            .collect();
+        Some(Self::Texels {
+            width: after.width(),
+            height: after.height(),
+            changes,
+        })
+    }
+
+    /// Refuses to write when `maps` is not the side this entry starts from (of another size,
+    /// or a changed texel holding another value, or out of range in a damaged history).
+    fn check(&self, maps: &RootMaps, forward: bool, path: &str) -> Result<(), HistoryMismatch> {
+        match self {
+            Self::Whole(swap) => swap.check(maps, forward, path),
+            Self::Texels {
+                width,
+                height,
+                changes,
+            } => {
+                let mismatch = |message: String| HistoryMismatch {
+                    path: path.into(),
+                    message,
+                };
+                if maps.is_empty() || (maps.width(), maps.height()) != (*width, *height) {
+                    return Err(mismatch(format!(
+                        "the maps are {} × {}, this history entry changed maps of {width} × {height}",
+                        maps.width(),
+                        maps.height()
+                    )));
+                }
+                for change in changes {
+                    let expected = if forward { change.before } else { change.after };
+                    if maps.texels().get(change.index as usize) != Some(&expected) {
+                        return Err(mismatch(format!(
+                            "texel {} does not hold the value this history entry changed",
+                            change.index
+                        )));
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Writes the entry's side into `maps` (checked first by [`Self::check`]).
+    fn write(&self, maps: &mut RootMaps, forward: bool) {
+        match self {
+            Self::Whole(swap) => swap.write(maps, forward),
+            Self::Texels { changes, .. } => {
+                let texels = maps.texels_mut();
+                for change in changes {
+                    if let Some(texel) = texels.get_mut(change.index as usize) {
+                        *texel = if forward { change.after } else { change.before };
+                    }
+                }
+            }
+        }
+    }
 }
 
 impl DocumentDiff {
@@ -224,7 +329,7 @@ impl DocumentDiff {
             body: Swap::between(&before.body, &after.body).map(Box::new),
             styling: Swap::between(&before.styling, &after.styling).map(Box::new),
             scene: Swap::between(&before.scene, &after.scene).map(Box::new),
-            root_maps: Swap::between(&before.root_maps, &after.root_maps).map(Box::new),
+            root_maps: RootMapsChange::between(&before.root_maps, &after.root_maps).map(Box::new),
         }
     }
 
@@ -592,5 +697,91 @@ impl Transaction {
     /// Abandons the gesture and restores the document.
     pub fn cancel(self, document: &mut Document) {
         *document = self.start;
+    }
+}
+
+#[cfg(test)]
+mod root_maps_tests {
+    use super::*;
+    use crate::model::root_maps::{RootMapChannel, RootMaps};
+
+    fn document() -> Document {
+        Document::new("grid", crate::model::mesh::test_meshes::grid(2, 2, 1, 0.1))
+    }
+
+    /// A stroke keeps only the texels it changed; the first stroke (maps made) and clearing
+    /// the last map keep both whole; undo and redo go through each exactly; a damaged entry
+    /// is a named mismatch, never a panic.
+    #[test]
+    fn a_stroke_keeps_only_the_texels_it_changed() {
+        let mut document = document();
+        let mut history = History::default();
+        // The first stroke: the maps come into being, whole.
+        let mut first = document.clone();
+        first.root_maps = RootMaps::blank(256, 256).expect("maps");
+        first.root_maps.texels_mut()[10][0] = 0;
+        let command = Command::record("Paint density", &document, &first).expect("a change");
+        let Command::Edit { diff, .. } = &command else {
+            panic!("an edit");
+        };
+        assert!(matches!(
+            diff.root_maps.as_deref(),
+            Some(RootMapsChange::Whole(_))
+        ));
+        history.commit(&mut document, "Paint density", first.clone());
+        // The next stroke: 100 texels of 65,536.
+        let mut second = document.clone();
+        for texel in &mut second.root_maps.texels_mut()[1000..1100] {
+            texel[1] = 128;
+        }
+        let command = Command::record("Paint length", &document, &second).expect("a change");
+        let Command::Edit { diff, .. } = &command else {
+            panic!("an edit");
+        };
+        let Some(RootMapsChange::Texels { changes, .. }) = diff.root_maps.as_deref() else {
+            panic!("texels, not whole maps: {:?}", diff.root_maps.is_some());
+        };
+        assert_eq!(changes.len(), 100);
+        let stored = serde_json::to_vec(&command).expect("json");
+        assert!(
+            stored.len() < 10_000,
+            "{} bytes for 100 texels",
+            stored.len()
+        );
+        history.commit(&mut document, "Paint length", second.clone());
+        // Clearing every map: whole again (the maps go).
+        let mut cleared = document.clone();
+        cleared.root_maps.clear_channel(RootMapChannel::Density);
+        cleared.root_maps.clear_channel(RootMapChannel::Length);
+        assert!(cleared.root_maps.is_empty());
+        history.commit(&mut document, "Clear", cleared.clone());
+        history.verify(&document).expect("a consistent history");
+        history.undo(&mut document).expect("undo");
+        assert_eq!(document.root_maps, second.root_maps);
+        history.undo(&mut document).expect("undo");
+        assert_eq!(document.root_maps, first.root_maps);
+        history.redo(&mut document).expect("redo");
+        assert_eq!(document.root_maps, second.root_maps);
+        // A damaged entry: a texel past the maps, or one holding another value.
+        for damage in [u32::MAX, 1000] {
+            let mut entry =
+                RootMapsChange::between(&first.root_maps, &second.root_maps).expect("a change");
+            let RootMapsChange::Texels { changes, .. } = &mut entry else {
+                panic!("texels");
+            };
+            changes[0].index = damage;
+            if damage == 1000 {
+                changes[0].before = [1, 2, 3, 4];
+            }
+            let error = entry
+                .check(&first.root_maps, true, "root_maps")
+                .expect_err("damaged");
+            assert!(error.message.contains("texel"), "{error}");
+        }
+        // Maps of another size than the entry's.
+        let entry = RootMapsChange::between(&first.root_maps, &second.root_maps).expect("a change");
+        let other = RootMaps::blank(8, 8).expect("maps");
+        let error = entry.check(&other, true, "root_maps").expect_err("size");
+        assert!(error.message.contains("8 × 8"), "{error}");
     }
 }
