@@ -784,8 +784,8 @@ pub fn load_runtime_asset_from(
             ),
         ));
     }
-    let load = |entry: &TextureEntry, channels: usize| -> Result<Texture3d, BundleError> {
-        let format = TexelFormat::for_precision(manifest.precision, channels);
+    // A texture of `format`, its entry checked against the format, its name and its file.
+    let load_as = |entry: &TextureEntry, format: TexelFormat| -> Result<Texture3d, BundleError> {
         if entry.vk_format != format.vk_name() {
             return Err(error(
                 &entry.file,
@@ -803,22 +803,17 @@ pub fn load_runtime_asset_from(
             .map_err(|e| error(&entry.file, e))?;
         read_texture(&bytes, format, entry.size).map_err(|message| error(&entry.file, message))
     };
+    let load = |entry: &TextureEntry, channels: usize| {
+        load_as(
+            entry,
+            TexelFormat::for_precision(manifest.precision, channels),
+        )
+    };
     let hair_mesh = load(&manifest.hair_mesh, 4)?;
     let uv = load(&manifest.uv, 2)?;
     let root_maps = match &manifest.root_maps {
         None => crate::model::root_maps::RootMaps::default(),
         Some(entry) => {
-            let format = TexelFormat::Rgba8Unorm;
-            if entry.vk_format != format.vk_name() {
-                return Err(error(
-                    &entry.file,
-                    format!(
-                        "manifest says {}, expected {} for root_maps",
-                        entry.vk_format,
-                        format.vk_name()
-                    ),
-                ));
-            }
             let [width, height, depth] = entry.size;
             if depth != 0 {
                 return Err(error(
@@ -827,14 +822,9 @@ pub fn load_runtime_asset_from(
                 ));
             }
             // Checked before the file is read: a hostile size names the problem.
-            crate::model::root_maps::RootMaps::blank(width, height)
+            crate::model::root_maps::check_size(width, height)
                 .map_err(|e| error(MANIFEST_FILE, format!("root_maps: {e}")))?;
-            check_file_name(&entry.file).map_err(|message| error(MANIFEST_FILE, message))?;
-            let bytes = files
-                .read(&entry.file, limits::FILE_BYTES)
-                .map_err(|e| error(&entry.file, e))?;
-            let texture = read_texture(&bytes, format, entry.size)
-                .map_err(|message| error(&entry.file, message))?;
+            let texture = load_as(entry, TexelFormat::Rgba8Unorm)?;
             let rgba8: Vec<u8> = texture
                 .texels
                 .iter()

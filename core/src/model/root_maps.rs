@@ -160,7 +160,8 @@ impl From<RootMaps> for StoredRootMaps {
     }
 }
 
-fn check_size(width: u32, height: u32) -> Result<(), RootMapError> {
+/// Refuses a side of 0 or over [`MAX_ROOT_MAP_SIDE`] (without allocating anything).
+pub fn check_size(width: u32, height: u32) -> Result<(), RootMapError> {
     if width > MAX_ROOT_MAP_SIDE || height > MAX_ROOT_MAP_SIDE {
         return Err(RootMapError::TooLarge { width, height });
     }

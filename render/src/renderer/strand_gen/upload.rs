@@ -28,6 +28,8 @@ pub struct GpuHair {
     /// The painted maps (one white texel when none), replaced when their size changes.
     pub(super) root_maps: Tracked<wgpu::Texture>,
     pub(super) root_maps_view: wgpu::TextureView,
+    /// The maps the texture holds (compared on a restyle, so a styling tick writes nothing).
+    root_maps_shown: RootMaps,
     pub(super) bundle_buffer: Tracked<wgpu::Buffer>,
     /// Each bundle's bounds and sizes for LOD, for the mesh path's task shaders.
     pub(super) bundle_lods: Tracked<wgpu::Buffer>,
@@ -47,15 +49,21 @@ pub struct GpuHair {
 
 /// The painted maps' texture: RGBA8 in root-uv space, or one white texel when nothing is
 /// painted (the shader then reads 1 everywhere and needs no switch).
+/// The maps' size and RGBA8 bytes as the GPU holds them: one white texel when nothing is
+/// painted.
+fn root_map_texels(maps: &RootMaps) -> (u32, u32, Vec<u8>) {
+    if maps.is_empty() {
+        (1, 1, vec![255; 4])
+    } else {
+        (maps.width(), maps.height(), maps.rgba8())
+    }
+}
+
 fn upload_root_maps(
     context: &GpuContext,
     maps: &RootMaps,
 ) -> (Tracked<wgpu::Texture>, wgpu::TextureView) {
-    let (width, height, bytes) = if maps.is_empty() {
-        (1, 1, vec![255; 4])
-    } else {
-        (maps.width(), maps.height(), maps.rgba8())
-    };
+    let (width, height, bytes) = root_map_texels(maps);
     let texture = context.resources.texture(
         &context.device,
         &wgpu::TextureDescriptor {
@@ -255,25 +263,21 @@ impl StrandGenRenderer {
     /// Takes the painted maps into `gpu`: written in place at the same size, a new texture
     /// otherwise (bind groups are made per frame, so the next frame reads it).
     pub fn update_root_maps(&self, context: &GpuContext, gpu: &mut GpuHair, maps: &RootMaps) {
-        let size = if maps.is_empty() {
-            (1, 1)
-        } else {
-            (maps.width(), maps.height())
-        };
-        if (gpu.root_maps.width(), gpu.root_maps.height()) == size {
-            let bytes = if maps.is_empty() {
-                vec![255; 4]
-            } else {
-                maps.rgba8()
-            };
-            write_root_maps(context, &gpu.root_maps, size.0, size.1, &bytes);
+        // A styling tick leaves the maps alone: nothing to write.
+        if gpu.root_maps_shown == *maps {
+            return;
+        }
+        let (width, height, bytes) = root_map_texels(maps);
+        if (gpu.root_maps.width(), gpu.root_maps.height()) == (width, height) {
+            write_root_maps(context, &gpu.root_maps, width, height, &bytes);
         } else {
             let before = 4 * u64::from(gpu.root_maps.width()) * u64::from(gpu.root_maps.height());
             let (texture, view) = upload_root_maps(context, maps);
-            gpu.bytes = gpu.bytes - before + 4 * u64::from(size.0) * u64::from(size.1);
+            gpu.bytes = gpu.bytes - before + 4 * u64::from(width) * u64::from(height);
             gpu.root_maps = texture;
             gpu.root_maps_view = view;
         }
+        gpu.root_maps_shown = maps.clone();
     }
 
     /// Uploads a runtime asset: the five textures (f32 or f16 as built), every bundle's block
@@ -344,6 +348,7 @@ impl StrandGenRenderer {
             v,
             root_maps,
             root_maps_view,
+            root_maps_shown: textures.root_maps.clone(),
             bundle_buffer: buffer("strand_gen_bundles", bundle_bytes),
             bundle_lods: buffer("strand_mesh_bundle_lods", lod_bytes),
             samples: buffer("strand_gen_samples", sample_bytes),
