@@ -19,6 +19,29 @@ struct VertexOutput {
     @location(4) coverage: f32,
     @location(5) @interpolate(flat) root: u32,
     @location(6) width_px: f32,
+    // The colour map at the strand's root: linear rgb, and its weight (0: the material's).
+    @location(7) @interpolate(flat) paint: vec4<f32>,
+}
+
+// The colour map at each root, packed as render/src/renderer/strand_gen/upload.rs uploads it
+// (mirror: PaintedColour::pack — sRGB-encoded rgb bytes, the weight in byte 3); one 0 (no
+// colour) when none is painted, or where the strands have no runtime asset.
+@group(0) @binding(3) var<storage, read> root_paint: array<u32>;
+
+// The sRGB transfer function's inverse (mirror: root_maps::srgb_to_linear).
+fn srgb_to_linear(encoded: vec3<f32>) -> vec3<f32> {
+    let low = encoded / 12.92;
+    let high = pow((encoded + vec3<f32>(0.055)) / 1.055, vec3<f32>(2.4));
+    return select(high, low, encoded <= vec3<f32>(0.04045));
+}
+
+// Root `root`'s painted colour (mirror: PaintedColour::unpack).
+fn root_paint_of(root: u32) -> vec4<f32> {
+    if root >= arrayLength(&root_paint) {
+        return vec4<f32>(0.0);
+    }
+    let packed = unpack4x8unorm(root_paint[root]);
+    return vec4<f32>(srgb_to_linear(packed.rgb), packed.a);
 }
 
 @vertex
@@ -44,6 +67,7 @@ fn pass_vertex(ribbon: RibbonVertex) -> VertexOutput {
     out.coverage = ribbon.coverage;
     out.root = ribbon.root;
     out.width_px = ribbon.width_px;
+    out.paint = root_paint_of(ribbon.root);
     return out;
 }
 
@@ -87,7 +111,7 @@ fn shade_hair(in: VertexOutput) -> vec3<f32> {
     let x = frame[0];
     let y = frame[1];
     let z = frame[2];
-    let sigma_a = strand_sigma_a(in.along, strand_shading_random(in.root));
+    let sigma_a = painted_strand_sigma_a(in.along, strand_shading_random(in.root), in.paint);
     let wo_local = vec3<f32>(dot(wo, x), dot(wo, y), dot(wo, z));
     var radiance = scene.ambient.rgb * hair_color(sigma_a);
     for (var i = 0u; i < scene.counts.x; i++) {

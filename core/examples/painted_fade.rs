@@ -61,6 +61,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 centre_m: centre.to_array(),
                 radius_m: 0.03,
                 value: 0.0,
+                colour_srgb: [0; 3],
                 strength: 0.5,
                 view_direction: None,
                 mirror_x: true,

@@ -243,7 +243,14 @@ pub fn write_strand_file(
     alembic: AlembicTarget,
 ) -> anyhow::Result<String> {
     check_strand_file(file)?;
-    let look = || StrandLook::new(strands, STRAND_WIDTH_M, &document.scene.material);
+    let look = || {
+        StrandLook::new(
+            strands,
+            STRAND_WIDTH_M,
+            &document.scene.material,
+            &document.root_maps,
+        )
+    };
     let bytes = match file.extension().and_then(|e| e.to_str()) {
         Some("hair") => hair_file(strands, &look()),
         Some("usda") => {

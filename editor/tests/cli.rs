@@ -821,11 +821,39 @@ fn maps_brings_painted_images_in_as_one_undo_step_and_refuses_bad_ones_by_name()
             "left as it was"
         );
     }
-    // Clearing the only painted map takes the texture away.
+    // A colour image (RGBA: its alpha the colour's weight) paints the colour map; the runtime
+    // bundle carries it as an sRGB texture.
+    let colour = dir.path().join("colour.png");
+    image::RgbaImage::from_fn(16, 8, |x, _| {
+        image::Rgba([200, 60, 20, if x < 8 { 255 } else { 0 }])
+    })
+    .save(&colour)
+    .expect("png");
+    let (code, stdout, stderr) = run(hairloom()
+        .arg("maps")
+        .arg(&project)
+        .arg("--colour")
+        .arg(&colour));
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("colour from"), "{stdout}");
+    let coloured = hairloom_core::io::project::load(&project).expect("load");
+    let maps = &coloured.document.root_maps;
+    assert_eq!(maps.colour_texels()[0], [200, 60, 20, 255]);
+    assert_eq!(maps.colour_texels()[15], [200, 60, 20, 0]);
+    let bundle = dir.path().join("bundle");
+    let (code, _, stderr) = run(hairloom()
+        .arg("export")
+        .arg(&project)
+        .arg("--runtime")
+        .arg(&bundle));
+    assert_eq!(code, 0, "{stderr}");
+    let manifest = std::fs::read_to_string(bundle.join("manifest.json")).expect("manifest");
+    assert!(manifest.contains("R8G8B8A8_SRGB"), "{manifest}");
+    // Clearing every painted map takes the textures away.
     let (code, _, stderr) = run(hairloom()
         .arg("maps")
         .arg(&project)
-        .args(["--clear", "density"]));
+        .args(["--clear", "density", "--clear", "colour"]));
     assert_eq!(code, 0, "{stderr}");
     let cleared = hairloom_core::io::project::load(&project).expect("load");
     assert!(cleared.document.root_maps.is_empty());

@@ -2428,7 +2428,7 @@ fn a_groom_from_another_tool_comes_in_as_one_undo_step_on_the_chosen_scalp() {
     );
     let dir = tempfile::tempdir().expect("temp dir");
     let groom = dir.path().join("other_tool.hair");
-    let look = StrandLook::new(&strands, 8e-5, &sample.scene.material);
+    let look = StrandLook::new(&strands, 8e-5, &sample.scene.material, &sample.root_maps);
     std::fs::write(&groom, hair_file(&strands, &look)).expect("write groom");
     let mut harness = harness_with(
         &fresh_recovery_dir(),
@@ -2726,6 +2726,103 @@ fn painting_the_density_map_thins_the_hair_as_one_undo_step() {
     harness.get_by_label("Clear density map").click();
     harness.run();
     assert!(harness.state().state.document().root_maps.is_empty());
+}
+
+/// Issue 35: Paint map ▸ Colour map paints the brush's colour over the scalp as one undo
+/// step; the exported strands take it (their vertex colours change at the painted roots, and
+/// only there); undo and redo go through it; Clear colour map forgets it.
+#[test]
+fn painting_the_colour_map_colours_the_strands_as_one_undo_step() {
+    use hairloom_core::model::root_maps::RootMapChannel;
+    let mut harness = harness();
+    harness.set_size(egui::vec2(1100.0, 720.0));
+    harness.run();
+    let original = harness.state().state.document().clone();
+    harness.get_by_label("Groom").click();
+    harness.run();
+    harness.get_by_label("Colour map").click();
+    harness.run();
+    assert_eq!(
+        harness.state().state.tool.brush.paint,
+        Some(RootMapChannel::Colour)
+    );
+    // The colour picker and the weight are offered, not the grey maps' value.
+    harness.get_by_label("Paint colour");
+    harness.get_by_role_and_label(Role::Slider, "Colour weight");
+    assert!(harness.query_by_label("Paint value").is_none());
+    let colour = harness.state().state.tool.brush.paint_colour;
+    wait_for_brush_field(&mut harness);
+    let start = brush_start(&mut harness, 3..12)
+        .expect("some point of the viewport shows the scalp under the brush");
+    drag(&mut harness, start, start + egui::vec2(60.0, 20.0));
+    let painted = harness.state().state.document().clone();
+    let message = harness.state().state.message.clone();
+    assert_eq!(
+        painted.hair_mesh, original.hair_mesh,
+        "painting moves no hair"
+    );
+    assert!(painted.root_maps.has_colour(), "{message}");
+    let coloured: Vec<_> = painted
+        .root_maps
+        .colour_texels()
+        .iter()
+        .filter(|t| t[3] > 0)
+        .collect();
+    assert!(
+        coloured.len() > 20,
+        "{} texels coloured: {message}",
+        coloured.len()
+    );
+    assert!(
+        coloured.iter().all(|t| t[..3] == colour),
+        "the brush's colour"
+    );
+    let history = &harness.state().state.project.history;
+    assert_eq!(history.undo.len(), 1, "{message}");
+    assert_eq!(history.undo[0].label(), "Paint colour");
+    // The exported strands' colours change where the roots were painted, and only there.
+    let colours = |document: &hairloom_core::model::document::Document| {
+        let strands = hairloom_core::strands::reference::generate(
+            document,
+            &hairloom_core::strands::reference::StrandOptions {
+                strands_per_bundle: 4,
+                ..Default::default()
+            },
+        );
+        let look = hairloom_core::io::strand_files::StrandLook::new(
+            &strands,
+            8e-5,
+            &document.scene.material,
+            &document.root_maps,
+        );
+        look.colors
+    };
+    let (before, after) = (colours(&original), colours(&painted));
+    assert_eq!(before.len(), after.len());
+    let changed = before.iter().zip(&after).filter(|(a, b)| a != b).count();
+    assert!(
+        changed > 0 && changed < before.len(),
+        "{changed} of {} points",
+        before.len()
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().root_maps,
+        original.root_maps
+    );
+    harness.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
+    harness.run();
+    assert_eq!(
+        harness.state().state.document().root_maps,
+        painted.root_maps
+    );
+    harness.get_by_label("Clear colour map").click();
+    harness.run();
+    assert!(!harness.state().state.document().root_maps.has_colour());
 }
 
 /// Issue 35's walkthrough (README, "A hairstyle from scratch"), step by step on the head

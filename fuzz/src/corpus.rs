@@ -46,7 +46,12 @@ fn groom_seeds() -> Vec<(String, Vec<u8>)> {
             ..StrandOptions::default()
         },
     );
-    let look = StrandLook::new(&strands, 1e-4, &document.scene.material);
+    let look = StrandLook::new(
+        &strands,
+        1e-4,
+        &document.scene.material,
+        &document.root_maps,
+    );
     let hair = hair_file(&strands, &look);
     let usda = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), &look);
     let groom = Groom::new(document, &strands, 1e-4);
@@ -181,7 +186,8 @@ fn strand_export_seeds() -> Vec<(String, Vec<u8>)> {
     ]
 }
 
-/// 4 × 2 painted maps: density, length and clump each falling across u.
+/// 4 × 2 painted maps: density, length and clump each falling across u, and a colour map
+/// (copper on the left at full weight, none on the right).
 fn painted_maps() -> hairloom_core::model::root_maps::RootMaps {
     use hairloom_core::model::root_maps::{RootMapChannel, RootMaps};
     let mut maps = RootMaps::blank(4, 2).expect("maps");
@@ -189,6 +195,8 @@ fn painted_maps() -> hairloom_core::model::root_maps::RootMaps {
         maps.set_channel_from_image(channel, 2, 1, &[0.2, 0.9])
             .expect("map");
     }
+    maps.set_colour_from_image(2, 1, &[[0.7, 0.3, 0.1, 1.0], [0.7, 0.3, 0.1, 0.0]])
+        .expect("colour");
     maps
 }
 

@@ -222,7 +222,12 @@ fn strand_export(input: &[u8]) {
         strands.iter().map(|s| s.points.len() as u64).sum::<u64>() <= size.points,
         "the export holds more points than its size said"
     );
-    let look = StrandLook::new(&strands, 1e-4, &document.scene.material);
+    let look = StrandLook::new(
+        &strands,
+        1e-4,
+        &document.scene.material,
+        &document.root_maps,
+    );
     let _ = hair_file(&strands, &look);
     let _ = usda_file(&strands, &ScalpMesh::of(&document.hair_mesh), &look);
     let _ = glb_lines(&strands);

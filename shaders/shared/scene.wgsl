@@ -84,18 +84,36 @@ fn tonemap(radiance: vec3<f32>) -> vec3<f32> {
 // The colour a thick mass of hair with absorption `sigma_a` shows (Chiang et al. 2016,
 // inverse of eq. 9; mirror: core/src/light/material.rs `color_from_sigma_a`).
 fn hair_color(sigma_a: vec3<f32>) -> vec3<f32> {
+    return exp(-sqrt(max(sigma_a, vec3<f32>(0.0))) * color_polynomial());
+}
+
+// Chiang et al. 2016 eq. 9's polynomial in the azimuthal roughness β_n.
+fn color_polynomial() -> f32 {
     let b = scene.fibre.w;
-    let p = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b * b * b + 5.574 * b * b * b * b
+    return 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b * b * b + 5.574 * b * b * b * b
         + 0.245 * b * b * b * b * b;
-    return exp(-sqrt(max(sigma_a, vec3<f32>(0.0))) * p);
 }
 
 // Absorption at fraction `along` of a strand with random value `xi`
 // (mirror: core/src/light/material.rs `Fibre::sigma_a`).
 fn strand_sigma_a(along: f32, xi: f32) -> vec3<f32> {
+    return painted_strand_sigma_a(along, xi, vec4<f32>(0.0));
+}
+
+// As `strand_sigma_a`, on a strand under the colour map's `paint` (linear rgb, weight): the
+// root's colour blended toward the painted one by its weight, and the absorption that shows
+// it (mirror: `Fibre::painted`, then `Fibre::sigma_a`).
+fn painted_strand_sigma_a(along: f32, xi: f32, paint: vec4<f32>) -> vec3<f32> {
+    var root = scene.sigma_a.rgb;
+    let weight = clamp(paint.a, 0.0, 1.0);
+    if weight > 0.0 {
+        let rgb = mix(hair_color(root), paint.rgb, weight);
+        let l = log(clamp(rgb, vec3<f32>(1e-4), vec3<f32>(0.9999))) / color_polynomial();
+        root = l * l;
+    }
     let t = clamp(along, 0.0, 1.0);
     let scale = (1.0 + (scene.sigma_a.w - 1.0) * t) * (1.0 + scene.fibre.x * (2.0 * xi - 1.0));
-    return scene.sigma_a.rgb * max(scale, 0.0);
+    return root * max(scale, 0.0);
 }
 
 // The fibre frame shading works in, for a strand with `tangent` seen along the unit `wo`

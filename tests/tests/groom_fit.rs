@@ -91,7 +91,12 @@ fn every_sample_round_trips_within_the_targets() {
             groom_file(&groom, AlembicTarget::Blender).expect("abc"),
         )
         .expect("write");
-        let look = StrandLook::new(&strands, 8e-5, &document.scene.material);
+        let look = StrandLook::new(
+            &strands,
+            8e-5,
+            &document.scene.material,
+            &document.root_maps,
+        );
         let usda = dir.path().join(format!("{name}.usda"));
         std::fs::write(
             &usda,

@@ -432,6 +432,8 @@ fn bake(
         let strand_id = hash_to_unit(pcg_hash(
             (strands[*index].bundle << 12) ^ (*index as u32).wrapping_mul(0x9E37_79B9),
         ));
+        // The colour map at the strand's root, as every renderer reads it.
+        let painted = fibre.painted(&document.root_maps.sample_colour(strands[*index].root_uv));
         for pair in points.windows(2) {
             let (x0, y0) = texel(card, &pair[0], tile);
             let (x1, y1) = texel(card, &pair[1], tile);
@@ -453,7 +455,7 @@ fn bake(
                 let along = pair[0].along + (pair[1].along - pair[0].along) * f;
                 let d = pair[0].depth_m + (pair[1].depth_m - pair[0].depth_m) * f;
                 count[at] += 1;
-                let rgb = fibre.color(fibre.sigma_a(along, strand_id));
+                let rgb = painted.color(painted.sigma_a(along, strand_id));
                 for k in 0..3 {
                     colour[at][k] += rgb[k];
                 }

@@ -117,8 +117,11 @@ pub struct MapDab {
     /// A point on the scalp (model units).
     pub centre_m: [f64; 3],
     pub radius_m: f64,
-    /// The value painted toward, a share in `[0, 1]`.
+    /// The value painted toward, a share in `[0, 1]`: for the colour map, the colour's weight
+    /// (0 takes the colour away).
     pub value: f64,
+    /// The colour map's colour (sRGB); the grey maps ignore it.
+    pub colour_srgb: [u8; 3],
     /// How far toward it one dab goes at the centre (`0 … 1`), falling off to the rim.
     pub strength: f64,
     /// Only texels whose root face looks toward the viewer (`None`: all).
@@ -148,36 +151,72 @@ pub fn paint_dab(maps: &mut RootMaps, raster: &RootMapRaster, dab: &MapDab) -> u
     let target = (dab.value.clamp(0.0, 1.0) * 255.0).round();
     let strength = dab.strength.clamp(0.0, 1.0);
     let view = dab.view_direction.map(DVec3::from_array);
-    let channel = dab.channel.index();
-    let mut changed = 0;
-    for (texel, root) in maps.texels_mut().iter_mut().zip(&raster.texels) {
+    // How far each texel the dab reaches goes toward the target (0: not reached).
+    let weights = raster.texels.iter().map(|root| {
         let Some((position, normal)) = root else {
-            continue;
+            return 0.0;
         };
         if let Some(view) = view
             && normal.dot(view) > 0.0
         {
-            continue;
+            return 0.0;
         }
         let mut weight = falloff_weight(position.distance(centre), dab.radius_m);
         if dab.mirror_x {
             weight = weight.max(falloff_weight(position.distance(mirrored), dab.radius_m));
         }
-        let weight = weight * strength;
-        if weight <= 0.0 {
-            continue;
+        weight * strength
+    });
+    let weights: Vec<f64> = weights.collect();
+    let mut changed = 0;
+    match dab.channel.grey_index() {
+        Some(channel) => {
+            for (texel, &weight) in maps.texels_mut().iter_mut().zip(&weights) {
+                if weight > 0.0 && step_toward(&mut texel[channel], target, weight) {
+                    changed += 1;
+                }
+            }
         }
-        let old = texel[channel] as f64;
-        let mut new = (old + (target - old) * weight).round();
-        if new == old && old != target {
-            new = old + (target - old).signum();
-        }
-        if new != old {
-            texel[channel] = new as u8;
-            changed += 1;
+        None => {
+            if target == 0.0 && !maps.has_colour() {
+                return 0;
+            }
+            for (texel, &weight) in maps.colour_texels_mut().iter_mut().zip(&weights) {
+                if weight <= 0.0 {
+                    continue;
+                }
+                let before = *texel;
+                // A texel with no colour yet has no colour to blend from: it takes the brush's.
+                if texel[3] == 0 && target > 0.0 {
+                    texel[..3].copy_from_slice(&dab.colour_srgb);
+                } else if target > 0.0 {
+                    for (byte, target) in texel.iter_mut().zip(dab.colour_srgb) {
+                        step_toward(byte, target as f64, weight);
+                    }
+                }
+                step_toward(&mut texel[3], target, weight);
+                if *texel != before {
+                    changed += 1;
+                }
+            }
+            if !maps.is_painted(RootMapChannel::Colour) {
+                maps.clear_colour();
+            }
         }
     }
     changed
+}
+
+/// Moves `byte` toward `target` by `weight` of the way, at least one step of 1/255 (so
+/// repeated light dabs always arrive); whether it changed.
+fn step_toward(byte: &mut u8, target: f64, weight: f64) -> bool {
+    let old = *byte as f64;
+    let mut new = (old + (target - old) * weight).round();
+    if new == old && old != target {
+        new = old + (target - old).signum();
+    }
+    *byte = new as u8;
+    new != old
 }
 
 #[cfg(test)]
@@ -221,6 +260,7 @@ mod tests {
             centre_m: corner.to_array(),
             radius_m: 0.04,
             value: 0.0,
+            colour_srgb: [0; 3],
             strength: 1.0,
             view_direction: None,
             mirror_x: false,
@@ -297,6 +337,7 @@ mod tests {
             },
             MapDab {
                 value: f64::INFINITY,
+                colour_srgb: [0; 3],
                 ..dab
             },
         ] {
@@ -306,5 +347,71 @@ mod tests {
         // Maps of another size than the raster's: nothing.
         let mut other = RootMaps::blank(8, 8).expect("maps");
         assert_eq!(paint_dab(&mut other, &raster, &dab), 0);
+    }
+
+    #[test]
+    fn a_colour_dab_paints_colour_and_weight_and_ctrl_takes_it_away() {
+        let mesh = scalp();
+        let side = 64;
+        let raster = RootMapRaster::new(&mesh, side, side);
+        let mut maps = RootMaps::blank(side, side).expect("maps");
+        let (lo, hi) = mesh.bounds().expect("a scalp");
+        let centre = 0.5 * (lo + hi);
+        let dab = MapDab {
+            channel: RootMapChannel::Colour,
+            centre_m: centre.to_array(),
+            radius_m: 0.05,
+            value: 1.0,
+            colour_srgb: [200, 40, 10],
+            strength: 1.0,
+            view_direction: None,
+            mirror_x: false,
+            mirror_plane_x: centre.x,
+        };
+        // Taking colour away where none is painted changes nothing and makes no colour map.
+        assert_eq!(
+            paint_dab(&mut maps, &raster, &MapDab { value: 0.0, ..dab }),
+            0
+        );
+        assert!(!maps.has_colour());
+        let changed = paint_dab(&mut maps, &raster, &dab);
+        assert!(changed > 0);
+        assert!(
+            maps.texels().iter().all(|t| *t == [255; 4]),
+            "grey maps untouched"
+        );
+        let painted: Vec<&[u8; 4]> = maps.colour_texels().iter().filter(|t| t[3] > 0).collect();
+        assert_eq!(painted.len(), changed);
+        // A texel with no colour before takes the brush's colour whole (never a blend with
+        // the black of "no colour"), whatever weight the falloff gives it.
+        assert!(
+            painted.iter().all(|t| t[..3] == [200, 40, 10]),
+            "{painted:?}"
+        );
+        assert!(
+            painted.iter().any(|t| t[3] > 240),
+            "near full weight at the centre"
+        );
+        // A second colour blends over the first.
+        paint_dab(
+            &mut maps,
+            &raster,
+            &MapDab {
+                colour_srgb: [0, 0, 255],
+                strength: 0.5,
+                ..dab
+            },
+        );
+        assert!(
+            maps.colour_texels()
+                .iter()
+                .any(|t| t[2] > 0 && t[2] < 255 && t[0] > 0),
+            "half-way colours"
+        );
+        // Ctrl (weight 0) at full strength takes it all away: the colour map goes.
+        for _ in 0..300 {
+            paint_dab(&mut maps, &raster, &MapDab { value: 0.0, ..dab });
+        }
+        assert!(!maps.has_colour());
     }
 }

@@ -19,6 +19,9 @@ pub enum TexelFormat {
     R16Float,
     /// The painted maps (`root_maps`): bytes, read as byte / 255.
     Rgba8Unorm,
+    /// The colour map (`colour_map`): sRGB-encoded rgb, linear alpha; read as the stored
+    /// byte / 255 (a GPU sampling it as an sRGB texture decodes the rgb).
+    Rgba8Srgb,
 }
 
 impl TexelFormat {
@@ -31,6 +34,7 @@ impl TexelFormat {
             Self::Rg16Float => "R16G16_SFLOAT",
             Self::R16Float => "R16_SFLOAT",
             Self::Rgba8Unorm => "R8G8B8A8_UNORM",
+            Self::Rgba8Srgb => "R8G8B8A8_SRGB",
         }
     }
 
@@ -48,12 +52,13 @@ impl TexelFormat {
             Self::Rg16Float => ktx2::Format::R16G16_SFLOAT,
             Self::R16Float => ktx2::Format::R16_SFLOAT,
             Self::Rgba8Unorm => ktx2::Format::R8G8B8A8_UNORM,
+            Self::Rgba8Srgb => ktx2::Format::R8G8B8A8_SRGB,
         }
     }
 
     pub fn channels(self) -> usize {
         match self {
-            Self::Rgba32Float | Self::Rgba16Float | Self::Rgba8Unorm => 4,
+            Self::Rgba32Float | Self::Rgba16Float | Self::Rgba8Unorm | Self::Rgba8Srgb => 4,
             Self::Rg32Float | Self::Rg16Float => 2,
             Self::R32Float | Self::R16Float => 1,
         }
@@ -62,7 +67,7 @@ impl TexelFormat {
     pub fn bytes_per_channel(self) -> usize {
         match self {
             Self::Rgba32Float | Self::Rg32Float | Self::R32Float => 4,
-            Self::Rgba8Unorm => 1,
+            Self::Rgba8Unorm | Self::Rgba8Srgb => 1,
             _ => 2,
         }
     }

@@ -15,7 +15,9 @@ pub use crate::runtime::hair::LodEntry;
 use crate::runtime::hair::{RootSamples, RuntimeHair, RuntimeOptions};
 use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, Texture3d};
 
-/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 8
+/// Version of the runtime bundle format described in `docs/runtime-format.md`. Version 9
+/// adds the painted colour map (`manifest.colour_map`: sRGB colour and its weight in root-uv
+/// space; a version 8 reader would draw every strand in the material's colour). Version 8
 /// adds painted maps (`manifest.root_maps`: density, length and clump in root-uv space; a
 /// version 7 reader would grow every strand where the maps thin or shorten them). Version 7
 /// adds `wave.lock_phase_spread` (how far apart the locks' wave phases lie; absent means 1,
@@ -29,7 +31,7 @@ use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, T
 /// segment (`p_k, q0, q1`); version 1 stored the quadratics' joint `m` too (4 slices). All
 /// are read (version 1's `m` slices are dropped on load: `m` is exactly `(q0 + q1) / 2`;
 /// bundles before version 3 have no far hair).
-pub const RUNTIME_FORMAT_VERSION: u32 = 8;
+pub const RUNTIME_FORMAT_VERSION: u32 = 9;
 /// Hair-mesh slices per segment in format version 1 bundles.
 const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
@@ -146,6 +148,11 @@ pub struct Manifest {
     /// `R8G8B8A8_UNORM` texture; absent where nothing is painted (1 everywhere).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub root_maps: Option<TextureEntry>,
+    /// The colour painted in root-uv space (format version 9): a 2D `R8G8B8A8_SRGB` texture
+    /// of `root_maps`' size (rgb the colour, a its weight over the material's); absent where
+    /// none is painted. Only with `root_maps`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour_map: Option<TextureEntry>,
 }
 
 /// File name of the manifest, the bundle's single commit point (see [`write_bundle_folder`]).
@@ -165,7 +172,7 @@ pub(crate) fn content_addressed_name(stem: &str, extension: &str, bytes: &[u8]) 
 /// Whether `name` is a data file a runtime bundle export writes (content-addressed, or
 /// the fixed names of bundles written before content addressing).
 fn is_bundle_data_file(name: &str) -> bool {
-    const STEMS: [&str; 8] = [
+    const STEMS: [&str; 9] = [
         "hair_mesh",
         "uv",
         "w",
@@ -174,6 +181,7 @@ fn is_bundle_data_file(name: &str) -> bool {
         "body",
         "far_hair",
         "root_maps",
+        "colour_map",
     ];
     let Some((stem, rest)) = name.split_once('.') else {
         return false;
@@ -541,21 +549,40 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         false,
         "unit styling direction v per layer slice (xyz)",
     )?;
-    let root_maps = if textures.root_maps.is_empty() {
-        None
-    } else {
-        let maps = &textures.root_maps;
-        let format = TexelFormat::Rgba8Unorm;
-        let bytes = ktx2_bytes(format, maps.width(), maps.height(), 0, &maps.rgba8())?;
-        let file = content_addressed_name("root_maps", "ktx2", &bytes);
+    let maps = &textures.root_maps;
+    // A 2D RGBA8 map of the maps' size, content-addressed, as a manifest entry.
+    let mut map_entry = |stem: &str, format: TexelFormat, bytes: &[u8], contents: &str| {
+        let bytes = ktx2_bytes(format, maps.width(), maps.height(), 0, bytes)?;
+        let file = content_addressed_name(stem, "ktx2", &bytes);
         files.push((file.clone(), bytes));
-        Some(TextureEntry {
+        Ok::<_, ExportError>(TextureEntry {
             file,
             vk_format: format.vk_name().to_string(),
             size: [maps.width(), maps.height(), 0],
-            contents: "painted maps in root-uv space: r density, g length, b clump (shares, byte / 255); a unused".into(),
+            contents: contents.into(),
         })
     };
+    let root_maps = (!maps.is_empty())
+        .then(|| {
+            map_entry(
+                "root_maps",
+                TexelFormat::Rgba8Unorm,
+                &maps.rgba8(),
+                "painted maps in root-uv space: r density, g length, b clump (shares, byte / 255); a unused",
+            )
+        })
+        .transpose()?;
+    let colour_map = maps
+        .has_colour()
+        .then(|| {
+            map_entry(
+                "colour_map",
+                TexelFormat::Rgba8Srgb,
+                &maps.colour_rgba8(),
+                "the colour painted in root-uv space: rgb the colour a thick mass of the hair shows (sRGB), a its weight over the material's colour (byte / 255)",
+            )
+        })
+        .transpose()?;
     let body_glb = (!hair.body.triangles.is_empty()).then(|| glb_body(&hair.body));
     let manifest = Manifest {
         format: "hairloom-runtime".into(),
@@ -600,6 +627,7 @@ pub fn bundle_files(hair: &RuntimeHair) -> Result<Vec<(String, Vec<u8>)>, Export
         column_layers: textures.topology.column_layers.clone(),
         bare_faces: textures.topology.bare_faces.clone(),
         root_maps,
+        colour_map,
     };
     if let (Some(name), Some(bytes)) = (&manifest.body, body_glb) {
         files.push((name.clone(), bytes));
@@ -811,6 +839,14 @@ pub fn load_runtime_asset_from(
     };
     let hair_mesh = load(&manifest.hair_mesh, 4)?;
     let uv = load(&manifest.uv, 2)?;
+    // An RGBA8 texture's bytes again (read as byte / 255).
+    let bytes_of = |texture: &Texture3d| -> Vec<u8> {
+        texture
+            .texels
+            .iter()
+            .flat_map(|t| t.to_array().map(|c| (c * 255.0).round() as u8))
+            .collect()
+    };
     let root_maps = match &manifest.root_maps {
         None => crate::model::root_maps::RootMaps::default(),
         Some(entry) => {
@@ -825,15 +861,32 @@ pub fn load_runtime_asset_from(
             crate::model::root_maps::check_size(width, height)
                 .map_err(|e| error(MANIFEST_FILE, format!("root_maps: {e}")))?;
             let texture = load_as(entry, TexelFormat::Rgba8Unorm)?;
-            let rgba8: Vec<u8> = texture
-                .texels
-                .iter()
-                .flat_map(|t| t.to_array().map(|c| (c * 255.0).round() as u8))
-                .collect();
-            crate::model::root_maps::RootMaps::from_rgba8(width, height, &rgba8)
-                .map_err(|e| error(&entry.file, e.to_string()))?
+            let mut maps =
+                crate::model::root_maps::RootMaps::from_rgba8(width, height, &bytes_of(&texture))
+                    .map_err(|e| error(&entry.file, e.to_string()))?;
+            if let Some(colour) = &manifest.colour_map {
+                if colour.size != entry.size {
+                    return Err(error(
+                        MANIFEST_FILE,
+                        format!(
+                            "colour_map's size {:?} is not root_maps' {:?}",
+                            colour.size, entry.size
+                        ),
+                    ));
+                }
+                let texture = load_as(colour, TexelFormat::Rgba8Srgb)?;
+                maps.set_colour_rgba8(&bytes_of(&texture))
+                    .map_err(|e| error(&colour.file, e.to_string()))?;
+            }
+            maps
         }
     };
+    if manifest.colour_map.is_some() && manifest.root_maps.is_none() {
+        return Err(error(
+            MANIFEST_FILE,
+            "colour_map is present without root_maps (they share one size)".to_string(),
+        ));
+    }
     let w = load(&manifest.w, 1)?;
     let u = load(&manifest.u, 4)?;
     let v = load(&manifest.v, 4)?;
@@ -1357,6 +1410,7 @@ mod tests {
         maps.set_channel_from_image(RootMapChannel::Density, 2, 1, &[0.2, 0.9])
             .expect("density");
         maps.texels_mut()[7] = [1, 2, 3, 255];
+        maps.colour_texels_mut()[4] = [200, 100, 50, 128];
         document.root_maps = maps.clone();
         let files: HashMap<String, Vec<u8>> = runtime_bundle(&document, &RuntimeOptions::default())
             .expect("export")
@@ -1367,6 +1421,29 @@ mod tests {
             serde_json::from_slice(&files[MANIFEST_FILE]).expect("json");
         assert_eq!(manifest["root_maps"]["vk_format"], "R8G8B8A8_UNORM");
         assert_eq!(manifest["root_maps"]["size"], serde_json::json!([5, 3, 0]));
+        assert_eq!(manifest["colour_map"]["vk_format"], "R8G8B8A8_SRGB");
+        // The colour map shares the grey maps' size, and needs them.
+        let mut value = manifest.clone();
+        value["colour_map"]["size"] = serde_json::json!([4, 3, 0]);
+        let mut value_alone = manifest.clone();
+        value_alone
+            .as_object_mut()
+            .expect("object")
+            .remove("root_maps");
+        for (value, names) in [
+            (value, "is not root_maps'"),
+            (value_alone, "without root_maps"),
+        ] {
+            let mut hostile = files.clone();
+            hostile.insert(
+                MANIFEST_FILE.into(),
+                serde_json::to_vec(&value).expect("json"),
+            );
+            let Err(error) = load_runtime_asset_from(&hostile, "memory") else {
+                panic!("{names}: refused");
+            };
+            assert!(error.to_string().contains(names), "{error}");
+        }
         for (key, replacement, names) in [
             ("size", serde_json::json!([5000, 3, 0]), "larger than 4096"),
             ("size", serde_json::json!([5, 3, 1]), "2D texture"),
@@ -1732,7 +1809,7 @@ mod tests {
                         .expect("a bundle")
                         .remove("columns");
                 }),
-                "bundles[0] has no columns (format_version 8 needs them)",
+                "bundles[0] has no columns (format_version 9 needs them)",
             ),
             (
                 Box::new(|m| {

@@ -19,7 +19,14 @@ pub struct StrandLook {
 }
 
 impl StrandLook {
-    pub fn new(strands: &[Strand], root_width_m: f32, material: &HairMaterial) -> Self {
+    /// The look of `strands`: tapered widths, and the material's colour under the colour map
+    /// of `maps` at each strand's root.
+    pub fn new(
+        strands: &[Strand],
+        root_width_m: f32,
+        material: &HairMaterial,
+        maps: &crate::model::root_maps::RootMaps,
+    ) -> Self {
         let roots = root_indices(strands);
         Self {
             root_width_m,
@@ -27,7 +34,7 @@ impl StrandLook {
                 .iter()
                 .flat_map(|s| tapered_widths_m(s.points.len(), root_width_m))
                 .collect(),
-            colors: crate::light::material::strand_point_colors(material, strands, &roots),
+            colors: crate::light::material::strand_point_colors(material, maps, strands, &roots),
         }
     }
 }
@@ -561,7 +568,12 @@ mod tests {
                 ..StrandOptions::default()
             },
         );
-        let look = StrandLook::new(&strands, 1e-4, &document.scene.material);
+        let look = StrandLook::new(
+            &strands,
+            1e-4,
+            &document.scene.material,
+            &document.root_maps,
+        );
         let hair = hair_file(&strands, &look);
         let u32_at = |at: usize| u32::from_le_bytes(hair[at..at + 4].try_into().expect("4"));
         let f32_at = |at: usize| f32::from_le_bytes(hair[at..at + 4].try_into().expect("4"));
@@ -629,10 +641,15 @@ mod tests {
             .collect();
         assert_eq!(root_indices(&strands), expected);
         let material = &document.scene.material;
-        let look = StrandLook::new(&strands, 1e-4, material);
+        let look = StrandLook::new(&strands, 1e-4, material, &Default::default());
         assert_eq!(
             look.colors,
-            crate::light::material::strand_point_colors(material, &strands, &expected)
+            crate::light::material::strand_point_colors(
+                material,
+                &Default::default(),
+                &strands,
+                &expected
+            )
         );
         // The old guess (3 per bundle, numbered by bundle) gives other colours: the test can
         // tell them apart.
@@ -642,7 +659,12 @@ mod tests {
             .collect();
         assert_ne!(
             look.colors,
-            crate::light::material::strand_point_colors(material, &strands, &guessed)
+            crate::light::material::strand_point_colors(
+                material,
+                &Default::default(),
+                &strands,
+                &guessed
+            )
         );
         // The runtime mirror numbers its strands the same way.
         let runtime = crate::runtime::hair::RuntimeHair::from_document(

@@ -8,6 +8,7 @@
 //!   5.574β⁴ + 0.245β⁵` (Chiang eq. 9, fitted so that a thick mass of hair shows colour `c`),
 //!   and its exact inverse `c = exp(−√σ_a · P(β_n))`.
 
+use crate::model::root_maps::{PaintedColour, RootMaps};
 use crate::model::scene::{HairMaterial, Pigment};
 
 /// Eumelanin absorption per unit concentration (per unit fibre radius).
@@ -112,6 +113,28 @@ impl Fibre {
     pub fn color(&self, sigma_a: [f64; 3]) -> [f64; 3] {
         color_from_sigma_a(sigma_a, self.beta_n)
     }
+
+    /// This fibre on a strand under the colour map's `paint`: the root colour blended toward
+    /// the painted one by its weight (in colour, so half a weight looks half-way), and the
+    /// absorption that shows it; the tip factor and per-strand variation then apply as
+    /// before. Mirror of `painted_sigma_a_root` in `shaders/shared/scene.wgsl`.
+    pub fn painted(&self, paint: &PaintedColour) -> Fibre {
+        let weight = if paint.weight.is_nan() {
+            0.0
+        } else {
+            paint.weight.clamp(0.0, 1.0)
+        };
+        if weight == 0.0 {
+            return *self;
+        }
+        let own = self.color(self.sigma_a_root);
+        let rgb: [f64; 3] =
+            std::array::from_fn(|c| own[c] + (paint.rgb_linear[c] - own[c]) * weight);
+        Fibre {
+            sigma_a_root: sigma_a_from_color(rgb, self.beta_n),
+            ..*self
+        }
+    }
 }
 
 /// The random value of a strand's absorption variation, from its root index (bundle ×
@@ -122,18 +145,21 @@ pub(crate) fn strand_shading_random(root: u32) -> f64 {
 }
 
 /// The colour (linear RGB: what a thick mass of such hair shows) at every point of `strands`,
-/// in order: the material's absorption at the point's fraction along its strand (root to
-/// tip) with the strand's own variation, hashed from its root index in `roots` (one per
-/// strand, as [`crate::strands::reference::root_indices`] numbers them). What strand exports
-/// write as vertex colour so that other tools start from the hair's look.
+/// in order: the material's absorption, under the colour map at the strand's root uv, at the
+/// point's fraction along its strand (root to tip) with the strand's own variation, hashed
+/// from its root index in `roots` (one per strand, as
+/// [`crate::strands::reference::root_indices`] numbers them). What strand exports write as
+/// vertex colour so that other tools start from the hair's look.
 pub fn strand_point_colors(
     material: &HairMaterial,
+    colour_map: &RootMaps,
     strands: &[crate::strands::reference::Strand],
     roots: &[u32],
 ) -> Vec<[f32; 3]> {
-    let fibre = Fibre::new(material);
+    let material_fibre = Fibre::new(material);
     let mut colors = Vec::with_capacity(strands.iter().map(|s| s.points.len()).sum());
     for (strand, &root) in strands.iter().zip(roots) {
+        let fibre = material_fibre.painted(&colour_map.sample_colour(strand.root_uv));
         let xi = strand_shading_random(root);
         let last = strand.points.len().saturating_sub(1).max(1) as f64;
         colors.extend((0..strand.points.len()).map(|k| {
@@ -203,5 +229,83 @@ mod tests {
         // Brown hair is reddish: it absorbs blue most.
         let color = fibre.color(root);
         assert!(color[0] > color[1] && color[1] > color[2], "{color:?}");
+    }
+
+    #[test]
+    fn painting_a_colour_blends_the_root_colour_and_keeps_the_variation() {
+        let material = HairMaterial::default();
+        let fibre = Fibre::new(&material);
+        assert_eq!(fibre.painted(&PaintedColour::NONE), fibre);
+        let nan = PaintedColour {
+            rgb_linear: [0.5; 3],
+            weight: f64::NAN,
+        };
+        assert_eq!(fibre.painted(&nan), fibre);
+        let own = fibre.color(fibre.sigma_a_root);
+        let red = [0.6, 0.1, 0.05];
+        for weight in [0.0, 0.25, 1.0] {
+            let painted = fibre.painted(&PaintedColour {
+                rgb_linear: red,
+                weight,
+            });
+            let root = painted.color(painted.sigma_a_root);
+            for c in 0..3 {
+                let expected = own[c] + (red[c] - own[c]) * weight;
+                assert!((root[c] - expected).abs() < 1e-9, "{weight}: {root:?}");
+            }
+            // The tip factor and per-strand variation apply to the painted absorption.
+            let ratio = painted.sigma_a(1.0, 0.9)[0] / painted.sigma_a(0.0, 0.5)[0];
+            let plain_ratio = fibre.sigma_a(1.0, 0.9)[0] / fibre.sigma_a(0.0, 0.5)[0];
+            assert!((ratio - plain_ratio).abs() < 1e-9);
+            assert!(painted.sigma_a(0.7, 0.3).iter().all(|s| s.is_finite()));
+        }
+        // Black and white paint stay finite (clamped into the fit's range).
+        for rgb in [[0.0; 3], [1.0; 3], [f64::NAN, f64::INFINITY, -1.0]] {
+            let painted = fibre.painted(&PaintedColour {
+                rgb_linear: rgb,
+                weight: 1.0,
+            });
+            assert!(
+                painted
+                    .sigma_a_root
+                    .iter()
+                    .all(|s| s.is_finite() && *s >= 0.0),
+                "{rgb:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn exported_colours_follow_the_colour_map_at_each_root() {
+        use crate::strands::reference::Strand;
+        let material = HairMaterial {
+            strand_absorption_variation: 0.0,
+            ..HairMaterial::default()
+        };
+        let strand = |u: f64| Strand {
+            bundle: 0,
+            root: 7,
+            coord: crate::geometry::curve::FaceCoord { s: 0.5, t: 0.5 },
+            root_uv: glam::DVec2::new(u, 0.5),
+            length_fraction: 1.0,
+            points: vec![glam::DVec3::ZERO, glam::DVec3::Y],
+        };
+        let strands = [strand(0.1), strand(0.9)];
+        // Colour on the left half only, at full weight.
+        let mut maps = RootMaps::blank(4, 1).expect("maps");
+        for x in 0..2 {
+            maps.colour_texels_mut()[x] = [200, 100, 50, 255];
+        }
+        let plain = strand_point_colors(&material, &RootMaps::default(), &strands, &[7, 7]);
+        let colours = strand_point_colors(&material, &maps, &strands, &[7, 7]);
+        let painted = maps.sample_colour(glam::DVec2::new(0.1, 0.5)).rgb_linear;
+        for c in 0..3 {
+            assert!(
+                (colours[0][c] as f64 - painted[c]).abs() < 1e-5,
+                "{colours:?}"
+            );
+        }
+        assert_eq!(colours[2..], plain[2..], "unpainted on the right");
+        assert_ne!(colours[..2], plain[..2]);
     }
 }

@@ -215,7 +215,9 @@ pub struct DocumentDiff {
 /// A change of the painted maps. A stroke keeps their size, and only the texels it changed
 /// are kept (a few thousand of a 256² map's 65,536): a history of 200 strokes holding both
 /// whole maps each was up to 100 MB in memory and in the project file. A change of size
-/// (the first stroke, clearing the last map, an import) keeps both whole.
+/// (the first stroke, clearing the last map, an import, the colour map's first stroke or its
+/// clearing) keeps both whole. Texel indices run over the grey maps' texels, then the
+/// colour map's ([`RootMaps::stacked_texels`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RootMapsChange {
@@ -240,17 +242,18 @@ impl RootMapsChange {
         if before == after {
             return None;
         }
-        let same_size = (before.width(), before.height()) == (after.width(), after.height());
+        let same_size = (before.width(), before.height()) == (after.width(), after.height())
+            && before.has_colour() == after.has_colour();
         if !same_size || before.is_empty() {
             return Some(Self::Whole(Swap {
                 before: before.clone(),
                 after: after.clone(),
             }));
         }
+        // Indices run over both textures, the colour map's after the grey maps'.
         let changes = before
-            .texels()
-            .iter()
-            .zip(after.texels())
+            .stacked_texels()
+            .zip(after.stacked_texels())
             .enumerate()
             .filter(|(_, (b, a))| b != a)
             .map(|(index, (b, a))| TexelChange {
@@ -289,7 +292,7 @@ impl RootMapsChange {
                 }
                 for change in changes {
                     let expected = if forward { change.before } else { change.after };
-                    if maps.texels().get(change.index as usize) != Some(&expected) {
+                    if maps.stacked_texel(change.index as usize) != Some(&expected) {
                         return Err(mismatch(format!(
                             "texel {} does not hold the value this history entry changed",
                             change.index
@@ -306,9 +309,8 @@ impl RootMapsChange {
         match self {
             Self::Whole(swap) => swap.write(maps, forward),
             Self::Texels { changes, .. } => {
-                let texels = maps.texels_mut();
                 for change in changes {
-                    if let Some(texel) = texels.get_mut(change.index as usize) {
+                    if let Some(texel) = maps.stacked_texel_mut(change.index as usize) {
                         *texel = if forward { change.after } else { change.before };
                     }
                 }
@@ -783,5 +785,50 @@ mod root_maps_tests {
         let other = RootMaps::blank(8, 8).expect("maps");
         let error = entry.check(&other, true, "root_maps").expect_err("size");
         assert!(error.message.contains("8 × 8"), "{error}");
+    }
+
+    #[test]
+    fn colour_strokes_keep_only_their_texels_and_undo() {
+        let mut document = document();
+        let mut history = History::default();
+        let mut first = document.clone();
+        first.root_maps = RootMaps::blank(64, 64).expect("maps");
+        first.root_maps.texels_mut()[3][0] = 0;
+        history.commit(&mut document, "Paint density", first.clone());
+        // The colour map's first stroke: whole (the map appears).
+        let mut second = document.clone();
+        second.root_maps.colour_texels_mut()[10] = [200, 40, 10, 255];
+        let command = Command::record("Paint colour", &document, &second).expect("a change");
+        let Command::Edit { diff, .. } = &command else {
+            panic!("an edit");
+        };
+        assert!(matches!(
+            diff.root_maps.as_deref(),
+            Some(RootMapsChange::Whole(_))
+        ));
+        history.commit(&mut document, "Paint colour", second.clone());
+        // The next: only its texels, indexed after the grey maps' 4096.
+        let mut third = document.clone();
+        third.root_maps.colour_texels_mut()[11] = [10, 40, 200, 128];
+        let command = Command::record("Paint colour", &document, &third).expect("a change");
+        let Command::Edit { diff, .. } = &command else {
+            panic!("an edit");
+        };
+        let Some(RootMapsChange::Texels { changes, .. }) = diff.root_maps.as_deref() else {
+            panic!("texels");
+        };
+        assert_eq!(
+            changes.iter().map(|c| c.index).collect::<Vec<_>>(),
+            vec![4096 + 11]
+        );
+        history.commit(&mut document, "Paint colour", third.clone());
+        history.verify(&document).expect("a consistent history");
+        history.undo(&mut document).expect("undo");
+        assert_eq!(document.root_maps, second.root_maps);
+        history.undo(&mut document).expect("undo");
+        assert_eq!(document.root_maps, first.root_maps);
+        history.redo(&mut document).expect("redo");
+        history.redo(&mut document).expect("redo");
+        assert_eq!(document.root_maps, third.root_maps);
     }
 }

@@ -10,6 +10,13 @@
 //! it would have, and feels `clump` of its styling group's clump and sub-clump pulls. Empty
 //! maps (the default) are 1 everywhere: nothing changes. The runtime bundle carries them as
 //! `root_maps.HASH.ktx2` (`docs/runtime-format.md`, "Painted maps").
+//!
+//! The colour map is a second RGBA8 texture of the same size (present only once painted):
+//! rgb the colour a thick mass of the hair shows there (sRGB-encoded, as a colour picker and
+//! an image give it), a the share of it the strand takes over the material's own colour
+//! (0: none; see [`crate::light::material::Fibre::painted`]). It colours whole strands by
+//! their root, as dyed or greying hair is; the root-to-tip darkening and per-strand variation
+//! of the material still apply. The runtime bundle carries it as `colour_map.HASH.ktx2`.
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -20,7 +27,8 @@ pub const MAX_ROOT_MAP_SIDE: u32 = 4096;
 /// The side of the maps painting starts on when there are none yet.
 pub const DEFAULT_ROOT_MAP_SIDE: u32 = 256;
 
-/// One of the painted maps (its channel of the RGBA8 texture).
+/// One of the painted maps: a channel of the RGBA8 texture, or the colour map (a texture of
+/// its own).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RootMapChannel {
@@ -30,16 +38,24 @@ pub enum RootMapChannel {
     Length,
     /// The share of the clump op's pull a strand feels (b).
     Clump,
+    /// The strand's colour and how much of it it takes (the colour map).
+    Colour,
 }
 
 impl RootMapChannel {
+    /// The three grey maps of the RGBA8 texture.
     pub const ALL: [RootMapChannel; 3] = [Self::Density, Self::Length, Self::Clump];
+    /// Every map a brush paints.
+    pub const PAINTABLE: [RootMapChannel; 4] =
+        [Self::Density, Self::Length, Self::Clump, Self::Colour];
 
-    pub fn index(self) -> usize {
+    /// The grey map's channel of the RGBA8 texture (`None` for the colour map).
+    pub fn grey_index(self) -> Option<usize> {
         match self {
-            Self::Density => 0,
-            Self::Length => 1,
-            Self::Clump => 2,
+            Self::Density => Some(0),
+            Self::Length => Some(1),
+            Self::Clump => Some(2),
+            Self::Colour => None,
         }
     }
 
@@ -48,14 +64,81 @@ impl RootMapChannel {
             Self::Density => "Density",
             Self::Length => "Length",
             Self::Clump => "Clump",
+            Self::Colour => "Colour",
         }
     }
 
-    /// Parses `density`, `length` or `clump`.
+    /// Parses `density`, `length`, `clump` or `colour` (`color` too).
     pub fn parse(text: &str) -> Option<Self> {
-        Self::ALL
+        let text = text.trim();
+        if text.eq_ignore_ascii_case("color") {
+            return Some(Self::Colour);
+        }
+        Self::PAINTABLE
             .into_iter()
-            .find(|c| c.label().eq_ignore_ascii_case(text.trim()))
+            .find(|c| c.label().eq_ignore_ascii_case(text))
+    }
+}
+
+/// The colour map at one root uv: the colour a thick mass of the hair shows (linear RGB) and
+/// the share of it the strand takes over the material's own (0: none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PaintedColour {
+    pub rgb_linear: [f64; 3],
+    pub weight: f64,
+}
+
+impl PaintedColour {
+    pub const NONE: PaintedColour = PaintedColour {
+        rgb_linear: [0.0; 3],
+        weight: 0.0,
+    };
+
+    /// Packed as the renderers' per-root buffer holds it: sRGB-encoded rgb in bytes 0-2, the
+    /// weight in byte 3 (WGSL's `unpack4x8unorm` order). Mirror of `root_paint` in
+    /// `shaders/preview_hair.wgsl`, which decodes it.
+    pub fn pack(&self) -> u32 {
+        let [r, g, b] = self.rgb_linear.map(|c| unit_to_byte(linear_to_srgb(c)));
+        u32::from_le_bytes([r, g, b, unit_to_byte(self.weight)])
+    }
+
+    /// What [`Self::pack`] keeps of a colour (8 bits per channel).
+    pub fn unpack(packed: u32) -> Self {
+        let [r, g, b, a] = packed.to_le_bytes();
+        PaintedColour {
+            rgb_linear: [r, g, b].map(|c| srgb_to_linear(c as f64 / 255.0)),
+            weight: a as f64 / 255.0,
+        }
+    }
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1): an encoded value to linear.
+pub fn srgb_to_linear(encoded: f64) -> f64 {
+    if encoded <= 0.04045 {
+        encoded / 12.92
+    } else {
+        ((encoded + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// [`srgb_to_linear`] of every byte / 255, computed once: the colour map's texels are decoded
+/// per root, four texels of three channels each, and `powf` dominated that.
+fn srgb_byte_table() -> &'static [f64; 256] {
+    static TABLE: std::sync::OnceLock<[f64; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|b| srgb_to_linear(b as f64 / 255.0)))
+}
+
+/// The sRGB transfer function: linear to an encoded value (NaN and out-of-range clamped).
+pub fn linear_to_srgb(linear: f64) -> f64 {
+    let linear = if linear.is_nan() {
+        0.0
+    } else {
+        linear.clamp(0.0, 1.0)
+    };
+    if linear <= 0.0031308 {
+        linear * 12.92
+    } else {
+        1.055 * linear.powf(1.0 / 2.4) - 0.055
     }
 }
 
@@ -102,15 +185,20 @@ pub enum RootMapError {
     },
     #[error("painted map texels are not valid base64: {0}")]
     Base64(String),
+    #[error("the colour map is painted from a colour image, not a grey one")]
+    NotGrey,
 }
 
-/// The painted maps: an RGBA8 texture in root-uv space, or none (1 everywhere).
+/// The painted maps: an RGBA8 texture in root-uv space, or none (1 everywhere), and the
+/// colour map of the same size, or none (no colour painted).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "StoredRootMaps", into = "StoredRootMaps")]
 pub struct RootMaps {
     width: u32,
     height: u32,
     texels: Vec<[u8; 4]>,
+    /// Empty, or one per texel: sRGB colour and weight. Present only with `texels`.
+    colour: Vec<[u8; 4]>,
 }
 
 /// How a project file stores the maps: the texels as base64 (a JSON array of numbers would
@@ -121,41 +209,62 @@ struct StoredRootMaps {
     width: u32,
     height: u32,
     rgba8_base64: String,
+    /// The colour map (absent in files from before it, and while none is painted).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    colour_rgba8_base64: Option<String>,
+}
+
+/// Decodes one stored texture of `width × height` RGBA8 texels, checking the text's length
+/// before decoding: a hostile file cannot make us decode more than the size says.
+fn decode_texels(width: u32, height: u32, text: &str) -> Result<Vec<u8>, RootMapError> {
+    use base64::Engine as _;
+    let expected = width as usize * height as usize * 4;
+    if text.len() > expected.div_ceil(3) * 4 + 4 {
+        return Err(RootMapError::WrongLength {
+            width,
+            height,
+            bytes: text.len() / 4 * 3,
+            expected,
+        });
+    }
+    base64::engine::general_purpose::STANDARD
+        .decode(text.as_bytes())
+        .map_err(|e| RootMapError::Base64(e.to_string()))
 }
 
 impl TryFrom<StoredRootMaps> for RootMaps {
     type Error = RootMapError;
 
     fn try_from(stored: StoredRootMaps) -> Result<Self, Self::Error> {
-        use base64::Engine as _;
-        if stored.width == 0 && stored.height == 0 && stored.rgba8_base64.is_empty() {
+        if stored.width == 0
+            && stored.height == 0
+            && stored.rgba8_base64.is_empty()
+            && stored.colour_rgba8_base64.is_none()
+        {
             return Ok(Self::default());
         }
         check_size(stored.width, stored.height)?;
-        // Checked before decoding: a hostile file cannot make us decode more than the size says.
-        let expected = stored.width as usize * stored.height as usize * 4;
-        if stored.rgba8_base64.len() > expected.div_ceil(3) * 4 + 4 {
-            return Err(RootMapError::WrongLength {
-                width: stored.width,
-                height: stored.height,
-                bytes: stored.rgba8_base64.len() / 4 * 3,
-                expected,
-            });
+        let bytes = decode_texels(stored.width, stored.height, &stored.rgba8_base64)?;
+        let mut maps = Self::from_rgba8(stored.width, stored.height, &bytes)?;
+        if let Some(text) = &stored.colour_rgba8_base64 {
+            let bytes = decode_texels(stored.width, stored.height, text)?;
+            maps.set_colour_rgba8(&bytes)?;
         }
-        let bytes = base64::engine::general_purpose::STANDARD
-            .decode(stored.rgba8_base64.as_bytes())
-            .map_err(|e| RootMapError::Base64(e.to_string()))?;
-        Self::from_rgba8(stored.width, stored.height, &bytes)
+        Ok(maps)
     }
 }
 
 impl From<RootMaps> for StoredRootMaps {
     fn from(maps: RootMaps) -> Self {
         use base64::Engine as _;
+        let engine = base64::engine::general_purpose::STANDARD;
         Self {
             width: maps.width,
             height: maps.height,
-            rgba8_base64: base64::engine::general_purpose::STANDARD.encode(maps.rgba8()),
+            rgba8_base64: engine.encode(maps.rgba8()),
+            colour_rgba8_base64: maps
+                .has_colour()
+                .then(|| engine.encode(maps.colour_rgba8())),
         }
     }
 }
@@ -186,6 +295,7 @@ impl RootMaps {
             width,
             height,
             texels: vec![[255; 4]; width as usize * height as usize],
+            colour: Vec::new(),
         })
     }
 
@@ -208,7 +318,167 @@ impl RootMaps {
                 .chunks_exact(4)
                 .map(|c| [c[0], c[1], c[2], c[3]])
                 .collect(),
+            colour: Vec::new(),
         })
+    }
+
+    /// Checks an image of `width × height` holding `values` values, and makes blank maps of
+    /// its size where nothing is painted yet (an image onto painted maps is resampled).
+    fn ready_for_image(
+        &mut self,
+        width: u32,
+        height: u32,
+        values: usize,
+    ) -> Result<(), RootMapError> {
+        check_size(width, height)?;
+        if values != width as usize * height as usize {
+            return Err(RootMapError::WrongLength {
+                width,
+                height,
+                bytes: values,
+                expected: width as usize * height as usize,
+            });
+        }
+        if self.is_empty() {
+            *self = Self::blank(width, height)?;
+        }
+        Ok(())
+    }
+
+    /// Sets the colour map from RGBA8 bytes of these maps' size (sRGB rgb, weight a).
+    pub fn set_colour_rgba8(&mut self, bytes: &[u8]) -> Result<(), RootMapError> {
+        let expected = self.texels.len() * 4;
+        if self.is_empty() || bytes.len() != expected {
+            return Err(RootMapError::WrongLength {
+                width: self.width,
+                height: self.height,
+                bytes: bytes.len(),
+                expected,
+            });
+        }
+        self.colour = bytes
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect();
+        Ok(())
+    }
+
+    /// Every texel of both textures: the grey maps', then the colour map's (none when none is
+    /// painted). Index `i` of this order is what [`Self::stacked_texel`] reads.
+    pub fn stacked_texels(&self) -> impl Iterator<Item = &[u8; 4]> {
+        self.texels.iter().chain(&self.colour)
+    }
+
+    /// Texel `index` of [`Self::stacked_texels`].
+    pub fn stacked_texel(&self, index: usize) -> Option<&[u8; 4]> {
+        match index.checked_sub(self.texels.len()) {
+            None => self.texels.get(index),
+            Some(i) => self.colour.get(i),
+        }
+    }
+
+    /// Texel `index` of [`Self::stacked_texels`], to write.
+    pub fn stacked_texel_mut(&mut self, index: usize) -> Option<&mut [u8; 4]> {
+        match index.checked_sub(self.texels.len()) {
+            None => self.texels.get_mut(index),
+            Some(i) => self.colour.get_mut(i),
+        }
+    }
+
+    /// Whether a colour map is painted.
+    pub fn has_colour(&self) -> bool {
+        !self.colour.is_empty()
+    }
+
+    /// The colour map's texels (empty when none is painted).
+    pub fn colour_texels(&self) -> &[[u8; 4]] {
+        &self.colour
+    }
+
+    /// The colour map's texels, made (no colour: weight 0) if there were none yet; the maps
+    /// must not be empty (paint on [`Self::blank`] maps).
+    pub fn colour_texels_mut(&mut self) -> &mut [[u8; 4]] {
+        if self.colour.is_empty() {
+            self.colour = vec![[0; 4]; self.texels.len()];
+        }
+        &mut self.colour
+    }
+
+    /// The colour map's bytes (what the runtime bundle's `colour_map` KTX2 file holds).
+    pub fn colour_rgba8(&self) -> Vec<u8> {
+        self.colour.iter().flatten().copied().collect()
+    }
+
+    /// Forgets the colour map; with no grey map painted either, the maps go.
+    pub fn clear_colour(&mut self) {
+        self.colour = Vec::new();
+        self.drop_if_unpainted();
+    }
+
+    fn drop_if_unpainted(&mut self) {
+        if self.colour.is_empty() && self.texels.iter().all(|t| t[..3] == [255, 255, 255]) {
+            *self = Self::default();
+        }
+    }
+
+    /// Whether `channel` holds anything painted.
+    pub fn is_painted(&self, channel: RootMapChannel) -> bool {
+        match channel.grey_index() {
+            Some(c) => self.texels.iter().any(|t| t[c] != 255),
+            None => self.colour.iter().any(|t| t[3] != 0),
+        }
+    }
+
+    /// The colour map at `uv` (mirror of the renderers' per-root colour): bilinear between
+    /// texel centres as [`Self::sample`], of linear colour (each texel decoded from sRGB
+    /// first, as a GPU's sRGB texture does) and weight.
+    pub fn sample_colour(&self, uv: DVec2) -> PaintedColour {
+        if self.colour.is_empty() {
+            return PaintedColour::NONE;
+        }
+        let decoded = srgb_byte_table();
+        let at = |c: usize| {
+            bilinear(self.width, self.height, uv, |x, y| {
+                let byte = self.colour[(y * self.width + x) as usize][c];
+                if c < 3 {
+                    decoded[byte as usize]
+                } else {
+                    byte as f64 / 255.0
+                }
+            })
+        };
+        PaintedColour {
+            rgb_linear: [at(0), at(1), at(2)],
+            weight: at(3),
+        }
+    }
+
+    /// Replaces the colour map by an image of `width × height` sRGB colours and weights in
+    /// `[0, 1]` (row 0 at `v = 0`), resampled bilinearly to these maps' size; maps with
+    /// nothing painted take the image's size. NaN counts as 0.
+    pub fn set_colour_from_image(
+        &mut self,
+        width: u32,
+        height: u32,
+        values: &[[f64; 4]],
+    ) -> Result<(), RootMapError> {
+        self.ready_for_image(width, height, values.len())?;
+        let (w, h) = (self.width, self.height);
+        let colour = self.colour_texels_mut();
+        for y in 0..h {
+            for x in 0..w {
+                let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+                let texel = &mut colour[(y * w + x) as usize];
+                for (c, byte) in texel.iter_mut().enumerate() {
+                    let value = bilinear(width, height, uv, |ix, iy| {
+                        let v = values[(iy * width + ix) as usize][c];
+                        if v.is_nan() { 0.0 } else { v }
+                    });
+                    *byte = unit_to_byte(value);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Whether nothing is painted (no texture: 1 everywhere).
@@ -247,18 +517,10 @@ impl RootMaps {
         height: u32,
         values: &[f64],
     ) -> Result<(), RootMapError> {
-        check_size(width, height)?;
-        if values.len() != width as usize * height as usize {
-            return Err(RootMapError::WrongLength {
-                width,
-                height,
-                bytes: values.len(),
-                expected: width as usize * height as usize,
-            });
-        }
-        if self.is_empty() {
-            *self = Self::blank(width, height)?;
-        }
+        let Some(index) = channel.grey_index() else {
+            return Err(RootMapError::NotGrey);
+        };
+        self.ready_for_image(width, height, values.len())?;
         let (w, h) = (self.width, self.height);
         let image = |x: u32, y: u32| {
             let v = values[(y * width + x) as usize];
@@ -268,28 +530,32 @@ impl RootMaps {
             for x in 0..w {
                 let uv = DVec2::new((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
                 let value = bilinear(width, height, uv, image);
-                self.texels[(y * w + x) as usize][channel.index()] = unit_to_byte(value);
+                self.texels[(y * w + x) as usize][index] = unit_to_byte(value);
             }
         }
         Ok(())
     }
 
-    /// One map as values in `[0, 1]`, row-major (empty when nothing is painted).
+    /// One map as values in `[0, 1]`, row-major (empty when nothing is painted); the colour
+    /// map's weights for [`RootMapChannel::Colour`].
     pub fn channel_values(&self, channel: RootMapChannel) -> Vec<f64> {
-        self.texels
-            .iter()
-            .map(|t| t[channel.index()] as f64 / 255.0)
-            .collect()
+        match channel.grey_index() {
+            Some(c) => self.texels.iter().map(|t| t[c] as f64 / 255.0).collect(),
+            None => self.colour.iter().map(|t| t[3] as f64 / 255.0).collect(),
+        }
     }
 
-    /// Forgets one map (1 everywhere); with none of the three left painted, the texture goes.
+    /// Forgets one map (1 everywhere, or no colour); with nothing left painted, the
+    /// texture goes.
     pub fn clear_channel(&mut self, channel: RootMapChannel) {
+        let Some(c) = channel.grey_index() else {
+            self.clear_colour();
+            return;
+        };
         for texel in &mut self.texels {
-            texel[channel.index()] = 255;
+            texel[c] = 255;
         }
-        if self.texels.iter().all(|t| t[..3] == [255, 255, 255]) {
-            *self = Self::default();
-        }
+        self.drop_if_unpainted();
     }
 
     /// The maps at `uv` (mirror of `root_map_values` in `shaders/shared/strand_vertex.wgsl`):
@@ -431,5 +697,90 @@ mod tests {
         assert!(maps.is_empty(), "nothing painted is left");
         wide.clear_channel(RootMapChannel::Density);
         assert!(!wide.is_empty(), "the clump map is still painted");
+    }
+
+    #[test]
+    fn the_colour_map_samples_in_linear_light_packs_and_round_trips() {
+        let mut maps = RootMaps::blank(2, 1).expect("test value");
+        assert_eq!(maps.sample_colour(DVec2::splat(0.5)), PaintedColour::NONE);
+        assert!(!maps.is_painted(RootMapChannel::Colour));
+        maps.colour_texels_mut()[0] = [255, 0, 0, 255];
+        maps.colour_texels_mut()[1] = [0, 0, 0, 0];
+        assert!(maps.is_painted(RootMapChannel::Colour));
+        // Half-way between the texel centres: the linear colours' and weights' mean (not the
+        // sRGB bytes' mean, which would be 0.214 linear).
+        let half = maps.sample_colour(DVec2::new(0.5, 0.5));
+        assert!((half.rgb_linear[0] - 0.5).abs() < 1e-12, "{half:?}");
+        assert!((half.weight - 0.5).abs() < 1e-12, "{half:?}");
+        // Packing keeps 8 bits of sRGB: within half a step.
+        for colour in [
+            PaintedColour {
+                rgb_linear: [0.5, 0.02, 0.9],
+                weight: 0.25,
+            },
+            PaintedColour {
+                rgb_linear: [f64::NAN, -1.0, 7.0],
+                weight: f64::NAN,
+            },
+        ] {
+            let back = PaintedColour::unpack(colour.pack());
+            for c in 0..3 {
+                let expected = linear_to_srgb(colour.rgb_linear[c]);
+                assert!(
+                    (linear_to_srgb(back.rgb_linear[c]) - expected).abs() <= 0.5 / 255.0 + 1e-12,
+                    "{colour:?} -> {back:?}"
+                );
+            }
+            assert!(back.weight.is_finite());
+        }
+        // The project text carries the colour map; text from before it has none.
+        let text = serde_json::to_string(&maps).expect("test value");
+        assert!(text.contains("colour_rgba8_base64"), "{text}");
+        assert_eq!(
+            serde_json::from_str::<RootMaps>(&text).expect("test value"),
+            maps
+        );
+        let old = r#"{"width":1,"height":1,"rgba8_base64":"AAAA/w=="}"#;
+        assert!(
+            !serde_json::from_str::<RootMaps>(old)
+                .expect("test value")
+                .has_colour()
+        );
+        let wrong =
+            r#"{"width":1,"height":1,"rgba8_base64":"AAAA/w==","colour_rgba8_base64":"AAAAAAAA"}"#;
+        let error = serde_json::from_str::<RootMaps>(wrong)
+            .expect_err("refused")
+            .to_string();
+        assert!(error.contains("not 4"), "{error}");
+        // Clearing the colour leaves the grey maps; with nothing else painted the maps go.
+        let mut density = maps.clone();
+        density.texels_mut()[0][0] = 0;
+        density.clear_channel(RootMapChannel::Colour);
+        assert!(!density.has_colour() && !density.is_empty());
+        maps.clear_channel(RootMapChannel::Colour);
+        assert!(maps.is_empty());
+        // Clearing a grey map keeps a painted colour.
+        let mut colour_only = RootMaps::blank(2, 1).expect("test value");
+        colour_only.colour_texels_mut()[0] = [1, 2, 3, 4];
+        colour_only.clear_channel(RootMapChannel::Density);
+        assert!(colour_only.has_colour());
+        assert_eq!(RootMapChannel::parse("Color"), Some(RootMapChannel::Colour));
+    }
+
+    #[test]
+    fn a_colour_image_fills_the_colour_map_resampled() {
+        let mut maps = RootMaps::default();
+        maps.set_colour_from_image(2, 1, &[[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, f64::NAN]])
+            .expect("test value");
+        assert_eq!((maps.width(), maps.height()), (2, 1));
+        assert_eq!(maps.colour_texels(), &[[255, 0, 0, 255], [0, 0, 255, 0]]);
+        assert!(
+            maps.texels().iter().all(|t| *t == [255; 4]),
+            "grey maps unpainted"
+        );
+        let error = maps
+            .set_channel_from_image(RootMapChannel::Colour, 1, 1, &[0.5])
+            .expect_err("a colour map is not grey");
+        assert_eq!(error, RootMapError::NotGrey);
     }
 }

@@ -236,6 +236,41 @@ impl RuntimeHair {
         crate::strands::lod::density_count(density as f64, self.strands_per_bundle)
     }
 
+    /// The colour map at every root of [`Self::strand_roots`], packed as the renderers' per-root
+    /// buffer holds it ([`crate::model::root_maps::PaintedColour::pack`]); empty when no
+    /// colour map is painted. Each root's uv is read from the uv-texture exactly, as
+    /// `strand_input` reads it: what a game does once at load (and again when the map
+    /// changes), `docs/runtime-format.md` "Painted colour".
+    pub fn root_paint(&self) -> Vec<u32> {
+        let maps = &self.textures.root_maps;
+        if !maps.has_colour() {
+            return Vec::new();
+        }
+        let roots = self.strand_roots();
+        // Deterministic chunks on every core: a stroke re-resolves every root per dab.
+        crate::parallel::in_chunks(
+            roots.len(),
+            4096,
+            std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |range| {
+                roots[range]
+                    .iter()
+                    .map(|root| {
+                        let texel = glam::Vec2::from_array(root.texel).extend(0.5);
+                        let uv = crate::runtime::strand_gen::fetch(
+                            &self.textures.uv,
+                            texel,
+                            crate::runtime::strand_gen::Filtering::Exact,
+                        );
+                        maps.sample_colour(glam::DVec2::new(uv.x as f64, uv.y as f64))
+                            .pack()
+                    })
+                    .collect::<Vec<u32>>()
+            },
+        )
+        .concat()
+    }
+
     /// Every strand root at full detail, bundle-major (root `i` is sample
     /// `i % strands_per_bundle` of block `i / strands_per_bundle`), as the GPU lays them out.
     pub fn strand_roots(&self) -> Vec<StrandRoot> {

@@ -61,6 +61,10 @@ pub struct BrushSettings {
     pub paint: Option<hairloom_core::model::root_maps::RootMapChannel>,
     /// The share the map brush paints toward (Ctrl: 1, the unpainted value).
     pub paint_value: f64,
+    /// The colour map brush's colour (sRGB) and the weight it paints toward (Ctrl: 0, the
+    /// material's own colour).
+    pub paint_colour: [u8; 3],
+    pub colour_weight: f64,
 }
 
 impl BrushSettings {
@@ -83,6 +87,9 @@ impl Default for BrushSettings {
             front_only: true,
             paint: None,
             paint_value: 0.0,
+            // A copper red: visible on the samples' brown hair.
+            paint_colour: [170, 70, 35],
+            colour_weight: 1.0,
         }
     }
 }

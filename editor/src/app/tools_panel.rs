@@ -57,7 +57,7 @@ fn brush_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
     });
     ui.horizontal_wrapped(|ui| {
         ui.label("Paint map:");
-        for channel in RootMapChannel::ALL {
+        for channel in RootMapChannel::PAINTABLE {
             let response = ui.selectable_label(
                 brush.paint == Some(channel),
                 format!("{} map", channel.label()),
@@ -72,6 +72,9 @@ fn brush_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
                 RootMapChannel::Length => "Paint the share of its length the hair keeps",
                 RootMapChannel::Clump => {
                     "Paint how strongly the hair clumps (the Clump op's share)"
+                }
+                RootMapChannel::Colour => {
+                    "Paint the hair's colour by its root: dyed streaks, grey, tips (Ctrl: the material's own)"
                 }
             });
         }
@@ -97,7 +100,19 @@ fn brush_ui(ui: &mut egui::Ui, brush: &mut BrushSettings) {
         "Strength",
         egui::Slider::new(&mut brush.strength, 0.0..=1.0),
     );
-    if brush.paint.is_some() {
+    if brush.paint == Some(RootMapChannel::Colour) {
+        ui.horizontal(|ui| {
+            let label = ui.label("Paint colour");
+            ui.color_edit_button_srgb(&mut brush.paint_colour)
+                .labelled_by(label.id)
+                .on_hover_text("The colour a mass of the painted hair shows");
+        });
+        labelled_slider(
+            ui,
+            "Colour weight",
+            egui::Slider::new(&mut brush.colour_weight, 0.0..=1.0),
+        );
+    } else if brush.paint.is_some() {
         labelled_slider(
             ui,
             "Paint value",
@@ -152,17 +167,15 @@ impl ToolsPanel {
         if state.tool.drag == DragTool::Groom {
             brush_ui(ui, &mut state.tool.brush);
             if let Some(channel) = state.tool.brush.paint {
-                let painted = !state.document().root_maps.is_empty()
-                    && state
-                        .document()
-                        .root_maps
-                        .texels()
-                        .iter()
-                        .any(|t| t[channel.index()] != 255);
+                let painted = state.document().root_maps.is_painted(channel);
                 let label = format!("Clear {} map", channel.label().to_lowercase());
                 if ui
                     .add_enabled(painted, egui::Button::new(&label))
-                    .on_hover_text("Forget this painted map: 1 everywhere again")
+                    .on_hover_text(if channel == RootMapChannel::Colour {
+                        "Forget the painted colour: the material's everywhere again"
+                    } else {
+                        "Forget this painted map: 1 everywhere again"
+                    })
                     .clicked()
                 {
                     state.commit_edit();

@@ -52,7 +52,7 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Bring density, length and clump maps painted in another tool (grey images over the
+    /// Bring density, length, clump and colour maps painted in another tool (grey images over the
     /// scalp's uv layout) into a project, as one undo step.
     Maps(maps::MapsArgs),
     /// Create a project from a glTF/GLB scalp (every face becomes a bare bundle).

@@ -253,7 +253,12 @@ pub fn run(settings: &SimulateSettings) -> anyhow::Result<()> {
     }
     if settings.usda {
         let first = strand_frames.first().map_or(&[][..], |f| &f.strands[..]);
-        let look = StrandLook::new(first, STRAND_WIDTH_M, &document.scene.material);
+        let look = StrandLook::new(
+            first,
+            STRAND_WIDTH_M,
+            &document.scene.material,
+            &document.root_maps,
+        );
         let text = usda_animation(&strand_frames, &look, fps).map_err(anyhow::Error::msg)?;
         let path = settings.out.join("hair.usda");
         hairloom_core::io::project::write_atomic(&path, text.as_bytes(), |_| {})

@@ -320,9 +320,17 @@ pub fn prepare(
                 far_levels: plan.far_levels.clone(),
             }),
         ),
-        _ => renderers
-            .hair
-            .prepare(context, &hair_views, &ranges, &strands, &runs),
+        _ => renderers.hair.prepare(
+            context,
+            &hair_views,
+            &ranges,
+            &strands,
+            &runs,
+            match &inputs.hair {
+                HairSource::Generated { hair, .. } | HairSource::Skinned { hair, .. } => Some(hair),
+                _ => None,
+            },
+        ),
     };
     let body = renderers.body.prepare(context, &body_views);
     let far = match (&renderers.far_hair, &inputs.hair) {

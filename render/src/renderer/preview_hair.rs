@@ -89,8 +89,14 @@ struct HairPipelines {
     oit: Option<Tracked<wgpu::RenderPipeline>>,
 }
 
+/// Where the hair's passes bind the colour map at each root (`root_paint` in
+/// `shaders/preview_hair.wgsl`; [`GpuHair`]'s, or one 0 where strands have no runtime asset).
+pub const ROOT_PAINT_BINDING: u32 = 3;
+
 /// The ribbons' bindings and the lit pipelines of the current effects.
 pub struct HairRenderer {
+    /// One 0 (no colour): the per-root colours of strands with no runtime asset.
+    no_paint: wgpu::Buffer,
     /// Group 0 with the vertices in a buffer.
     draw_layout: wgpu::BindGroupLayout,
     /// Group 0 with strand_gen's resources, for ribbons that generate their vertices.
@@ -135,6 +141,7 @@ impl HairRenderer {
                     2,
                     size_of::<hairloom_core::runtime::gpu_types::StrandRun>() as u64,
                 ),
+                storage(ROOT_PAINT_BINDING, 4),
             ],
         });
         let mut generated_entries = vec![
@@ -143,6 +150,7 @@ impl HairRenderer {
                 2,
                 size_of::<hairloom_core::runtime::gpu_types::StrandRun>() as u64,
             ),
+            storage(ROOT_PAINT_BINDING, 4),
         ];
         generated_entries.extend(source_layout_entries(
             device,
@@ -183,7 +191,13 @@ impl HairRenderer {
             })
         });
         let alignment = device.limits().min_uniform_buffer_offset_alignment as u64;
+        let no_paint = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("root_paint_none"),
+            contents: bytemuck::bytes_of(&0u32),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         Self {
+            no_paint,
             draw_layout,
             generated_layout,
             mesh_layout,
@@ -375,7 +389,9 @@ impl HairRenderer {
     }
 
     /// The uniforms of every view in `views` for every batch of `batches`, and one bind
-    /// group over them, the strand vertices and the runs ([`RibbonInput::Buffer`]).
+    /// group over them, the strand vertices, the runs and the per-root colours of the hair
+    /// they were generated from (`None`: strands with no runtime asset, no colour map)
+    /// ([`RibbonInput::Buffer`]).
     pub fn prepare(
         &self,
         context: &GpuContext,
@@ -383,6 +399,7 @@ impl HairRenderer {
         batches: &[[u32; 2]],
         strands: &wgpu::Buffer,
         runs: &wgpu::Buffer,
+        hair: Option<&GpuHair>,
     ) -> PreparedHair {
         let (uniforms, batch_count) = self.uniforms(context, views, batches);
         let group = context
@@ -399,6 +416,12 @@ impl HairRenderer {
                     wgpu::BindGroupEntry {
                         binding: 2,
                         resource: runs.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: ROOT_PAINT_BINDING,
+                        resource: hair
+                            .map_or(&self.no_paint, |hair| &*hair.root_paint)
+                            .as_entire_binding(),
                     },
                 ],
             });
@@ -443,6 +466,10 @@ impl HairRenderer {
             wgpu::BindGroupEntry {
                 binding: 2,
                 resource: runs.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: ROOT_PAINT_BINDING,
+                resource: hair.root_paint.as_entire_binding(),
             },
         ];
         entries.extend(generator.source_entries(GENERATED_BINDING_OFFSET, hair, &params));

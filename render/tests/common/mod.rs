@@ -56,15 +56,35 @@ pub fn frames(
     eye_direction: glam::Vec3,
     paths: &[hairloom_render::renderer::strand_gen::GenerationPath],
 ) -> (Vec<Vec<u8>>, hairloom_core::runtime::frame_plan::FramePlan) {
+    frames_of(
+        context,
+        &sample(sample_name),
+        strands_per_bundle,
+        vertex_count,
+        lod,
+        eye_direction,
+        paths,
+    )
+}
+
+/// As [`frames`], of `document`.
+pub fn frames_of(
+    context: &hairloom_render::device::GpuContext,
+    document: &hairloom_core::model::document::Document,
+    strands_per_bundle: u32,
+    vertex_count: u32,
+    lod: hairloom_core::runtime::frame_plan::LodSettings,
+    eye_direction: glam::Vec3,
+    paths: &[hairloom_render::renderer::strand_gen::GenerationPath],
+) -> (Vec<Vec<u8>>, hairloom_core::runtime::frame_plan::FramePlan) {
     use hairloom_core::model::scene::{Coverage, SelfShadowing};
     use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
     use hairloom_core::runtime::strand_gen::Filtering;
     use hairloom_render::preview::{Camera, HairSource, PreviewRenderer, default_scene};
     use hairloom_render::renderer::preview_body::GpuBody;
     use hairloom_render::renderer::strand_gen::StrandGenRenderer;
-    let document = sample(sample_name);
     let runtime = RuntimeHair::from_document(
-        &document,
+        document,
         &RuntimeOptions {
             strands_per_bundle,
             ..RuntimeOptions::default()

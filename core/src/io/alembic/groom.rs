@@ -160,7 +160,12 @@ impl Groom {
             curves.group_id.push(group);
             curves.id.push(guide_count + i as i32);
         }
-        let look = StrandLook::new(strands, width_m, &document.scene.material);
+        let look = StrandLook::new(
+            strands,
+            width_m,
+            &document.scene.material,
+            &document.root_maps,
+        );
         (groom.strands.widths_m, groom.strands.colors) = (look.widths_m, look.colors);
         groom
     }

@@ -40,7 +40,12 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> std::path::PathBuf {
 #[test]
 fn our_exports_read_back_in_every_format() {
     let (document, strands) = strands();
-    let look = StrandLook::new(&strands, 8e-5, &document.scene.material);
+    let look = StrandLook::new(
+        &strands,
+        8e-5,
+        &document.scene.material,
+        &document.root_maps,
+    );
     let dir = tempfile::tempdir().expect("temp dir");
     let groom = Groom::new(&document, &strands, 8e-5);
     let files = [

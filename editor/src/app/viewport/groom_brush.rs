@@ -16,7 +16,7 @@ use hairloom_core::edit::paint_maps::{MapDab, RootMapRaster, paint_dab};
 use hairloom_core::edit::{BrushDab, apply_brush, pick::pick_bundle};
 use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::document::BodyMesh;
-use hairloom_core::model::root_maps::{DEFAULT_ROOT_MAP_SIDE, RootMaps};
+use hairloom_core::model::root_maps::{DEFAULT_ROOT_MAP_SIDE, RootMapChannel, RootMaps};
 use hairloom_core::simulate::BodySdf;
 
 use super::camera::Projector;
@@ -433,11 +433,19 @@ impl Viewport {
                     maps = RootMaps::blank(DEFAULT_ROOT_MAP_SIDE, DEFAULT_ROOT_MAP_SIDE)
                         .expect("the default side is within the limit");
                 }
+                // Ctrl paints the unpainted value back: 1, or no colour.
+                let value = match (channel, invert) {
+                    (RootMapChannel::Colour, true) => 0.0,
+                    (RootMapChannel::Colour, false) => brush.colour_weight,
+                    (_, true) => 1.0,
+                    (_, false) => brush.paint_value,
+                };
                 let dab = MapDab {
                     channel,
                     centre_m: centre.to_array(),
                     radius_m: brush.radius_m,
-                    value: if invert { 1.0 } else { brush.paint_value },
+                    value,
+                    colour_srgb: brush.paint_colour,
                     strength: brush.strength * pressure.unwrap_or(1.0),
                     view_direction: brush.front_only.then(|| projector.ray(point).1.to_array()),
                     mirror_x: brush.mirror_x,

@@ -30,6 +30,9 @@ pub struct GpuHair {
     pub(super) root_maps_view: wgpu::TextureView,
     /// The maps the texture holds (compared on a restyle, so a styling tick writes nothing).
     root_maps_shown: RootMaps,
+    /// The colour map at every root, packed ([`RuntimeHair::root_paint`]; one 0, no colour,
+    /// when none is painted): what the hair's colour pass reads per strand.
+    pub(crate) root_paint: Tracked<wgpu::Buffer>,
     pub(super) bundle_buffer: Tracked<wgpu::Buffer>,
     /// Each bundle's bounds and sizes for LOD, for the mesh path's task shaders.
     pub(super) bundle_lods: Tracked<wgpu::Buffer>,
@@ -57,6 +60,23 @@ fn root_map_texels(maps: &RootMaps) -> (u32, u32, Vec<u8>) {
     } else {
         (maps.width(), maps.height(), maps.rgba8())
     }
+}
+
+/// The per-root colours of `hair` in a storage buffer (one 0 when no colour is painted: a
+/// storage binding is never empty).
+fn upload_root_paint(context: &GpuContext, hair: &RuntimeHair) -> Tracked<wgpu::Buffer> {
+    let mut paint = hair.root_paint();
+    if paint.is_empty() {
+        paint.push(0);
+    }
+    context.resources.buffer_init(
+        &context.device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("root_paint"),
+            contents: bytemuck::cast_slice(&paint),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        },
+    )
 }
 
 fn upload_root_maps(
@@ -112,6 +132,7 @@ fn upload_texture(
         TexelFormat::Rg16Float => wgpu::TextureFormat::Rg16Float,
         TexelFormat::R16Float => wgpu::TextureFormat::R16Float,
         TexelFormat::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
+        TexelFormat::Rgba8Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
     };
     let bytes = hairloom_core::io::ktx2::texel_bytes(&texture.texels, export_format);
     let size = wgpu::Extent3d {
@@ -260,12 +281,29 @@ impl GpuHair {
 }
 
 impl StrandGenRenderer {
-    /// Takes the painted maps into `gpu`: written in place at the same size, a new texture
-    /// otherwise (bind groups are made per frame, so the next frame reads it).
-    pub fn update_root_maps(&self, context: &GpuContext, gpu: &mut GpuHair, maps: &RootMaps) {
+    /// Takes `hair`'s painted maps into `gpu`: written in place at the same size, a new
+    /// texture otherwise (bind groups are made per frame, so the next frame reads it); the
+    /// per-root colours are worked out again when the colour map changed.
+    pub fn update_root_maps(&self, context: &GpuContext, gpu: &mut GpuHair, hair: &RuntimeHair) {
+        let maps = &hair.textures.root_maps;
         // A styling tick leaves the maps alone: nothing to write.
         if gpu.root_maps_shown == *maps {
             return;
+        }
+        let shown = &gpu.root_maps_shown;
+        if shown.colour_texels() != maps.colour_texels()
+            || (shown.width(), shown.height()) != (maps.width(), maps.height())
+        {
+            let before = gpu.root_paint.size();
+            let paint = hair.root_paint();
+            if !paint.is_empty() && paint.len() as u64 * 4 == before {
+                context
+                    .queue
+                    .write_buffer(&gpu.root_paint, 0, bytemuck::cast_slice(&paint));
+            } else {
+                gpu.root_paint = upload_root_paint(context, hair);
+                gpu.bytes = gpu.bytes - before + gpu.root_paint.size();
+            }
         }
         let (width, height, bytes) = root_map_texels(maps);
         if (gpu.root_maps.width(), gpu.root_maps.height()) == (width, height) {
@@ -332,6 +370,7 @@ impl StrandGenRenderer {
         let styling = styling_or_default(styling_array(&hair.styling));
         let styling_bytes: &[u8] = bytemuck::cast_slice(&styling);
         let (root_maps, root_maps_view) = upload_root_maps(context, &textures.root_maps);
+        let root_paint = upload_root_paint(context, hair);
         let root_maps_bytes = 4 * u64::from(root_maps.width()) * u64::from(root_maps.height());
         let bundle_bytes: &[u8] = bytemuck::cast_slice(&bundles);
         let sample_bytes: &[u8] = bytemuck::cast_slice(&sample_data);
@@ -349,6 +388,16 @@ impl StrandGenRenderer {
             root_maps,
             root_maps_view,
             root_maps_shown: textures.root_maps.clone(),
+            bytes: a
+                + b
+                + c
+                + d
+                + e
+                + root_maps_bytes
+                + root_paint.size()
+                + (bundle_bytes.len() + lod_bytes.len() + sample_bytes.len() + styling_bytes.len())
+                    as u64,
+            root_paint,
             bundle_buffer: buffer("strand_gen_bundles", bundle_bytes),
             bundle_lods: buffer("strand_mesh_bundle_lods", lod_bytes),
             samples: buffer("strand_gen_samples", sample_bytes),
@@ -358,14 +407,6 @@ impl StrandGenRenderer {
             bundles: bounds,
             per_bundle: per_bundle as u32,
             layout: TextureLayout::of(hair, per_bundle as u32),
-            bytes: a
-                + b
-                + c
-                + d
-                + e
-                + root_maps_bytes
-                + (bundle_bytes.len() + lod_bytes.len() + sample_bytes.len() + styling_bytes.len())
-                    as u64,
         })
     }
 
@@ -414,7 +455,7 @@ impl StrandGenRenderer {
     /// styling buffer is replaced only when groups were added). What a styling-only edit
     /// costs; `hair` must be the asset `gpu` was uploaded from, restyled.
     pub fn update_styling(&self, context: &GpuContext, gpu: &mut GpuHair, hair: &RuntimeHair) {
-        self.update_root_maps(context, gpu, &hair.textures.root_maps);
+        self.update_root_maps(context, gpu, hair);
         // A group's per-area density target changes how many strands each bundle grows.
         let bounds = hair.bundle_bounds();
         if bounds.len() == gpu.bundles.len() && bounds != gpu.bundles {
