@@ -121,3 +121,68 @@ fn the_colour_map_reaches_every_ribbon_input() {
         );
     }
 }
+
+/// The per-root colours follow the roots' uv: a reshape that moves the uv layout (a Layout
+/// edit, or its undo) reads the colour map again at the new uvs; one that moves none (motion)
+/// leaves the buffer as it was.
+#[test]
+fn a_uv_layout_edit_reads_the_colour_map_again() {
+    use hairloom_core::model::root_maps::RootMaps;
+    use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
+    use hairloom_render::renderer::strand_gen::StrandGenRenderer;
+    let Some(context) = headless_for_test(module_path!()) else {
+        return;
+    };
+    let mut document = common::sample("head_short_straight");
+    // Colour over the left half of uv space only.
+    let mut maps = RootMaps::blank(8, 1).expect("maps");
+    for texel in &mut maps.colour_texels_mut()[..4] {
+        *texel = [200, 60, 20, 255];
+    }
+    document.root_maps = maps;
+    let mut runtime = RuntimeHair::from_document(
+        &document,
+        &RuntimeOptions {
+            strands_per_bundle: 4,
+            ..RuntimeOptions::default()
+        },
+    );
+    let generator = StrandGenRenderer::with_path(&context, GenerationPath::ComputePerStrand);
+    let mut hair = generator.upload(&context, &runtime).expect("upload");
+    let read = |hair: &hairloom_render::renderer::strand_gen::GpuHair| -> Vec<u32> {
+        let source = hair.root_paint();
+        let staging = context.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("root_paint_readback"),
+            size: source.size(),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = context
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        encoder.copy_buffer_to_buffer(source, 0, &staging, 0, source.size());
+        context.queue.submit([encoder.finish()]);
+        let bytes = hairloom_render::device::read_buffer(&context, &staging).expect("read");
+        bytemuck::cast_slice(&bytes).to_vec()
+    };
+    let before = runtime.root_paint();
+    assert_eq!(read(&hair), before);
+    let painted = before.iter().filter(|p| **p >> 24 > 0).count();
+    assert!(
+        painted > 0 && painted < before.len(),
+        "{painted} of {}",
+        before.len()
+    );
+    // Mirror the uv layout (u -> 1 - u): the other roots take the colour.
+    for texel in &mut runtime.textures.uv.texels {
+        texel.x = 1.0 - texel.x;
+    }
+    assert!(generator.update_shape(&context, &mut hair, &runtime));
+    let after = runtime.root_paint();
+    assert_ne!(after, before);
+    assert_eq!(
+        read(&hair),
+        after,
+        "the GPU reads the colours at the new uvs"
+    );
+}

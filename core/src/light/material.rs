@@ -117,7 +117,7 @@ impl Fibre {
     /// This fibre on a strand under the colour map's `paint`: the root colour blended toward
     /// the painted one by its weight (in colour, so half a weight looks half-way), and the
     /// absorption that shows it; the tip factor and per-strand variation then apply as
-    /// before. Mirror of `painted_sigma_a_root` in `shaders/shared/scene.wgsl`.
+    /// before. Mirror of `painted_strand_sigma_a` in `shaders/shared/scene.wgsl`.
     pub fn painted(&self, paint: &PaintedColour) -> Fibre {
         let weight = if paint.weight.is_nan() {
             0.0

@@ -429,27 +429,33 @@ impl RootMaps {
         }
     }
 
-    /// The colour map at `uv` (mirror of the renderers' per-root colour): bilinear between
-    /// texel centres as [`Self::sample`], of linear colour (each texel decoded from sRGB
-    /// first, as a GPU's sRGB texture does) and weight.
+    /// The colour map at `uv` (the renderers' per-root colour, [`crate::runtime::hair::
+    /// RuntimeHair::root_paint`]): bilinear between texel centres as [`Self::sample`], of
+    /// the weight and of the linear colour (each texel decoded from sRGB first, as a GPU's
+    /// sRGB texture does) weighted by each texel's weight — premultiplied, so the rim of a
+    /// stroke is its colour at less weight, never a blend with the colour of texels that
+    /// hold none.
     pub fn sample_colour(&self, uv: DVec2) -> PaintedColour {
         if self.colour.is_empty() {
             return PaintedColour::NONE;
         }
         let decoded = srgb_byte_table();
-        let at = |c: usize| {
+        let texel = |x: u32, y: u32| self.colour[(y * self.width + x) as usize];
+        let weight = bilinear(self.width, self.height, uv, |x, y| {
+            texel(x, y)[3] as f64 / 255.0
+        });
+        if weight <= 0.0 {
+            return PaintedColour::NONE;
+        }
+        let premultiplied = |c: usize| {
             bilinear(self.width, self.height, uv, |x, y| {
-                let byte = self.colour[(y * self.width + x) as usize][c];
-                if c < 3 {
-                    decoded[byte as usize]
-                } else {
-                    byte as f64 / 255.0
-                }
+                let t = texel(x, y);
+                decoded[t[c] as usize] * (t[3] as f64 / 255.0)
             })
         };
         PaintedColour {
-            rgb_linear: [at(0), at(1), at(2)],
-            weight: at(3),
+            rgb_linear: [0, 1, 2].map(|c| premultiplied(c) / weight),
+            weight,
         }
     }
 
@@ -477,6 +483,10 @@ impl RootMaps {
                     *byte = unit_to_byte(value);
                 }
             }
+        }
+        // A transparent image paints no colour: no colour map is left behind.
+        if !self.is_painted(RootMapChannel::Colour) {
+            self.clear_colour();
         }
         Ok(())
     }
@@ -707,11 +717,17 @@ mod tests {
         maps.colour_texels_mut()[0] = [255, 0, 0, 255];
         maps.colour_texels_mut()[1] = [0, 0, 0, 0];
         assert!(maps.is_painted(RootMapChannel::Colour));
-        // Half-way between the texel centres: the linear colours' and weights' mean (not the
-        // sRGB bytes' mean, which would be 0.214 linear).
+        // Half-way between red and no colour: red at half the weight (premultiplied: never
+        // a blend with the black a texel without colour holds).
+        let half = maps.sample_colour(DVec2::new(0.5, 0.5));
+        assert!((half.rgb_linear[0] - 1.0).abs() < 1e-12, "{half:?}");
+        assert!((half.weight - 0.5).abs() < 1e-12, "{half:?}");
+        // Half-way between two colours at full weight: their linear mean (not the sRGB
+        // bytes' mean, which would be 0.214 linear).
+        maps.colour_texels_mut()[1] = [0, 0, 0, 255];
         let half = maps.sample_colour(DVec2::new(0.5, 0.5));
         assert!((half.rgb_linear[0] - 0.5).abs() < 1e-12, "{half:?}");
-        assert!((half.weight - 0.5).abs() < 1e-12, "{half:?}");
+        maps.colour_texels_mut()[1] = [0, 0, 0, 0];
         // Packing keeps 8 bits of sRGB: within half a step.
         for colour in [
             PaintedColour {
@@ -782,5 +798,9 @@ mod tests {
             .set_channel_from_image(RootMapChannel::Colour, 1, 1, &[0.5])
             .expect_err("a colour map is not grey");
         assert_eq!(error, RootMapError::NotGrey);
+        // A transparent image leaves no colour map behind.
+        maps.set_colour_from_image(1, 1, &[[0.5, 0.5, 0.5, 0.0]])
+            .expect("test value");
+        assert!(maps.is_empty(), "nothing painted is left");
     }
 }

@@ -33,6 +33,9 @@ pub struct GpuHair {
     /// The colour map at every root, packed ([`RuntimeHair::root_paint`]; one 0, no colour,
     /// when none is painted): what the hair's colour pass reads per strand.
     pub(crate) root_paint: Tracked<wgpu::Buffer>,
+    /// The uv-texture the per-root colours were read at (a reshape that moves uvs — a
+    /// Layout edit — reads them again; motion, which moves none, does not).
+    root_uv_shown: Vec<glam::Vec4>,
     pub(super) bundle_buffer: Tracked<wgpu::Buffer>,
     /// Each bundle's bounds and sizes for LOD, for the mesh path's task shaders.
     pub(super) bundle_lods: Tracked<wgpu::Buffer>,
@@ -74,9 +77,26 @@ fn upload_root_paint(context: &GpuContext, hair: &RuntimeHair) -> Tracked<wgpu::
         &wgpu::util::BufferInitDescriptor {
             label: Some("root_paint"),
             contents: bytemuck::cast_slice(&paint),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
         },
     )
+}
+
+/// Works out `hair`'s per-root colours again into `gpu` (in place where the count is the same).
+fn refresh_root_paint(context: &GpuContext, gpu: &mut GpuHair, hair: &RuntimeHair) {
+    gpu.root_uv_shown.clone_from(&hair.textures.uv.texels);
+    let before = gpu.root_paint.size();
+    let paint = hair.root_paint();
+    if !paint.is_empty() && paint.len() as u64 * 4 == before {
+        context
+            .queue
+            .write_buffer(&gpu.root_paint, 0, bytemuck::cast_slice(&paint));
+    } else {
+        gpu.root_paint = upload_root_paint(context, hair);
+        gpu.bytes = gpu.bytes - before + gpu.root_paint.size();
+    }
 }
 
 fn upload_root_maps(
@@ -273,6 +293,12 @@ fn styling_or_default(styling: Vec<StylingGpu>) -> Vec<StylingGpu> {
 }
 
 impl GpuHair {
+    /// The colour map at every root, packed (one 0 when none is painted): what the colour
+    /// pass reads per strand.
+    pub fn root_paint(&self) -> &wgpu::Buffer {
+        &self.root_paint
+    }
+
     /// Each bundle's bounds and LOD sizes (block order): what the mesh path's task shaders
     /// cull and plan with.
     pub fn bundle_lods(&self) -> &wgpu::Buffer {
@@ -294,16 +320,7 @@ impl StrandGenRenderer {
         if shown.colour_texels() != maps.colour_texels()
             || (shown.width(), shown.height()) != (maps.width(), maps.height())
         {
-            let before = gpu.root_paint.size();
-            let paint = hair.root_paint();
-            if !paint.is_empty() && paint.len() as u64 * 4 == before {
-                context
-                    .queue
-                    .write_buffer(&gpu.root_paint, 0, bytemuck::cast_slice(&paint));
-            } else {
-                gpu.root_paint = upload_root_paint(context, hair);
-                gpu.bytes = gpu.bytes - before + gpu.root_paint.size();
-            }
+            refresh_root_paint(context, gpu, hair);
         }
         let (width, height, bytes) = root_map_texels(maps);
         if (gpu.root_maps.width(), gpu.root_maps.height()) == (width, height) {
@@ -398,6 +415,7 @@ impl StrandGenRenderer {
                 + (bundle_bytes.len() + lod_bytes.len() + sample_bytes.len() + styling_bytes.len())
                     as u64,
             root_paint,
+            root_uv_shown: textures.uv.texels.clone(),
             bundle_buffer: buffer("strand_gen_bundles", bundle_bytes),
             bundle_lods: buffer("strand_mesh_bundle_lods", lod_bytes),
             samples: buffer("strand_gen_samples", sample_bytes),
@@ -438,6 +456,10 @@ impl StrandGenRenderer {
             let format = TexelFormat::for_precision(precision, channels);
             let bytes = hairloom_core::io::ktx2::texel_bytes(&texture.texels, format);
             write_texels(context, gpu_texture, texture, &bytes, channels, format);
+        }
+        // A reshape may move the roots' uvs (a Layout edit): the colour map is read there.
+        if textures.root_maps.has_colour() && gpu.root_uv_shown != textures.uv.texels {
+            refresh_root_paint(context, gpu, hair);
         }
         gpu.position_offset = textures.position_offset.to_array();
         gpu.bundles = hair.bundle_bounds();
