@@ -115,8 +115,9 @@ run: toolchain gpu-deps
 
 # `cargo test --all-targets` builds examples as test harnesses, so the game example that
 # render/tests/game_window.rs opens in a window is built as a program first.
-# The mesh-shader tests, and the game runtime (whose default is mesh shaders where the
-# device has them), run again on Mesa 25's lavapipe, where the mesh tests must not skip.
+# The mesh-shader tests, the game runtime (whose default is mesh shaders where the device
+# has them) and the colour map on every ribbon input run again on Mesa 25's lavapipe, where
+# the mesh tests must not skip.
 test: toolchain deps mesh-deps blender-deps
 	$(CARGO) build -p hairloom-render --example game
 	if $(BPY_VENV)/bin/python -c 'import bpy' 2>/dev/null; then export HAIRLOOM_REQUIRE_BLENDER=1; fi; \
@@ -124,7 +125,8 @@ test: toolchain deps mesh-deps blender-deps
 	$(CARGO) test --workspace --doc
 	VK_ICD_FILENAMES=$(MESA_BACKPORT)/lvp_icd.json \
 	  LD_LIBRARY_PATH=$(MESA_BACKPORT)/root/usr/lib/x86_64-linux-gnu \
-	  HAIRLOOM_REQUIRE_MESH_SHADERS=1 $(CARGO) test -p hairloom-render --test strand_mesh --test game
+	  HAIRLOOM_REQUIRE_MESH_SHADERS=1 $(CARGO) test -p hairloom-render --test strand_mesh --test game \
+	    --test colour_map
 
 lint: toolchain
 	$(CARGO) fmt --all -- --check
