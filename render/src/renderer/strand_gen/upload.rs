@@ -317,11 +317,21 @@ impl StrandGenRenderer {
             return;
         }
         let shown = &gpu.root_maps_shown;
-        if shown.colour_texels() != maps.colour_texels()
-            || (shown.width(), shown.height()) != (maps.width(), maps.height())
-        {
+        let same_size = (shown.width(), shown.height()) == (maps.width(), maps.height());
+        let colour_changed = !same_size || shown.colour_texels() != maps.colour_texels();
+        // A colour stroke leaves the grey maps alone: their texture is not written again.
+        let grey_changed = !same_size || shown.texels() != maps.texels();
+        if colour_changed {
             refresh_root_paint(context, gpu, hair);
         }
+        if grey_changed {
+            self.write_grey_maps(context, gpu, maps);
+        }
+        gpu.root_maps_shown = maps.clone();
+    }
+
+    /// Writes the grey maps' texture of `gpu` (in place at the same size, a new one otherwise).
+    fn write_grey_maps(&self, context: &GpuContext, gpu: &mut GpuHair, maps: &RootMaps) {
         let (width, height, bytes) = root_map_texels(maps);
         if (gpu.root_maps.width(), gpu.root_maps.height()) == (width, height) {
             write_root_maps(context, &gpu.root_maps, width, height, &bytes);
@@ -332,7 +342,6 @@ impl StrandGenRenderer {
             gpu.root_maps = texture;
             gpu.root_maps_view = view;
         }
-        gpu.root_maps_shown = maps.clone();
     }
 
     /// Uploads a runtime asset: the five textures (f32 or f16 as built), every bundle's block
