@@ -1260,6 +1260,18 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
 }
 
 /// Presses Ctrl+Z `times` times.
+/// The label of the history's last undo step.
+fn last_step<'a>(harness: &'a Harness<'static, HairloomApp>) -> Option<&'a str> {
+    harness
+        .state()
+        .state
+        .project
+        .history
+        .undo
+        .last()
+        .map(|c| c.label())
+}
+
 fn undo(harness: &mut Harness<'static, HairloomApp>, times: usize) {
     for _ in 0..times {
         harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
@@ -1646,17 +1658,7 @@ fn scene_panel_switches_effects_and_edits_the_material_with_undo() {
     let changed = harness.state().state.document().clone();
     assert!(!changed.scene.effects.body_shadows);
     assert_eq!(changed.hair_mesh, original.hair_mesh);
-    assert_eq!(
-        harness
-            .state()
-            .state
-            .project
-            .history
-            .undo
-            .last()
-            .map(|c| c.label()),
-        Some("Scene: body shadows")
-    );
+    assert_eq!(last_step(&harness), Some("Scene: body shadows"));
     // Dual scattering (on with Marschner shading) switches off.
     harness.get_by_label("Dual scattering").click();
     harness.run();
@@ -1732,6 +1734,40 @@ fn scene_panel_switches_effects_and_edits_the_material_with_undo() {
     );
     // The costs are not measured without a GPU, and the panel says so.
     harness.get_by_label("costs not measured yet");
+}
+
+#[test]
+fn the_ombre_is_switched_and_shaped_in_the_material_with_undo() {
+    use hairloom_core::model::scene::Ombre;
+    let mut harness = harness();
+    harness.get_by_label("Scene").click();
+    harness.run();
+    let ombre = |h: &Harness<'static, HairloomApp>| h.state().state.document().scene.material.ombre;
+    assert_eq!(ombre(&harness), None, "the sample has none");
+    assert!(harness.query_by_label("Tip colour").is_none());
+    harness.get_by_label("Ombré").click();
+    harness.run();
+    assert_eq!(ombre(&harness), Some(Ombre::default()));
+    harness.get_by_label("Tip colour");
+    // Moving the start past the end takes the end along: the span stays ordered.
+    harness
+        .get_by_role_and_label(Role::Slider, "Ombré starts")
+        .set_value_accesskit(0.95);
+    harness.run();
+    let shaped = ombre(&harness).expect("on");
+    assert!((shaped.start - 0.95).abs() < 1e-6 && (shaped.end - 0.95).abs() < 1e-6);
+    harness
+        .get_by_role_and_label(Role::Slider, "Ombré ends")
+        .set_value_accesskit(0.2);
+    harness.run();
+    let shaped = ombre(&harness).expect("on");
+    assert!((shaped.start - 0.2).abs() < 1e-6 && (shaped.end - 0.2).abs() < 1e-6);
+    assert_eq!(last_step(&harness), Some("Scene: ombré ends"));
+    // One step each: undo twice is the default ombré, a third time none.
+    undo(&mut harness, 2);
+    assert_eq!(ombre(&harness), Some(Ombre::default()));
+    undo(&mut harness, 1);
+    assert_eq!(ombre(&harness), None);
 }
 
 #[test]
@@ -2235,18 +2271,7 @@ fn the_styling_direction_gizmo_points_the_wave_twists_and_mirrors_the_curl() {
         "the drawn arrow points {angle} rad off the pointer"
     );
     assert_eq!(harness.state().state.project.history.undo.len(), steps + 1);
-    assert_eq!(
-        harness
-            .state()
-            .state
-            .project
-            .history
-            .undo
-            .last()
-            .expect("step")
-            .label(),
-        "Wave direction"
-    );
+    assert_eq!(last_step(&harness), Some("Wave direction"));
 
     // Twist: drag the ring's handle; the bundle twists, one step.
     let now = harness.state().viewport.styling_handles.expect("handles");

@@ -239,6 +239,10 @@ fn project_seeds() -> Vec<(String, Vec<u8>)> {
     scene["document"]["scene"]["lights"][0]["source"]["directional"]["to_light"] = json!([0, 0, 0]);
     scene["document"]["scene"]["effects"]["shadow_resolution"] = json!(4_294_967_295u64);
     scene["document"]["scene"]["material"]["longitudinal_roughness"] = json!(1e39);
+    // An ombré that ends before it starts, with tip colours out of range.
+    let mut ombre: Value = serde_json::from_slice(&valid).expect("json");
+    ombre["document"]["scene"]["material"]["ombre"] =
+        json!({"tip_rgb": [1e39, -1.0, 0.5], "start": 0.9, "end": 0.1});
     // Painted maps claiming 4096² texels with 8 bytes of them.
     let mut maps: Value = serde_json::from_slice(&valid).expect("json");
     maps["document"]["root_maps"] =
@@ -256,6 +260,10 @@ fn project_seeds() -> Vec<(String, Vec<u8>)> {
         (
             "crafted_scene_zero_light_huge_shadow_map.hairloom".into(),
             serde_json::to_vec(&scene).expect("json"),
+        ),
+        (
+            "crafted_scene_ombre_reversed.hairloom".into(),
+            serde_json::to_vec(&ombre).expect("json"),
         ),
         (
             "crafted_root_maps_4096_short.hairloom".into(),

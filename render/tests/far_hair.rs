@@ -142,6 +142,34 @@ fn a_far_head_draws_thick_hairs_that_keep_the_strands_look() {
          {strand_count}; mean sRGB {far_mean:.1?} vs {strand_mean:.1?}",
         far_plan.far_bundles, far_plan.strands, strand_plan.strands
     );
+    // An ombré to blue over the whole strand turns far hair blue, within the look's bounds of
+    // the strands' (far hair takes it in its ambient term; its aggregated lobes keep the
+    // material's own colour, its tables being per material).
+    let blue = |scene: &Scene| {
+        let mut scene = scene.clone();
+        scene.material.ombre = Some(hairloom_core::model::scene::Ombre {
+            tip_rgb: [0.05, 0.12, 0.5],
+            start: 0.0,
+            end: 0.05,
+        });
+        scene
+    };
+    let (blue_strands, ..) = draw(&blue(&strands_scene));
+    let (blue_far, blue_plan, ..) = draw(&blue(&far_scene));
+    assert!(blue_plan.far_bundles * 2 > bundles);
+    let (_, strand_blue) = hair_pixels(&blue_strands, background);
+    let (_, far_blue) = hair_pixels(&blue_far, background);
+    eprintln!("blue ends: mean sRGB far {far_blue:.1?}, strands {strand_blue:.1?}");
+    assert!(
+        strand_blue[2] > strand_blue[0] && far_blue[2] > far_blue[0],
+        "blue ends: strands {strand_blue:?}, far {far_blue:?}"
+    );
+    for c in 0..3 {
+        assert!(
+            (far_blue[c] - strand_blue[c]).abs() < 40.0,
+            "blue ends: strands {strand_blue:?}, far {far_blue:?}"
+        );
+    }
 }
 
 #[test]

@@ -43,6 +43,10 @@ struct SceneUniforms {
     body_color: vec4<f32>,
     // x: Gauss-Legendre offsets averaged across thin fibres (1 to 3).
     quality: vec4<u32>,
+    // The ombré: rgb the tip colour (linear), w 1 when the material has one.
+    ombre_tip: vec4<f32>,
+    // x: where the ombré starts, y: where it ends (fractions along the strand).
+    ombre_span: vec4<f32>,
 }
 
 @group(1) @binding(0) var<uniform> scene: SceneUniforms;
@@ -100,18 +104,48 @@ fn strand_sigma_a(along: f32, xi: f32) -> vec3<f32> {
     return painted_strand_sigma_a(along, xi, vec4<f32>(0.0));
 }
 
+// The absorption that shows colour `rgb` on a thick mass of hair (Chiang et al. 2016 eq. 9;
+// mirror: core/src/light/material.rs `sigma_a_from_color`).
+fn sigma_a_from_color(rgb: vec3<f32>) -> vec3<f32> {
+    let l = log(clamp(rgb, vec3<f32>(1e-4), vec3<f32>(0.9999))) / color_polynomial();
+    return l * l;
+}
+
+// How far the ombré has turned the colour toward the tip's at fraction `t` of the strand: 0
+// up to its start, 1 from its end, a smoothstep between (a step when the span is empty).
+// Mirror: `FibreOmbre::share`.
+fn ombre_share(t: f32) -> f32 {
+    let start = scene.ombre_span.x;
+    let span = scene.ombre_span.y - start;
+    if span <= 1e-6 {
+        return select(0.0, 1.0, t >= start);
+    }
+    let x = clamp((t - start) / span, 0.0, 1.0);
+    return x * x * (3.0 - 2.0 * x);
+}
+
 // As `strand_sigma_a`, on a strand under the colour map's `paint` (linear rgb, weight): the
-// root's colour blended toward the painted one by its weight, and the absorption that shows
-// it (mirror: `Fibre::painted`, then `Fibre::sigma_a`).
+// root's colour blended toward the painted one by its weight, then along the strand toward
+// the ombré's tip colour, and the absorption that shows it (mirror: `Fibre::painted`, then
+// `Fibre::sigma_a`).
 fn painted_strand_sigma_a(along: f32, xi: f32, paint: vec4<f32>) -> vec3<f32> {
     var root = scene.sigma_a.rgb;
-    let weight = clamp(paint.a, 0.0, 1.0);
-    if weight > 0.0 {
-        let rgb = mix(hair_color(root), paint.rgb, weight);
-        let l = log(clamp(rgb, vec3<f32>(1e-4), vec3<f32>(0.9999))) / color_polynomial();
-        root = l * l;
-    }
     let t = clamp(along, 0.0, 1.0);
+    let weight = clamp(paint.a, 0.0, 1.0);
+    var share = 0.0;
+    if scene.ombre_tip.w > 0.0 {
+        share = ombre_share(t);
+    }
+    if weight > 0.0 || share > 0.0 {
+        var rgb = hair_color(root);
+        if weight > 0.0 {
+            rgb = mix(rgb, paint.rgb, weight);
+            root = sigma_a_from_color(rgb);
+        }
+        if share > 0.0 {
+            root = sigma_a_from_color(mix(rgb, scene.ombre_tip.rgb, share));
+        }
+    }
     let scale = (1.0 + (scene.sigma_a.w - 1.0) * t) * (1.0 + scene.fibre.x * (2.0 * xi - 1.0));
     return root * max(scale, 0.0);
 }

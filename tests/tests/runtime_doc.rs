@@ -2,7 +2,7 @@
 //! `Scene::default()` field for field, and every numeric range in its table of valid scene
 //! values is the one validation enforces (the bound itself loads, just past it is refused).
 
-use hairloom_core::model::scene::Scene;
+use hairloom_core::model::scene::{HairMaterial, Ombre, Scene};
 use serde_json::Value;
 
 fn document() -> String {
@@ -80,7 +80,19 @@ fn documented_ranges(text: &str) -> Vec<(String, f64, f64)> {
 fn the_documented_scene_ranges_are_the_ones_validation_enforces() {
     let ranges = documented_ranges(&document());
     assert!(ranges.len() >= 8, "{ranges:?}");
-    let default = serde_json::to_value(Scene::default()).expect("serialises");
+    // With an ombré spanning the whole strand, so that its fields are there to be set.
+    let default = serde_json::to_value(Scene {
+        material: HairMaterial {
+            ombre: Some(Ombre {
+                start: 0.0,
+                end: 1.0,
+                ..Ombre::default()
+            }),
+            ..HairMaterial::default()
+        },
+        ..Scene::default()
+    })
+    .expect("serialises");
     let loads = |pointer: &str, value: f64| -> bool {
         let mut scene = default.clone();
         let slot = scene

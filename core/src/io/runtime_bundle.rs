@@ -31,7 +31,7 @@ use crate::runtime::textures::{Precision, RuntimeTextures, SLICES_PER_SEGMENT, T
 /// segment (`p_k, q0, q1`); version 1 stored the quadratics' joint `m` too (4 slices). All
 /// are read (version 1's `m` slices are dropped on load: `m` is exactly `(q0 + q1) / 2`;
 /// bundles before version 3 have no far hair).
-pub const RUNTIME_FORMAT_VERSION: u32 = 9;
+pub const RUNTIME_FORMAT_VERSION: u32 = 10;
 /// Hair-mesh slices per segment in format version 1 bundles.
 const VERSION_1_SLICES_PER_SEGMENT: u32 = 4;
 
@@ -1482,7 +1482,9 @@ mod tests {
         use crate::runtime::strand_gen::{Filtering, StrandGen};
         let mut mesh = grid(3, 2, 2, 0.5);
         crate::geometry::interior::place_interior(&mut mesh, None);
-        let document = Document::new("grid", mesh);
+        let mut document = Document::new("grid", mesh);
+        // A material with an ombré (format version 10), which the scene carries.
+        document.scene.material.ombre = Some(crate::model::scene::Ombre::default());
         let temp = tempfile::tempdir().expect("temp dir");
         let dir = temp.path().join("bundle");
         for precision in [Precision::F32, Precision::F16] {
@@ -1809,7 +1811,7 @@ mod tests {
                         .expect("a bundle")
                         .remove("columns");
                 }),
-                "bundles[0] has no columns (format_version 9 needs them)",
+                "bundles[0] has no columns (format_version",
             ),
             (
                 Box::new(|m| {

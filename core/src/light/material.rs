@@ -9,7 +9,7 @@
 //!   and its exact inverse `c = exp(−√σ_a · P(β_n))`.
 
 use crate::model::root_maps::{PaintedColour, RootMaps};
-use crate::model::scene::{HairMaterial, Pigment};
+use crate::model::scene::{HairMaterial, Ombre, Pigment};
 
 /// Eumelanin absorption per unit concentration (per unit fibre radius).
 pub const EUMELANIN_SIGMA_A: [f64; 3] = [0.419, 0.697, 1.37];
@@ -61,6 +61,47 @@ pub struct Fibre {
     pub beta_n: f64,
     pub alpha_rad: f64,
     pub eta: f64,
+    /// The colour along the strand, when the material has an ombré.
+    pub ombre: Option<FibreOmbre>,
+}
+
+/// [`Ombre`] in the numbers shading uses: its tip colour clamped into the colour fit's range,
+/// and its span ordered.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FibreOmbre {
+    pub tip_rgb: [f64; 3],
+    pub start: f64,
+    pub end: f64,
+}
+
+impl FibreOmbre {
+    pub fn new(ombre: &Ombre) -> Self {
+        let unit = |v: f32| {
+            if v.is_finite() {
+                (v as f64).clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        };
+        let start = unit(ombre.start);
+        Self {
+            tip_rgb: ombre.tip_rgb.map(|c| unit(c).clamp(MIN_COLOR, MAX_COLOR)),
+            start,
+            end: unit(ombre.end).max(start),
+        }
+    }
+
+    /// How far the colour has turned toward the tip's at fraction `along` of the strand: 0
+    /// up to `start`, 1 from `end`, a smoothstep between (a step at `start` when the span is
+    /// empty). Mirror of `ombre_share` in `shaders/shared/scene.wgsl`.
+    pub fn share(&self, along: f64) -> f64 {
+        let span = self.end - self.start;
+        if span <= 1e-6 {
+            return if along >= self.start { 1.0 } else { 0.0 };
+        }
+        let x = ((along - self.start) / span).clamp(0.0, 1.0);
+        x * x * (3.0 - 2.0 * x)
+    }
 }
 
 /// Roughness below this is raised to it: the longitudinal lobe's variance goes as β², and
@@ -91,22 +132,49 @@ impl Fibre {
             beta_n,
             alpha_rad: (material.cuticle_tilt_deg as f64).to_radians(),
             eta: (material.ior as f64).max(MIN_IOR),
+            ombre: material.ombre.as_ref().map(FibreOmbre::new),
         }
     }
 
     /// Absorption at fraction `along` of a strand (0 root, 1 tip) for a strand whose random
-    /// value is `xi` in `[0, 1)`: `σ_a,root · lerp(1, tip, along) · (1 + variation (2ξ − 1))`.
+    /// value is `xi` in `[0, 1)`: `σ_a,along · lerp(1, tip, along) · (1 + variation (2ξ − 1))`,
+    /// where `σ_a,along` is the root's absorption, or under an ombré the absorption that shows
+    /// the root's colour blended toward the tip colour by [`FibreOmbre::share`].
     pub fn sigma_a(&self, along: f64, xi: f64) -> [f64; 3] {
-        let along = along.clamp(0.0, 1.0);
+        let along = if along.is_nan() {
+            0.0
+        } else {
+            along.clamp(0.0, 1.0)
+        };
         let scale = (1.0 + (self.tip_absorption_factor - 1.0) * along)
             * (1.0 + self.strand_absorption_variation * (2.0 * xi - 1.0));
-        self.sigma_a_root.map(|s| s * scale.max(0.0))
+        self.sigma_a_along(along).map(|s| s * scale.max(0.0))
     }
 
-    /// The absorption of an average strand at mid-length: what precomputed tables (dual
-    /// scattering, forward transmittance) are made from.
+    /// The absorption before the tip factor and variation at fraction `along`: the root's,
+    /// turned toward the ombré's tip colour where the material has one.
+    fn sigma_a_along(&self, along: f64) -> [f64; 3] {
+        let Some(ombre) = &self.ombre else {
+            return self.sigma_a_root;
+        };
+        let share = ombre.share(along);
+        if share <= 0.0 {
+            return self.sigma_a_root;
+        }
+        let own = self.color(self.sigma_a_root);
+        let rgb: [f64; 3] = std::array::from_fn(|c| own[c] + (ombre.tip_rgb[c] - own[c]) * share);
+        sigma_a_from_color(rgb, self.beta_n)
+    }
+
+    /// The absorption of an average strand at mid-length, in the material's own colour (no
+    /// ombré, as no colour map): what precomputed tables (dual scattering, forward
+    /// transmittance, far hair's aggregated BCSDF, Kajiya-Kay's weights) are made from.
     pub fn sigma_a_mean(&self) -> [f64; 3] {
-        self.sigma_a(0.5, 0.5)
+        Fibre {
+            ombre: None,
+            ..*self
+        }
+        .sigma_a(0.5, 0.5)
     }
 
     /// The colour a thick mass of this hair shows at `sigma_a`.
@@ -176,6 +244,141 @@ pub const SHADING_SALT: u32 = 0x5A3D_1E77;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A material with only the ombré shaping the colour along the strand.
+    fn ombre_material(tip_rgb: [f32; 3], start: f32, end: f32) -> HairMaterial {
+        HairMaterial {
+            tip_absorption_factor: 1.0,
+            strand_absorption_variation: 0.0,
+            ombre: Some(Ombre {
+                tip_rgb,
+                start,
+                end,
+            }),
+            ..HairMaterial::default()
+        }
+    }
+
+    #[test]
+    fn an_ombre_turns_the_colour_from_the_root_to_the_tip() {
+        let tip = [0.6, 0.4, 0.2];
+        let fibre = Fibre::new(&ombre_material(tip, 0.3, 0.8));
+        let own = fibre.color(fibre.sigma_a_root);
+        let colour_at = |along: f64| fibre.color(fibre.sigma_a(along, 0.5));
+        for along in [0.0, 0.1, 0.3] {
+            assert_eq!(colour_at(along), own, "the root's colour up to the start");
+        }
+        for along in [0.8, 0.9, 1.0] {
+            let rgb = colour_at(along);
+            for c in 0..3 {
+                assert!(
+                    (rgb[c] - tip[c] as f64).abs() < 1e-6,
+                    "the tip colour from the end: {along} {rgb:?}"
+                );
+            }
+        }
+        // Half-way through the span the colour is half-way (the blend is in colour).
+        let mid = colour_at(0.55);
+        for c in 0..3 {
+            let half = 0.5 * (own[c] + tip[c] as f64);
+            assert!((mid[c] - half).abs() < 1e-6, "{mid:?} against {half}");
+        }
+        // It turns monotonically in between, channel by channel.
+        let mut last = own;
+        for k in 0..=100 {
+            let rgb = colour_at(k as f64 / 100.0);
+            for c in 0..3 {
+                let toward = (tip[c] as f64 - own[c]).signum();
+                assert!(
+                    (rgb[c] - last[c]) * toward >= -1e-12,
+                    "step {k} channel {c}"
+                );
+            }
+            last = rgb;
+        }
+    }
+
+    #[test]
+    fn an_ombre_to_the_hairs_own_colour_changes_nothing() {
+        let plain = Fibre::new(&HairMaterial::default());
+        let own = plain.color(plain.sigma_a_root).map(|c| c as f32);
+        let material = HairMaterial {
+            ombre: Some(Ombre {
+                tip_rgb: own,
+                start: 0.0,
+                end: 1.0,
+            }),
+            ..HairMaterial::default()
+        };
+        let fibre = Fibre::new(&material);
+        for k in 0..=20 {
+            let along = k as f64 / 20.0;
+            for xi in [0.0, 0.37, 0.99] {
+                let (a, b) = (plain.sigma_a(along, xi), fibre.sigma_a(along, xi));
+                for c in 0..3 {
+                    assert!((a[c] - b[c]).abs() <= 1e-5 * a[c].max(1e-3), "{a:?} {b:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn precomputed_tables_take_the_materials_own_colour_under_an_ombre() {
+        let plain = Fibre::new(&HairMaterial::default());
+        let fibre = Fibre::new(&HairMaterial {
+            ombre: Some(Ombre {
+                start: 0.0,
+                ..Ombre::default()
+            }),
+            ..HairMaterial::default()
+        });
+        assert_eq!(fibre.sigma_a_mean(), plain.sigma_a_mean());
+        assert_ne!(fibre.sigma_a(0.5, 0.5), plain.sigma_a(0.5, 0.5));
+    }
+
+    #[test]
+    fn a_dip_dye_line_is_a_step_and_degenerate_input_stays_finite() {
+        // start = end: a hard line, the root's colour before it and the tip's from it.
+        let fibre = Fibre::new(&ombre_material([0.9, 0.1, 0.5], 0.5, 0.5));
+        let own = fibre.color(fibre.sigma_a_root);
+        assert_eq!(fibre.color(fibre.sigma_a(0.4999, 0.5)), own);
+        let dyed = fibre.color(fibre.sigma_a(0.5, 0.5));
+        assert!((dyed[0] - 0.9).abs() < 1e-6 && (dyed[1] - 0.1).abs() < 1e-6);
+        // Black and white ends are clamped into the colour fit's range; NaN positions along
+        // the strand and out-of-order spans (which validation refuses) give finite absorption.
+        for (tip, start, end) in [
+            ([0.0, 0.0, 0.0], 0.0, 1.0),
+            ([1.0, 1.0, 1.0], 0.2, 0.4),
+            ([0.5, 0.5, 0.5], 0.8, 0.2),
+            ([f32::NAN, 0.5, 0.5], f32::NAN, f32::INFINITY),
+        ] {
+            let fibre = Fibre::new(&ombre_material(tip, start, end));
+            for along in [f64::NAN, -1.0, 0.0, 0.5, 1.0, 2.0] {
+                let sigma_a = fibre.sigma_a(along, 0.5);
+                assert!(
+                    sigma_a.iter().all(|s| s.is_finite() && *s >= 0.0),
+                    "{tip:?} {start} {end} at {along}: {sigma_a:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_painted_strand_turns_from_its_painted_colour_to_the_ombres() {
+        let tip = [0.7, 0.5, 0.3];
+        let fibre = Fibre::new(&ombre_material(tip, 0.5, 1.0));
+        let paint = PaintedColour {
+            rgb_linear: [0.05, 0.2, 0.4],
+            weight: 1.0,
+        };
+        let painted = fibre.painted(&paint);
+        let root = painted.color(painted.sigma_a(0.0, 0.5));
+        let end = painted.color(painted.sigma_a(1.0, 0.5));
+        for c in 0..3 {
+            assert!((root[c] - paint.rgb_linear[c]).abs() < 1e-6, "{root:?}");
+            assert!((end[c] - tip[c] as f64).abs() < 1e-6, "{end:?}");
+        }
+    }
 
     #[test]
     fn colour_and_absorption_round_trip() {
@@ -307,5 +510,30 @@ mod tests {
         }
         assert_eq!(colours[2..], plain[2..], "unpainted on the right");
         assert_ne!(colours[..2], plain[..2]);
+        // Under an ombré the tips take its colour and the roots keep theirs.
+        let tip = [0.6, 0.45, 0.3];
+        let dyed = HairMaterial {
+            tip_absorption_factor: 1.0,
+            ombre: Some(Ombre {
+                tip_rgb: tip,
+                start: 0.5,
+                end: 1.0,
+            }),
+            ..material.clone()
+        };
+        let plain_untipped = strand_point_colors(
+            &HairMaterial {
+                tip_absorption_factor: 1.0,
+                ..material.clone()
+            },
+            &RootMaps::default(),
+            &strands,
+            &[7, 7],
+        );
+        let ombre = strand_point_colors(&dyed, &RootMaps::default(), &strands, &[7, 7]);
+        assert_eq!(ombre[0], plain_untipped[0], "the root keeps its colour");
+        for c in 0..3 {
+            assert!((ombre[1][c] - tip[c]).abs() < 1e-5, "{ombre:?}");
+        }
     }
 }

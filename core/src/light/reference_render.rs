@@ -25,6 +25,7 @@ use crate::light::hair_bsdf::HairBsdf;
 use crate::light::material::{Fibre, strand_shading_random};
 use crate::light::{linear_to_srgb, tonemap};
 use crate::model::document::BodyMesh;
+use crate::model::root_maps::PaintedColour;
 use crate::model::scene::Scene;
 use crate::strands::random::SplitMix64;
 
@@ -45,10 +46,18 @@ pub struct FibreStrand {
     /// The strand's root index (bundle × roots per bundle + sample), for its random
     /// absorption variation.
     pub root: u32,
+    /// The colour map at the strand's root (none: the material's colour), as the GPU's
+    /// per-root colours hold it.
+    pub paint: PaintedColour,
 }
 
 impl Fibres {
     pub fn push(&mut self, points: &[DVec3], root: u32) {
+        self.push_painted(points, root, PaintedColour::NONE);
+    }
+
+    /// A strand whose root lies under the colour map's `paint`.
+    pub fn push_painted(&mut self, points: &[DVec3], root: u32, paint: PaintedColour) {
         if points.len() < 2 {
             return;
         }
@@ -56,6 +65,7 @@ impl Fibres {
             first: self.points.len() as u32,
             count: points.len() as u32,
             root,
+            paint,
         });
         self.points.extend_from_slice(points);
     }
@@ -325,8 +335,13 @@ impl<'a> World<'a> {
                     let h = ((point - axis_point).dot(y) / radius).clamp(-1.0, 1.0);
                     let fraction =
                         along[0] + (along[1] - along[0]) * (hit.s / length).clamp(0.0, 1.0);
-                    let root = self.fibres.strands[*strand as usize].root;
-                    let sigma_a = self.fibre.sigma_a(fraction, strand_shading_random(root));
+                    let strand = &self.fibres.strands[*strand as usize];
+                    // The material under the colour map at the root, as every GPU path
+                    // shades it (the ombré along the strand is in `sigma_a`).
+                    let sigma_a = self
+                        .fibre
+                        .painted(&strand.paint)
+                        .sigma_a(fraction, strand_shading_random(strand.root));
                     let wo_local = frame * wo;
                     // Direct light from every light, with exact shadows.
                     for light in &scene.lights {
@@ -734,6 +749,69 @@ mod tests {
         let values: Vec<u8> = one.pixels.chunks(4).map(|p| p[0]).collect();
         assert!(values.iter().any(|&v| v > 40), "lit fibres");
         assert!(one.pixels[centre + 3] == 255);
+    }
+
+    /// Mean (r, g, b) over the picture's lit pixels.
+    fn mean_lit_colour(pixels: &[u8]) -> [f64; 3] {
+        let lit: Vec<&[u8]> = pixels
+            .chunks(4)
+            .filter(|p| p[0] as u32 + p[1] as u32 + p[2] as u32 > 30)
+            .collect();
+        assert!(!lit.is_empty(), "nothing lit");
+        std::array::from_fn(|c| lit.iter().map(|p| p[c] as f64).sum::<f64>() / lit.len() as f64)
+    }
+
+    #[test]
+    fn painted_strands_and_an_ombre_take_their_colour_as_the_gpu_does() {
+        let settings = ReferenceSettings {
+            samples_per_pixel: 4,
+            max_bounces: 4,
+            ..ReferenceSettings::default()
+        };
+        let render = |fibres: &Fibres, material: HairMaterial| {
+            render_reference(
+                fibres,
+                &BodyMesh::default(),
+                &one_light_scene(material),
+                &camera(24),
+                &settings,
+            )
+            .pixels
+        };
+        let plain = curtain(24, 0.05, 0.02);
+        let brown = mean_lit_colour(&render(&plain, HairMaterial::default()));
+        assert!(brown[0] > brown[2], "brown hair: {brown:?}");
+        // The colour map's green at the roots turns every strand green.
+        let mut green = Fibres {
+            width_m: plain.width_m,
+            ..Fibres::default()
+        };
+        for strand in &plain.strands {
+            let points = &plain.points[strand.first as usize..][..strand.count as usize];
+            let paint = PaintedColour {
+                rgb_linear: [0.05, 0.4, 0.08],
+                weight: 1.0,
+            };
+            green.push_painted(points, strand.root, paint);
+        }
+        let painted = mean_lit_colour(&render(&green, HairMaterial::default()));
+        assert!(
+            painted[1] > painted[0] && painted[1] > painted[2],
+            "{painted:?}"
+        );
+        // An ombré to blue over the whole strand turns it blue.
+        let blue = mean_lit_colour(&render(
+            &plain,
+            HairMaterial {
+                ombre: Some(crate::model::scene::Ombre {
+                    tip_rgb: [0.05, 0.1, 0.5],
+                    start: 0.0,
+                    end: 0.2,
+                }),
+                ..HairMaterial::default()
+            },
+        ));
+        assert!(blue[2] > blue[0], "{blue:?}");
     }
 
     #[test]

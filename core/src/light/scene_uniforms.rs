@@ -72,6 +72,11 @@ pub struct SceneUniforms {
     pub body_color: [f32; 4],
     /// x: Gauss-Legendre offsets across thin fibres (1 to 3); y, z, w: 0.
     pub quality: [u32; 4],
+    /// The ombré ([`crate::model::scene::Ombre`]): rgb the tip colour (linear), w 1 when
+    /// the material has one (0: none, the rest unused).
+    pub ombre_tip: [f32; 4],
+    /// x: where the ombré starts, y: where it ends (fractions along the strand); z, w: 0.
+    pub ombre_span: [f32; 4],
 }
 
 /// Deep opacity maps' default depth (the layers' span behind the first hair) as a fraction of
@@ -198,6 +203,10 @@ impl SceneUniforms {
         }
         uniforms.body_color = rgb(scene.body_color, 0.0);
         uniforms.quality = [effects.fibre_offsets.clamp(1, 3), 0, 0, 0];
+        if let Some(ombre) = &fibre.ombre {
+            uniforms.ombre_tip = rgb(ombre.tip_rgb.map(|c| c as f32), 1.0);
+            uniforms.ombre_span = [ombre.start as f32, ombre.end as f32, 0.0, 0.0];
+        }
         uniforms
     }
 

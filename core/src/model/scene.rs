@@ -123,6 +123,37 @@ pub struct HairMaterial {
     pub tip_absorption_factor: f32,
     /// Per-strand random spread of the absorption, in `[0, 1]` (0: every strand alike).
     pub strand_absorption_variation: f32,
+    /// Colour along the strand (an ombré, a dip-dye, lightened ends): none keeps the root's
+    /// colour to the tip. Files from before it have none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ombre: Option<Ombre>,
+}
+
+/// An ombré: along every strand the hair turns from its own colour (the material's, or the
+/// colour map's at its root) to `tip_rgb`, smoothly from `start` to `end` (fractions of the
+/// strand's length, root 0, tip 1). The blend is in colour, so half-way looks half-way; the
+/// absorption that shows it follows (Chiang et al. 2016, eq. 9), and the tip factor and the
+/// per-strand variation still apply on top.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ombre {
+    /// The colour a thick mass of the ends shows (linear, each channel in `[0, 1]`).
+    pub tip_rgb: [f32; 3],
+    /// Where along the strand the colour starts to turn, in `[0, 1]`.
+    pub start: f32,
+    /// Where it has turned fully, in `[start, 1]` (equal to `start`: a hard dip-dye line).
+    pub end: f32,
+}
+
+impl Default for Ombre {
+    fn default() -> Self {
+        // Lightened ends: a honey blond over the lower half.
+        Self {
+            tip_rgb: [0.55, 0.38, 0.2],
+            start: 0.4,
+            end: 0.9,
+        }
+    }
 }
 
 impl Default for HairMaterial {
@@ -139,6 +170,7 @@ impl Default for HairMaterial {
             ior: 1.55,
             tip_absorption_factor: 0.7,
             strand_absorption_variation: 0.2,
+            ombre: None,
         }
     }
 }
@@ -665,7 +697,18 @@ impl HairMaterial {
             self.strand_absorption_variation,
             0.0,
             1.0,
-        )
+        )?;
+        if let Some(ombre) = &self.ombre {
+            check_color(&at("ombre.tip_rgb"), ombre.tip_rgb, 1.0)?;
+            check_range(&at("ombre.start"), ombre.start, 0.0, 1.0)?;
+            check_range(
+                &at("ombre.end"),
+                ombre.end,
+                ombre.start.clamp(0.0, 1.0),
+                1.0,
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -935,6 +978,34 @@ mod tests {
             (
                 Box::new(|s| s.effects.fur_shells.strands_above_px = 1.0),
                 "effects.fur_shells.strands_above_px",
+            ),
+            (
+                Box::new(|s| {
+                    s.material.ombre = Some(Ombre {
+                        tip_rgb: [0.5, f32::NAN, 0.2],
+                        ..Ombre::default()
+                    })
+                }),
+                "material.ombre.tip_rgb[1]",
+            ),
+            (
+                Box::new(|s| {
+                    s.material.ombre = Some(Ombre {
+                        start: -0.1,
+                        ..Ombre::default()
+                    })
+                }),
+                "material.ombre.start",
+            ),
+            (
+                Box::new(|s| {
+                    s.material.ombre = Some(Ombre {
+                        start: 0.6,
+                        end: 0.3,
+                        ..Ombre::default()
+                    })
+                }),
+                "material.ombre.end",
             ),
         ];
         for (change, path) in cases {

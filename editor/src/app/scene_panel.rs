@@ -8,7 +8,8 @@ use hairloom_core::model::change::ChangeKind;
 use hairloom_core::model::motion::Motion;
 use hairloom_core::model::scene::{
     Coverage, Effects, FIBRE_OFFSET_CHOICES, FarHair, Fur, HairMaterial, Light, LightSource,
-    MAX_LIGHTS, MultipleScattering, OPACITY_LAYER_CHOICES, Pigment, Scene, SelfShadowing, Shading,
+    MAX_LIGHTS, MultipleScattering, OPACITY_LAYER_CHOICES, Ombre, Pigment, Scene, SelfShadowing,
+    Shading,
 };
 use hairloom_render::measure::EffectCost;
 
@@ -525,6 +526,59 @@ fn material_ui(ui: &mut egui::Ui, state: &mut EditorState) {
             |s| *field(&mut s.material) = value,
         );
     }
+    ombre_ui(ui, state, material.ombre);
+}
+
+/// Colour along the strand: on, the tip colour and where along the strand it turns. Each
+/// slider keeps the span ordered (moving the start past the end takes the end along).
+fn ombre_ui(ui: &mut egui::Ui, state: &mut EditorState, ombre: Option<Ombre>) {
+    let mut on = ombre.is_some();
+    let r = ui.checkbox(&mut on, "Ombré").on_hover_text(
+        "Colour along the strand: toward the tip the hair turns from its own (or painted) \
+         colour to the tip colour",
+    );
+    edit_scene(state, &r, "Scene: ombré", |s| {
+        s.material.ombre = on.then(Ombre::default)
+    });
+    let Some(ombre) = ombre else {
+        return;
+    };
+    let mut tip_rgb = ombre.tip_rgb;
+    let r = ui
+        .horizontal(|ui| {
+            let r = ui.color_edit_button_rgb(&mut tip_rgb);
+            ui.label("Tip colour");
+            r
+        })
+        .inner;
+    edit_scene(state, &r, "Scene: tip colour", |s| {
+        if let Some(o) = &mut s.material.ombre {
+            o.tip_rgb = tip_rgb;
+        }
+    });
+    let (mut start, mut end) = (ombre.start, ombre.end);
+    let r = ui.add(
+        egui::Slider::new(&mut start, 0.0..=1.0)
+            .text("Ombré starts")
+            .suffix(" of the length"),
+    );
+    edit_scene(state, &r, "Scene: ombré starts", |s| {
+        if let Some(o) = &mut s.material.ombre {
+            o.start = start;
+            o.end = o.end.max(start);
+        }
+    });
+    let r = ui.add(
+        egui::Slider::new(&mut end, 0.0..=1.0)
+            .text("Ombré ends")
+            .suffix(" of the length"),
+    );
+    edit_scene(state, &r, "Scene: ombré ends", |s| {
+        if let Some(o) = &mut s.material.ombre {
+            o.end = end;
+            o.start = o.start.min(end);
+        }
+    });
 }
 
 /// Azimuth (about the up axis, from +Z toward +X) and elevation of a direction, in degrees.

@@ -119,8 +119,8 @@ pub enum Which {
         #[command(flatten)]
         path_traced: PathTracedArgs,
     },
-    /// What the method's switches cost, side by side in one run: styling on vs off, MSAA
-    /// 1× / 4× / 8×, exact vs hardware texture filtering with the hardware weights' error,
+    /// What the method's switches cost, side by side in one run: styling on vs off, the
+    /// material's ombré off vs on, MSAA 1× / 4× / 8×, exact vs hardware texture filtering with the hardware weights' error,
     /// and the filtering the game runtime chooses on this adapter.
     Switches {
         #[arg(long)]

@@ -466,7 +466,8 @@ fn dolly_psnr<'a>(
     Ok((worst, sum / (DOLLY_FRAMES - 1) as f64))
 }
 
-/// The document's f64 reference strands as fibres, with their root indices.
+/// The document's f64 reference strands as fibres, with their root indices and the colour map
+/// at their roots.
 pub fn reference_fibres(
     document: &hairloom_core::Document,
     strands_per_bundle: u32,
@@ -486,7 +487,8 @@ pub fn reference_fibres(
     };
     let roots = hairloom_core::strands::reference::root_indices(&strands);
     for (strand, root) in strands.iter().zip(roots) {
-        fibres.push(&strand.points, root);
+        let paint = document.root_maps.sample_colour(strand.root_uv);
+        fibres.push_painted(&strand.points, root, paint);
     }
     fibres
 }

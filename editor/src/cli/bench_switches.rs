@@ -1,6 +1,7 @@
 //! `hairloom bench switches`: what the method's switches cost, measured side by side in one
 //! run (seed 000 §5): styling on against every styling op off (the paper: 10-20 % of the
-//! render time), each op alone against none (its generation cost), MSAA 1× / 4× / 8×, and exact against hardware (8-bit) texture filtering
+//! render time), each op alone against none (its generation cost), the material's ombré off
+//! against on (its shading cost), MSAA 1× / 4× / 8×, and exact against hardware (8-bit) texture filtering
 //! with the hardware weights' error beside their time — the measure the game runtime takes
 //! on its own adapter to choose its default filtering ([`GameHair::filtering_measure`]).
 //!
@@ -97,9 +98,10 @@ pub fn run(settings: &SwitchSettings) -> anyhow::Result<()> {
             )?;
             Ok(super::bench::gpu_or_wall(trust, t.gpu_ms, t.wall_ms))
         };
-        let frame = |preview: &PreviewRenderer,
-                     hair: &GpuHair,
-                     filtering|
+        let frame_in = |preview: &PreviewRenderer,
+                        hair: &GpuHair,
+                        filtering,
+                        scene: &hairloom_core::model::scene::Scene|
          -> anyhow::Result<(f64, &'static str)> {
             let scene = default_scene(
                 &body,
@@ -117,7 +119,7 @@ pub fn run(settings: &SwitchSettings) -> anyhow::Result<()> {
                 vertex_count,
                 (lo, hi),
                 camera,
-                &unlit,
+                scene,
             );
             let t = super::bench::median_timing(
                 || preview.time_frame(&context, &scene, width, height),
@@ -125,6 +127,9 @@ pub fn run(settings: &SwitchSettings) -> anyhow::Result<()> {
                 |t| t.wall_ms,
             )?;
             Ok(super::bench::gpu_or_wall(trust, t.gpu_ms, t.wall_ms))
+        };
+        let frame = |preview: &PreviewRenderer, hair: &GpuHair, filtering| {
+            frame_in(preview, hair, filtering, &unlit)
         };
         let default_preview = previews
             .iter()
@@ -198,6 +203,28 @@ pub fn run(settings: &SwitchSettings) -> anyhow::Result<()> {
                 "",
             );
         }
+
+        // Colour along the strand: the material as it is against it with an ombré, which
+        // shades every fragment past the ombré's start with one more colour blend and a `log`
+        // per channel. Both frames measured here, side by side.
+        let ombre_scene = hairloom_core::model::scene::Scene {
+            material: hairloom_core::model::scene::HairMaterial {
+                ombre: Some(hairloom_core::model::scene::Ombre::default()),
+                ..unlit.material.clone()
+            },
+            ..unlit.clone()
+        };
+        let without_ombre = frame(default_preview, &styled_gpu, Filtering::Exact)?;
+        let with_ombre = frame_in(default_preview, &styled_gpu, Filtering::Exact, &ombre_scene)?;
+        row("ombré", "off", None, Some(without_ombre), Some(1.0), "");
+        row(
+            "ombré",
+            "on (lightened ends)",
+            None,
+            Some(with_ombre),
+            Some(with_ombre.0 / without_ombre.0),
+            "",
+        );
 
         // MSAA, the styled hair.
         let mut first = None;
