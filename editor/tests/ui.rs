@@ -1259,7 +1259,6 @@ fn wisp_shapes_copy_paste_and_mirror_as_undoable_steps() {
     assert_eq!(harness.state().state.document(), &original);
 }
 
-/// Presses Ctrl+Z `times` times.
 /// The label of the history's last undo step.
 fn last_step<'a>(harness: &'a Harness<'static, HairloomApp>) -> Option<&'a str> {
     harness
@@ -1272,6 +1271,7 @@ fn last_step<'a>(harness: &'a Harness<'static, HairloomApp>) -> Option<&'a str> 
         .map(|c| c.label())
 }
 
+/// Presses Ctrl+Z `times` times.
 fn undo(harness: &mut Harness<'static, HairloomApp>, times: usize) {
     for _ in 0..times {
         harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);

@@ -314,6 +314,54 @@ fn the_gizmo_is_drawn_at_the_selection() {
 }
 
 #[test]
+fn the_map_being_painted_is_shown_over_the_scalp() {
+    use hairloom_core::model::root_maps::{RootMapChannel, RootMaps};
+    use hairloom_editor::app::state::DragTool;
+    let Some(mut harness) = wgpu_harness() else {
+        return;
+    };
+    let before = viewport_image(&mut harness);
+    // Painting density with nothing painted yet shows the scalp red (1, unpainted).
+    {
+        let state = &mut harness.state_mut().state;
+        state.tool.drag = DragTool::Groom;
+        state.tool.brush.paint = Some(RootMapChannel::Density);
+    }
+    let unpainted = viewport_image(&mut harness);
+    // The density map painted to 0 everywhere shows it blue.
+    let mut maps = RootMaps::blank(8, 8).expect("maps");
+    for texel in maps.texels_mut() {
+        texel[0] = 0;
+    }
+    {
+        let state = &mut harness.state_mut().state;
+        state
+            .edit(ChangeKind::Restyle, "Paint density map")
+            .root_maps = maps;
+        state.commit_edit();
+    }
+    let painted = viewport_image(&mut harness);
+    painted
+        .save(root().join("target/editor-map-overlay.png"))
+        .expect("write picture");
+    let count = |image: &image::RgbaImage, test: fn(&image::Rgba<u8>) -> bool| {
+        image.pixels().filter(|p| test(p)).count()
+    };
+    let bluish = |p: &image::Rgba<u8>| p[2] as i32 > p[0] as i32 + 60 && p[2] > 120;
+    let reddish =
+        |p: &image::Rgba<u8>| p[0] as i32 > p[2] as i32 + 60 && p[0] as i32 > p[1] as i32 + 40;
+    let (blue_before, red_before) = (count(&before, bluish), count(&before, reddish));
+    let red = count(&unpainted, reddish);
+    let blue = count(&painted, bluish);
+    assert!(red > red_before + 2000, "red {red_before} -> {red}");
+    assert!(blue > blue_before + 2000, "blue {blue_before} -> {blue}");
+    // Switched off in the View menu, it is not drawn.
+    harness.state_mut().viewport.settings.map_overlay = false;
+    let hidden = viewport_image(&mut harness);
+    assert!(count(&hidden, bluish) < blue_before + 500);
+}
+
+#[test]
 fn motion_is_simulated_and_uploaded_only_when_the_scene_has_it() {
     let Some(mut harness) = wgpu_harness() else {
         return;

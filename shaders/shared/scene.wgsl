@@ -104,10 +104,18 @@ fn strand_sigma_a(along: f32, xi: f32) -> vec3<f32> {
     return painted_strand_sigma_a(along, xi, vec4<f32>(0.0));
 }
 
-// The absorption that shows colour `rgb` on a thick mass of hair (Chiang et al. 2016 eq. 9;
-// mirror: core/src/light/material.rs `sigma_a_from_color`).
-fn sigma_a_from_color(rgb: vec3<f32>) -> vec3<f32> {
-    let l = log(clamp(rgb, vec3<f32>(1e-4), vec3<f32>(0.9999))) / color_polynomial();
+// The colour `share` of the way from `own` toward `toward`, kept in the colour fit's range
+// except that hair darker than 1e-4 keeps its own floor (no jump in absorption where a blend
+// starts; never below 1e-30, so the logarithm stays finite). Mirror: material.rs
+// `blend_toward`; its absorption is `sigma_a_of_blend`.
+fn blend_toward(own: vec3<f32>, toward: vec3<f32>, share: f32) -> vec3<f32> {
+    let lowest = max(min(own, vec3<f32>(1e-4)), vec3<f32>(1e-30));
+    return clamp(mix(own, toward, share), lowest, vec3<f32>(0.9999));
+}
+
+// The absorption that shows a blended colour `rgb` (Chiang et al. 2016 eq. 9).
+fn sigma_a_of_blend(rgb: vec3<f32>) -> vec3<f32> {
+    let l = log(rgb) / color_polynomial();
     return l * l;
 }
 
@@ -139,11 +147,11 @@ fn painted_strand_sigma_a(along: f32, xi: f32, paint: vec4<f32>) -> vec3<f32> {
     if weight > 0.0 || share > 0.0 {
         var rgb = hair_color(root);
         if weight > 0.0 {
-            rgb = mix(rgb, paint.rgb, weight);
-            root = sigma_a_from_color(rgb);
+            rgb = blend_toward(rgb, paint.rgb, weight);
+            root = sigma_a_of_blend(rgb);
         }
         if share > 0.0 {
-            root = sigma_a_from_color(mix(rgb, scene.ombre_tip.rgb, share));
+            root = sigma_a_of_blend(blend_toward(rgb, scene.ombre_tip.rgb, share));
         }
     }
     let scale = (1.0 + (scene.sigma_a.w - 1.0) * t) * (1.0 + scene.fibre.x * (2.0 * xi - 1.0));

@@ -25,35 +25,15 @@ impl RootMapRaster {
     /// Quads are split along their 0-2 diagonal; faces of no uv area are skipped.
     pub fn new(mesh: &HairMesh, width: u32, height: u32) -> Self {
         let mut texels = vec![None; width as usize * height as usize];
-        for bundle in &mesh.bundles {
-            if bundle.removed
-                || bundle.vertices.len() < 3
-                || bundle.uvs.len() != bundle.vertices.len()
-            {
-                continue;
-            }
-            let roots: Option<Vec<DVec3>> = bundle
-                .vertices
-                .iter()
-                .map(|&v| mesh.columns.get(v as usize)?.positions.first().copied())
-                .collect();
-            let Some(roots) = roots else {
-                continue;
-            };
-            let corners = bundle.vertices.len();
-            for fan in 1..corners - 1 {
-                let ids = [0, fan, fan + 1];
-                let uv = ids.map(|i| bundle.uvs[i]);
-                let p = ids.map(|i| roots[i]);
-                let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-                rasterise_triangle(width, height, uv, |index, weights| {
-                    let position = p[0] * weights[0] + p[1] * weights[1] + p[2] * weights[2];
-                    if position.is_finite() {
-                        texels[index] = Some((position, normal));
-                    }
-                });
-            }
-        }
+        for_each_root_triangle(mesh, |p, uv| {
+            let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+            rasterise_triangle(width, height, uv, |index, weights| {
+                let position = p[0] * weights[0] + p[1] * weights[1] + p[2] * weights[2];
+                if position.is_finite() {
+                    texels[index] = Some((position, normal));
+                }
+            });
+        });
         Self {
             width,
             height,
@@ -74,6 +54,86 @@ impl RootMapRaster {
             .flatten()
             .map(|(p, _)| p)
     }
+}
+
+/// Calls `triangle(root positions, uvs)` for every root face of `mesh` with a uv per corner
+/// (removed bundles left out, bare ones kept: a map may be painted before hair grows there),
+/// quads and polygons fanned from their first corner (the 0-2 diagonal of a quad).
+fn for_each_root_triangle(mesh: &HairMesh, mut triangle: impl FnMut([DVec3; 3], [DVec2; 3])) {
+    for bundle in &mesh.bundles {
+        if bundle.removed || bundle.vertices.len() < 3 || bundle.uvs.len() != bundle.vertices.len()
+        {
+            continue;
+        }
+        let roots: Option<Vec<DVec3>> = bundle
+            .vertices
+            .iter()
+            .map(|&v| mesh.columns.get(v as usize)?.positions.first().copied())
+            .collect();
+        let Some(roots) = roots else {
+            continue;
+        };
+        for fan in 1..bundle.vertices.len() - 1 {
+            let ids = [0, fan, fan + 1];
+            triangle(ids.map(|i| roots[i]), ids.map(|i| bundle.uvs[i]));
+        }
+    }
+}
+
+/// One triangle of [`map_display_triangles`]: its corners on the scalp, their uvs (where a
+/// display reads the maps) and the root face's unit normal (to leave faces turned away).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapDisplayTriangle {
+    pub positions: [DVec3; 3],
+    pub uvs: [DVec2; 3],
+    pub normal: DVec3,
+}
+
+/// The scalp under the painted maps, for showing them while painting: every root face of
+/// `mesh` (as [`RootMapRaster`] covers them) cut into `cuts²` triangles per fan triangle, so a
+/// display that colours each corner by the map at its uv shows detail finer than a face.
+/// Triangles of no area or with a non-finite corner are left out; `cuts` is clamped to
+/// `1..=16`.
+pub fn map_display_triangles(mesh: &HairMesh, cuts: u32) -> Vec<MapDisplayTriangle> {
+    let n = cuts.clamp(1, 16) as usize;
+    let mut out = Vec::new();
+    for_each_root_triangle(mesh, |p, uv| {
+        let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        if normal == DVec3::ZERO || !normal.is_finite() {
+            return;
+        }
+        // Barycentric lattice point (i, j) of the n-cut triangle.
+        let at = |i: usize, j: usize| {
+            let (b1, b2) = (i as f64 / n as f64, j as f64 / n as f64);
+            let b0 = 1.0 - b1 - b2;
+            (
+                p[0] * b0 + p[1] * b1 + p[2] * b2,
+                uv[0] * b0 + uv[1] * b1 + uv[2] * b2,
+            )
+        };
+        let mut push = |corners: [(usize, usize); 3]| {
+            let points = corners.map(|(i, j)| at(i, j));
+            let triangle = MapDisplayTriangle {
+                positions: points.map(|(p, _)| p),
+                uvs: points.map(|(_, uv)| uv),
+                normal,
+            };
+            if triangle.positions.iter().all(|p| p.is_finite())
+                && triangle.uvs.iter().all(|uv| uv.is_finite())
+            {
+                out.push(triangle);
+            }
+        };
+        for i in 0..n {
+            for j in 0..n - i {
+                push([(i, j), (i + 1, j), (i, j + 1)]);
+                if i + j + 1 < n {
+                    push([(i + 1, j), (i + 1, j + 1), (i, j + 1)]);
+                }
+            }
+        }
+    });
+    out
 }
 
 /// Calls `texel(index, barycentric weights)` for every texel whose centre lies in the uv
@@ -228,6 +288,47 @@ mod tests {
     fn scalp() -> HairMesh {
         // A 4 × 4 grid of quads over x, z ∈ [0, 0.4] (y = 0) with uvs over [0, 1]².
         grid_scalp(4, 4, |s, t| DVec3::new(0.4 * s, 0.0, 0.4 * t))
+    }
+
+    #[test]
+    fn the_map_display_covers_every_root_face_once_at_its_uvs() {
+        let mut mesh = scalp();
+        let area = |a: DVec3, b: DVec3, c: DVec3| 0.5 * (b - a).cross(c - a).length();
+        let uv_area = |t: &MapDisplayTriangle| {
+            let [a, b, c] = t.uvs;
+            0.5 * ((b - a).perp_dot(c - a)).abs()
+        };
+        for cuts in [1, 3] {
+            let triangles = map_display_triangles(&mesh, cuts);
+            // 16 quads, two fan triangles each, cuts² pieces each.
+            assert_eq!(triangles.len(), 16 * 2 * (cuts * cuts) as usize);
+            let world: f64 = triangles
+                .iter()
+                .map(|t| area(t.positions[0], t.positions[1], t.positions[2]))
+                .sum();
+            let uv: f64 = triangles.iter().map(uv_area).sum();
+            assert!((world - 0.16).abs() < 1e-9, "{world}");
+            assert!((uv - 1.0).abs() < 1e-9, "{uv}");
+            // Each corner's uv maps to its position as the grid lays them out (x = 0.4 u).
+            for t in &triangles {
+                for k in 0..3 {
+                    assert!((t.positions[k].x - 0.4 * t.uvs[k].x).abs() < 1e-9);
+                }
+                assert!((t.normal.length() - 1.0).abs() < 1e-9);
+            }
+        }
+        // Degenerate input: a face collapsed to a point and one with a NaN root are left out;
+        // out-of-range cuts are clamped.
+        let first = mesh.bundles[0].vertices[0] as usize;
+        mesh.columns[first].positions[0] = DVec3::NAN;
+        let triangles = map_display_triangles(&mesh, 0);
+        assert!(triangles.len() < 32, "{}", triangles.len());
+        assert!(
+            triangles
+                .iter()
+                .all(|t| t.positions.iter().all(|p| p.is_finite()))
+        );
+        assert!(map_display_triangles(&mesh, u32::MAX).len() <= 32 * 256);
     }
 
     #[test]

@@ -42,6 +42,41 @@ pub(crate) fn sigma_a_from_color(rgb: [f64; 3], beta_n: f64) -> [f64; 3] {
     })
 }
 
+/// The darkest colour a blend is taken back to absorption from: above 0, so the logarithm
+/// stays finite (hair darker than this shows black either way).
+pub const MIN_BLEND_COLOR: f64 = 1e-30;
+
+/// The colour `share` of the way from `own` (what a fibre shows) toward `target`, and the
+/// absorption that shows it. Kept in the colour fit's range, except that hair darker than
+/// [`MIN_COLOR`] keeps its own floor: a share near 0 then leaves it as it was, with no jump in
+/// absorption where a blend starts. Mirror of `blend_toward` in `shaders/shared/scene.wgsl`.
+pub(crate) fn blend_toward(
+    own: [f64; 3],
+    target: [f64; 3],
+    share: f64,
+    beta_n: f64,
+) -> ([f64; 3], [f64; 3]) {
+    let p = color_polynomial(beta_n);
+    let rgb: [f64; 3] = std::array::from_fn(|c| {
+        // (Written out rather than `clamp`: a NaN colour takes the lowest floor, never a
+        // NaN one that `clamp` below would panic on.)
+        let floor = if own[c] >= MIN_COLOR {
+            MIN_COLOR
+        } else if own[c] > MIN_BLEND_COLOR {
+            own[c]
+        } else {
+            MIN_BLEND_COLOR
+        };
+        let blended = own[c] + (target[c] - own[c]) * share;
+        if blended.is_nan() {
+            floor
+        } else {
+            blended.clamp(floor, MAX_COLOR)
+        }
+    });
+    (rgb, rgb.map(|c| (c.ln() / p).powi(2)))
+}
+
 /// The inverse of [`sigma_a_from_color`]: the colour a thick mass of hair with this
 /// absorption shows. Used for ambient light and for Kajiya-Kay's base colour.
 pub(crate) fn color_from_sigma_a(sigma_a: [f64; 3], beta_n: f64) -> [f64; 3] {
@@ -65,8 +100,8 @@ pub struct Fibre {
     pub ombre: Option<FibreOmbre>,
 }
 
-/// [`Ombre`] in the numbers shading uses: its tip colour clamped into the colour fit's range,
-/// and its span ordered.
+/// [`Ombre`] in the numbers shading uses: its tip colour clamped into `[0, 1]`, and its span
+/// ordered.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FibreOmbre {
     pub tip_rgb: [f64; 3],
@@ -85,7 +120,9 @@ impl FibreOmbre {
         };
         let start = unit(ombre.start);
         Self {
-            tip_rgb: ombre.tip_rgb.map(|c| unit(c).clamp(MIN_COLOR, MAX_COLOR)),
+            // Into [0, 1] only: the blend keeps it in the colour fit's range (hair darker
+            // than the fit's floor may turn toward a tip as dark as itself).
+            tip_rgb: ombre.tip_rgb.map(unit),
             start,
             end: unit(ombre.end).max(start),
         }
@@ -162,8 +199,7 @@ impl Fibre {
             return self.sigma_a_root;
         }
         let own = self.color(self.sigma_a_root);
-        let rgb: [f64; 3] = std::array::from_fn(|c| own[c] + (ombre.tip_rgb[c] - own[c]) * share);
-        sigma_a_from_color(rgb, self.beta_n)
+        blend_toward(own, ombre.tip_rgb, share, self.beta_n).1
     }
 
     /// The absorption of an average strand at mid-length, in the material's own colour (no
@@ -196,10 +232,8 @@ impl Fibre {
             return *self;
         }
         let own = self.color(self.sigma_a_root);
-        let rgb: [f64; 3] =
-            std::array::from_fn(|c| own[c] + (paint.rgb_linear[c] - own[c]) * weight);
         Fibre {
-            sigma_a_root: sigma_a_from_color(rgb, self.beta_n),
+            sigma_a_root: blend_toward(own, paint.rgb_linear, weight, self.beta_n).1,
             ..*self
         }
     }
@@ -359,6 +393,69 @@ mod tests {
                     sigma_a.iter().all(|s| s.is_finite() && *s >= 0.0),
                     "{tip:?} {start} {end} at {along}: {sigma_a:?}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn very_dark_hair_turns_without_a_jump_where_a_blend_starts() {
+        // Black hair (eumelanin 8) shows colours far below the colour fit's 1e-4 floor.
+        // (Blending in colour, the absorption of hair this dark moves fast once the blend is
+        // under way — it is continuous, not a jump to the fit's floor, which is what this checks.)
+        for eumelanin in [2.5, 8.0] {
+            let material = HairMaterial {
+                pigment: Pigment::Melanin {
+                    eumelanin,
+                    pheomelanin: 0.0,
+                },
+                ..ombre_material([0.6, 0.4, 0.2], 0.5, 0.9)
+            };
+            let fibre = Fibre::new(&material);
+            let before = fibre.sigma_a(0.5, 0.5);
+            let just_after = fibre.sigma_a(0.5 + 1e-6, 0.5);
+            for c in 0..3 {
+                assert!(
+                    (just_after[c] - before[c]).abs() <= 1e-3 * before[c],
+                    "eumelanin {eumelanin}: {before:?} -> {just_after:?}"
+                );
+            }
+            // A colour-map stroke at a sliver of weight leaves it as it was, too.
+            let faint = fibre.painted(&PaintedColour {
+                rgb_linear: [0.9, 0.9, 0.9],
+                weight: 1e-12,
+            });
+            for c in 0..3 {
+                let (a, b) = (fibre.sigma_a_root[c], faint.sigma_a_root[c]);
+                assert!(
+                    (a - b).abs() <= 1e-3 * a,
+                    "eumelanin {eumelanin}: {a} -> {b}"
+                );
+            }
+            // And an ombré toward its own colour changes nothing.
+            let plain = Fibre::new(&HairMaterial {
+                ombre: None,
+                ..material.clone()
+            });
+            let own = plain.color(plain.sigma_a_root).map(|c| c as f32);
+            let same = Fibre::new(&HairMaterial {
+                ombre: Some(Ombre {
+                    tip_rgb: own,
+                    start: 0.0,
+                    end: 1.0,
+                }),
+                ..material.clone()
+            });
+            for k in 0..=10 {
+                let (a, b) = (
+                    plain.sigma_a(k as f64 / 10.0, 0.5),
+                    same.sigma_a(k as f64 / 10.0, 0.5),
+                );
+                for c in 0..3 {
+                    assert!(
+                        (a[c] - b[c]).abs() <= 1e-3 * a[c],
+                        "eumelanin {eumelanin}: {a:?} {b:?}"
+                    );
+                }
             }
         }
     }

@@ -762,7 +762,7 @@ mod tests {
     }
 
     #[test]
-    fn painted_strands_and_an_ombre_take_their_colour_as_the_gpu_does() {
+    fn painted_strands_and_an_ombre_take_their_colour_in_the_path_tracer() {
         let settings = ReferenceSettings {
             samples_per_pixel: 4,
             max_bounces: 4,

@@ -657,6 +657,16 @@ fn check_direction(path: &str, v: [f32; 3]) -> Result<(), InvalidScene> {
 pub const MAX_INTENSITY: f32 = 10_000.0;
 
 impl HairMaterial {
+    /// This material as the scene-wide tables (dual scattering, forward transmittance, far
+    /// hair, Kajiya-Kay's weights) are made from it: its own colour, no ombré. Renderers
+    /// key their table caches on it, so shaping an ombré rebuilds none.
+    pub fn for_tables(&self) -> HairMaterial {
+        HairMaterial {
+            ombre: None,
+            ..self.clone()
+        }
+    }
+
     pub fn validate(&self) -> Result<(), InvalidScene> {
         let at = |field: &str| format!("material.{field}");
         match &self.pigment {
@@ -987,6 +997,24 @@ mod tests {
                     })
                 }),
                 "material.ombre.tip_rgb[1]",
+            ),
+            (
+                Box::new(|s| {
+                    s.material.ombre = Some(Ombre {
+                        tip_rgb: [0.5, 0.2, 1.5],
+                        ..Ombre::default()
+                    })
+                }),
+                "material.ombre.tip_rgb[2]",
+            ),
+            (
+                Box::new(|s| {
+                    s.material.ombre = Some(Ombre {
+                        end: 1.01,
+                        ..Ombre::default()
+                    })
+                }),
+                "material.ombre.end",
             ),
             (
                 Box::new(|s| {

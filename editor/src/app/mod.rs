@@ -919,6 +919,11 @@ impl HairloomApp {
                     &mut settings.frame_glyphs,
                     "Styling frames (u red, v green, w blue)",
                 );
+                ui.checkbox(&mut settings.map_overlay, "Painted map over the scalp")
+                    .on_hover_text(
+                        "While a map brush paints, show that map over the scalp: blue 0 to \
+                         red 1 for density, length and clump; the colour map by its weight",
+                    );
                 ui.checkbox(&mut settings.turntable, "Turntable (look-dev)")
                     .on_hover_text(
                         "The camera goes round the hair once in 12 s, the lights turning with \

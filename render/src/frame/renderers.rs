@@ -76,7 +76,9 @@ impl FrameRenderers {
         scene: &Scene,
         input: RibbonInput,
     ) {
-        self.mean_forward = self.lighting.sync(context, active, &scene.material);
+        // The tables are the material's own colour: an ombré changes none of them.
+        let tables_material = scene.material.for_tables();
+        self.mean_forward = self.lighting.sync(context, active, &tables_material);
         let layout_key = (
             active.opacity_maps,
             active.body_shadows,
@@ -168,13 +170,13 @@ impl FrameRenderers {
         };
         if active.far_hair {
             let far = self.far_hair.get_or_insert_with(|| {
-                FarHairRenderer::new(context, self.targets, &scene.material)
+                FarHairRenderer::new(context, self.targets, &tables_material)
             });
             let effects_layout = self.effects_layout.as_ref().and_then(|(_, l)| l.as_ref());
             far.ensure(
                 context,
                 active,
-                &scene.material,
+                &tables_material,
                 &self.lighting.scene_layout,
                 effects_layout,
             );

@@ -84,6 +84,8 @@ pub struct ViewSettings {
     /// Look-dev: the camera goes round the hair, the scene's lights turning with it (the
     /// head seems to turn under studio lights), as `hairloom render --turntable` does.
     pub turntable: bool,
+    /// While a map brush paints, show that map over the scalp (under the hair).
+    pub map_overlay: bool,
     pub strands_per_bundle: u32,
     pub precision: Precision,
     pub filtering: Filtering,
@@ -98,6 +100,7 @@ impl Default for ViewSettings {
             gizmo: true,
             styling_gizmo: false,
             turntable: false,
+            map_overlay: true,
             strands_per_bundle: 32,
             precision: Precision::F32,
             filtering: Filtering::Exact,
@@ -259,6 +262,12 @@ pub struct Viewport {
     body_field: Option<groom_brush::BodyField>,
     /// The fingerprint of the document's body at a document revision.
     body_key: Option<(u64, u64)>,
+    /// The scalp cut finely for showing a painted map, for the document revision it was cut
+    /// at.
+    map_display: Option<(
+        u64,
+        Vec<hairloom_core::edit::paint_maps::MapDisplayTriangle>,
+    )>,
     /// Styling frames per layer and column for the document revision they were computed at.
     frames: Option<(
         u64,
@@ -357,6 +366,7 @@ impl Viewport {
             camera_bounds: None,
             framed_from_hair: false,
             interior: None,
+            map_display: None,
             body_depth: None,
             stroke: None,
             brush_cursor: None,

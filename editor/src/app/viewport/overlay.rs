@@ -1,5 +1,7 @@
-//! The 2D overlay over the picture: hair-mesh wireframe, styling frames, the selection and
-//! the region being dragged.
+//! The 2D overlay over the picture: the map being painted, hair-mesh wireframe, styling
+//! frames, the selection and the region being dragged.
+
+use hairloom_core::model::root_maps::{RootMapChannel, RootMaps, linear_to_srgb};
 
 use super::*;
 
@@ -82,6 +84,12 @@ impl Viewport {
                 polyline(&column.positions[..=end], false, stroke);
             }
         };
+        if self.settings.map_overlay
+            && state.tool.drag == DragTool::Groom
+            && let Some(channel) = state.tool.brush.paint
+        {
+            self.paint_map_display(&painter, state, &projector, channel);
+        }
         let vertex_mode = state.tool.mode == SelectMode::Vertices;
         if self.settings.wireframe || vertex_mode {
             let stroke = egui::Stroke::new(
@@ -275,5 +283,143 @@ impl Viewport {
                 egui::Color32::WHITE,
             );
         }
+    }
+
+    /// The map `channel` over the scalp while it is painted: the root faces cut finely, each
+    /// corner coloured by the map at its uv ([`map_display_colour`]), faces turned away from
+    /// the camera left out (the scalp hides them), drawn under the outlines.
+    fn paint_map_display(
+        &mut self,
+        painter: &egui::Painter,
+        state: &EditorState,
+        projector: &Projector,
+        channel: RootMapChannel,
+    ) {
+        let document = state.shown_document();
+        if self
+            .map_display
+            .as_ref()
+            .is_none_or(|(r, _)| *r != state.shown_revision())
+        {
+            let triangles = hairloom_core::edit::paint_maps::map_display_triangles(
+                &document.hair_mesh,
+                MAP_DISPLAY_CUTS,
+            );
+            self.map_display = Some((state.shown_revision(), triangles));
+        }
+        let Some((_, triangles)) = &self.map_display else {
+            return;
+        };
+        let eye = projector
+            .view
+            .inverse()
+            .transform_point3(Vec3::ZERO)
+            .as_dvec3();
+        let mut mesh = egui::Mesh::default();
+        for triangle in triangles {
+            let centre =
+                (triangle.positions[0] + triangle.positions[1] + triangle.positions[2]) / 3.0;
+            if triangle.normal.dot(eye - centre) <= 0.0 {
+                continue;
+            }
+            let corners: Option<Vec<egui::Pos2>> = triangle
+                .positions
+                .iter()
+                .map(|&p| projector.project(p))
+                .collect();
+            let Some(corners) = corners else {
+                continue;
+            };
+            let first = mesh.vertices.len() as u32;
+            for (at, uv) in corners.into_iter().zip(triangle.uvs) {
+                mesh.colored_vertex(at, map_display_colour(&document.root_maps, channel, uv));
+            }
+            mesh.add_triangle(first, first + 1, first + 2);
+        }
+        painter.add(egui::Shape::mesh(mesh));
+    }
+}
+
+/// Each fan triangle of a root face is cut into this many² for the map display: a 256² map
+/// over ~400 faces shows its strokes, and ~13K triangles draw in well under a millisecond.
+const MAP_DISPLAY_CUTS: u32 = 4;
+
+/// How the map display colours a point of the scalp at `uv`. Grey maps run from blue (0: no
+/// hair, no length, no clumping) through green to red (1, the unpainted value), as weight
+/// paint does in Blender; the colour map shows its colour over grey by its weight.
+pub(super) fn map_display_colour(
+    maps: &RootMaps,
+    channel: RootMapChannel,
+    uv: glam::DVec2,
+) -> egui::Color32 {
+    if channel == RootMapChannel::Colour {
+        let paint = maps.sample_colour(uv);
+        let weight = paint.weight.clamp(0.0, 1.0);
+        let byte = |linear: f64| {
+            let c = 0.5 + (linear_to_srgb(linear.clamp(0.0, 1.0)) - 0.5) * weight;
+            (c * 255.0).round() as u8
+        };
+        let [r, g, b] = paint.rgb_linear.map(byte);
+        return egui::Color32::from_rgba_unmultiplied(r, g, b, (60.0 + 170.0 * weight) as u8);
+    }
+    let values = maps.sample(uv);
+    let value = match channel {
+        RootMapChannel::Density => values.density,
+        RootMapChannel::Length => values.length,
+        _ => values.clump,
+    };
+    let v = if value.is_finite() {
+        value.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    // Blue → green → red.
+    let (r, g, b) = if v < 0.5 {
+        let t = 2.0 * v;
+        (0.0, t, 1.0 - t)
+    } else {
+        let t = 2.0 * v - 1.0;
+        (t, 1.0 - t, 0.0)
+    };
+    let byte = |c: f64| (40.0 + 200.0 * c).round() as u8;
+    egui::Color32::from_rgba_unmultiplied(byte(r), byte(g), byte(b), 130)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_map_display_shows_grey_maps_blue_to_red_and_colour_by_its_weight() {
+        let mut maps = RootMaps::blank(2, 1).expect("maps");
+        // The left texel painted to 0 in every grey map and coloured green at full weight;
+        // the right one left as it was.
+        maps.texels_mut()[0] = [0, 0, 0, 255];
+        maps.colour_texels_mut()[0] = [20, 200, 40, 255];
+        let left = glam::DVec2::new(0.0, 0.5);
+        let right = glam::DVec2::new(1.0, 0.5);
+        for channel in [
+            RootMapChannel::Density,
+            RootMapChannel::Length,
+            RootMapChannel::Clump,
+        ] {
+            let painted = map_display_colour(&maps, channel, left);
+            let unpainted = map_display_colour(&maps, channel, right);
+            assert!(
+                painted.b() > painted.r() && painted.b() > painted.g(),
+                "{painted:?}"
+            );
+            assert!(
+                unpainted.r() > unpainted.g() && unpainted.r() > unpainted.b(),
+                "{unpainted:?}"
+            );
+        }
+        let green = map_display_colour(&maps, RootMapChannel::Colour, left);
+        let none = map_display_colour(&maps, RootMapChannel::Colour, right);
+        assert!(green.g() > green.r() && green.g() > green.b(), "{green:?}");
+        assert!(green.a() > none.a(), "{green:?} over {none:?}");
+        // Where no colour is painted the scalp shows grey, faintly.
+        assert_eq!(none.r(), none.g());
+        assert!(none.a() > 0 && none.a() < 128);
     }
 }
