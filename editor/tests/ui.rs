@@ -58,8 +58,7 @@ fn a_styling_slider_change_is_one_undo_step() {
     assert_eq!(harness.state().state.project.history.undo.len(), 1);
     assert!(harness.state().state.is_dirty());
 
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original, "Ctrl+Z undoes");
 
     harness.get_by_label("Edit").click();
@@ -106,8 +105,7 @@ fn the_styling_structure_ops_have_sliders() {
         );
         assert_eq!(state.project.history.undo.len(), i + 1, "{label}: one step");
     }
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     let global = &harness.state().state.document().styling.global;
     assert_ne!(
         global.wave.clump_coherence, 0.35,
@@ -235,8 +233,7 @@ fn select_a_bundle_extrude_and_undo() {
     assert!(extruded.validate().is_ok());
     assert_eq!(harness.state().state.project.history.undo.len(), 1);
 
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original, "undo restores");
     // E extrudes too.
     harness.key_press(egui::Key::E);
@@ -637,8 +634,7 @@ fn importing_a_scalp_is_one_undo_step() {
     assert!(imported.hair_mesh.bundles.len() > original.hair_mesh.bundles.len());
     assert!(imported.hair_mesh.bundles.iter().all(|b| b.layers == 0));
     assert_eq!(imported.styling, original.styling, "the styling is kept");
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original);
 }
 
@@ -698,8 +694,7 @@ fn importing_a_body_asks_where_hair_grows_and_the_rest_stays_body() {
         "{}",
         state.message
     );
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original, "one undo step");
 
     // Cancel imports nothing, and neither does Escape.
@@ -1044,8 +1039,7 @@ fn box_select_vertices_then_g_moves_them_as_one_undo_step() {
     assert!(before.distance(after) > 1e-4, "{before} → {after}");
     assert!(moved.hair_mesh.validate().is_ok());
 
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original);
 }
 
@@ -1279,6 +1273,17 @@ fn undo(harness: &mut Harness<'static, HairloomApp>, times: usize) {
     }
 }
 
+/// Presses Ctrl+Shift+Z `times` times.
+fn redo(harness: &mut Harness<'static, HairloomApp>, times: usize) {
+    for _ in 0..times {
+        harness.key_press_modifiers(
+            egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+            egui::Key::Z,
+        );
+        harness.run();
+    }
+}
+
 #[test]
 fn e_over_the_viewport_extrudes_by_the_dragged_distance() {
     let mut harness = harness();
@@ -1388,8 +1393,7 @@ fn typing_g_z_a_value_enter_moves_up_and_the_modal_tool_owns_the_keyboard() {
     assert_eq!(harness.state().viewport.modal_tool(), Some("Move"));
     // Keys that would commit the move half-way and start something else.
     harness.key_press(egui::Key::E);
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().viewport.modal_tool(), Some("Move"));
     assert!(harness.state().state.project.history.undo.is_empty());
     assert!(harness.state().state.project.history.redo.is_empty());
@@ -1782,8 +1786,7 @@ fn the_far_hair_switch_is_one_undo_step() {
     harness.run();
     assert_eq!(far(&harness), FarHair::Aggregated);
     assert_eq!(harness.state().state.project.history.undo.len(), 1);
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(far(&harness), FarHair::Strands);
 }
 
@@ -1800,8 +1803,7 @@ fn the_fur_switch_is_one_undo_step() {
     assert_ne!(fur(&harness), before);
     assert!(matches!(fur(&harness), Fur::Off | Fur::ShellsFins));
     assert_eq!(harness.state().state.project.history.undo.len(), 1);
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(fur(&harness), before);
 }
 
@@ -1890,8 +1892,7 @@ fn drape_lets_the_hair_fall_onto_the_body_as_one_undo_step() {
         state.project.history.undo.last().map(|c| c.label()),
         Some("Drape")
     );
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original, "one undo step");
 }
 
@@ -1932,10 +1933,7 @@ fn lock_and_unlock_the_selected_bundles_vertices_as_undo_steps() {
         locked.len() - unlocked.len(),
         locked.len()
     );
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 2);
     assert_eq!(
         harness.state().state.document(),
         &original,
@@ -1972,8 +1970,7 @@ fn set_density_thins_the_selected_bundles_as_an_undo_step() {
         state.project.history.undo.last().map(|c| c.label()),
         Some("Set density")
     );
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(harness.state().state.document(), &original, "one undo step");
 }
 
@@ -2602,8 +2599,7 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
             .count()
     };
     assert!(moved_side(true) > 0 && moved_side(false) > 0);
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(
         harness.state().state.document().hair_mesh,
         original.hair_mesh
@@ -2624,8 +2620,7 @@ fn a_groom_brush_stroke_combs_the_hair_as_one_undo_step() {
         harness.hover_at(start + egui::vec2(12.0 * step as f32, 0.0));
         harness.run();
     }
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     for step in 5..=8 {
         harness.hover_at(start + egui::vec2(12.0 * step as f32, 0.0));
         harness.run();
@@ -2736,14 +2731,9 @@ fn painting_the_density_map_thins_the_hair_as_one_undo_step() {
             .count()
     };
     assert!(grown(&painted) < grown(&original));
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert!(harness.state().state.document().root_maps.is_empty());
-    harness.key_press_modifiers(
-        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
-        egui::Key::Z,
-    );
-    harness.run();
+    redo(&mut harness, 1);
     assert_eq!(
         harness.state().state.document().root_maps,
         painted.root_maps
@@ -2830,17 +2820,12 @@ fn painting_the_colour_map_colours_the_strands_as_one_undo_step() {
         "{changed} of {} points",
         before.len()
     );
-    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    undo(&mut harness, 1);
     assert_eq!(
         harness.state().state.document().root_maps,
         original.root_maps
     );
-    harness.key_press_modifiers(
-        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
-        egui::Key::Z,
-    );
-    harness.run();
+    redo(&mut harness, 1);
     assert_eq!(
         harness.state().state.document().root_maps,
         painted.root_maps

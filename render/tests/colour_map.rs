@@ -135,14 +135,8 @@ fn ribbon_paths(context: &GpuContext) -> Vec<GenerationPath> {
         GenerationPath::ComputePerStrand,
         GenerationPath::VertexShader,
     ];
-    if GenerationPath::MeshShader.available(&context.device) {
+    if common::has_mesh_shaders(context, "colour_map") {
         paths.push(GenerationPath::MeshShader);
-    } else {
-        assert!(
-            std::env::var("HAIRLOOM_REQUIRE_MESH_SHADERS").as_deref() != Ok("1"),
-            "no mesh shaders on this adapter (HAIRLOOM_REQUIRE_MESH_SHADERS=1)"
-        );
-        eprintln!("skipped the mesh path: this adapter has no mesh shaders");
     }
     paths
 }

@@ -15,7 +15,7 @@ use glam::Vec3;
 use hairloom_core::runtime::frame_plan::LodSettings;
 use hairloom_core::runtime::hair::{RuntimeHair, RuntimeOptions};
 use hairloom_core::runtime::strand_gen::Filtering;
-use hairloom_render::device::{GpuContext, describe, headless_for_test};
+use hairloom_render::device::{GpuContext, headless_for_test};
 use hairloom_render::preview::{Camera, HairSource, PreviewError, PreviewRenderer, default_scene};
 use hairloom_render::renderer::preview_body::GpuBody;
 use hairloom_render::renderer::strand_gen::{
@@ -25,19 +25,7 @@ use hairloom_render::renderer::strand_gen::{
 /// A device with mesh shaders, or `None` after saying why the test skipped.
 fn mesh_context(test: &str) -> Option<GpuContext> {
     let context = headless_for_test(test)?;
-    if mesh_shaders_available(&context.device) {
-        return Some(context);
-    }
-    let why = format!(
-        "{} has no mesh shaders (EXPERIMENTAL_MESH_SHADER)",
-        describe(&context.adapter_info)
-    );
-    assert!(
-        std::env::var("HAIRLOOM_REQUIRE_MESH_SHADERS").as_deref() != Ok("1"),
-        "{test}: {why} (HAIRLOOM_REQUIRE_MESH_SHADERS=1)"
-    );
-    eprintln!("skipped: {test}: {why}");
-    None
+    common::has_mesh_shaders(&context, test).then_some(context)
 }
 
 #[test]

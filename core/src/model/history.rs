@@ -711,6 +711,20 @@ mod root_maps_tests {
         Document::new("grid", crate::model::mesh::test_meshes::grid(2, 2, 1, 0.1))
     }
 
+    /// The command recording `before` → `after`, and what it keeps of the painted maps.
+    fn recorded_maps_change(
+        label: &str,
+        before: &Document,
+        after: &Document,
+    ) -> (Command, RootMapsChange) {
+        let command = Command::record(label, before, after).expect("a change");
+        let Command::Edit { diff, .. } = &command else {
+            panic!("an edit");
+        };
+        let change = diff.root_maps.as_deref().expect("the maps changed").clone();
+        (command, change)
+    }
+
     /// A stroke keeps only the texels it changed; the first stroke (maps made) and clearing
     /// the last map keep both whole; undo and redo go through each exactly; a damaged entry
     /// is a named mismatch, never a panic.
@@ -722,26 +736,17 @@ mod root_maps_tests {
         let mut first = document.clone();
         first.root_maps = RootMaps::blank(256, 256).expect("maps");
         first.root_maps.texels_mut()[10][0] = 0;
-        let command = Command::record("Paint density", &document, &first).expect("a change");
-        let Command::Edit { diff, .. } = &command else {
-            panic!("an edit");
-        };
-        assert!(matches!(
-            diff.root_maps.as_deref(),
-            Some(RootMapsChange::Whole(_))
-        ));
+        let (_, change) = recorded_maps_change("Paint density", &document, &first);
+        assert!(matches!(change, RootMapsChange::Whole(_)));
         history.commit(&mut document, "Paint density", first.clone());
         // The next stroke: 100 texels of 65,536.
         let mut second = document.clone();
         for texel in &mut second.root_maps.texels_mut()[1000..1100] {
             texel[1] = 128;
         }
-        let command = Command::record("Paint length", &document, &second).expect("a change");
-        let Command::Edit { diff, .. } = &command else {
-            panic!("an edit");
-        };
-        let Some(RootMapsChange::Texels { changes, .. }) = diff.root_maps.as_deref() else {
-            panic!("texels, not whole maps: {:?}", diff.root_maps.is_some());
+        let (command, change) = recorded_maps_change("Paint length", &document, &second);
+        let RootMapsChange::Texels { changes, .. } = &change else {
+            panic!("texels, not whole maps");
         };
         assert_eq!(changes.len(), 100);
         let stored = serde_json::to_vec(&command).expect("json");
@@ -798,23 +803,14 @@ mod root_maps_tests {
         // The colour map's first stroke: whole (the map appears).
         let mut second = document.clone();
         second.root_maps.colour_texels_mut()[10] = [200, 40, 10, 255];
-        let command = Command::record("Paint colour", &document, &second).expect("a change");
-        let Command::Edit { diff, .. } = &command else {
-            panic!("an edit");
-        };
-        assert!(matches!(
-            diff.root_maps.as_deref(),
-            Some(RootMapsChange::Whole(_))
-        ));
+        let (_, change) = recorded_maps_change("Paint colour", &document, &second);
+        assert!(matches!(change, RootMapsChange::Whole(_)));
         history.commit(&mut document, "Paint colour", second.clone());
         // The next: only its texels, indexed after the grey maps' 4096.
         let mut third = document.clone();
         third.root_maps.colour_texels_mut()[11] = [10, 40, 200, 128];
-        let command = Command::record("Paint colour", &document, &third).expect("a change");
-        let Command::Edit { diff, .. } = &command else {
-            panic!("an edit");
-        };
-        let Some(RootMapsChange::Texels { changes, .. }) = diff.root_maps.as_deref() else {
+        let (_, change) = recorded_maps_change("Paint colour", &document, &third);
+        let RootMapsChange::Texels { changes, .. } = &change else {
             panic!("texels");
         };
         assert_eq!(

@@ -147,3 +147,22 @@ pub fn compare(a: &[u8], b: &[u8]) -> (usize, usize) {
     let drawn = a.chunks(4).filter(|p| p[..3] != a[..3]).count();
     (differing, drawn)
 }
+
+/// Whether `context`'s adapter has mesh shaders. Without them `test` says it skipped its mesh
+/// path, or fails where `HAIRLOOM_REQUIRE_MESH_SHADERS=1` (`make test` runs the mesh tests
+/// again on an adapter that has them, where they must not skip).
+pub fn has_mesh_shaders(context: &hairloom_render::device::GpuContext, test: &str) -> bool {
+    if hairloom_render::renderer::strand_gen::mesh_shaders_available(&context.device) {
+        return true;
+    }
+    let why = format!(
+        "{} has no mesh shaders (EXPERIMENTAL_MESH_SHADER)",
+        hairloom_render::device::describe(&context.adapter_info)
+    );
+    assert!(
+        std::env::var("HAIRLOOM_REQUIRE_MESH_SHADERS").as_deref() != Ok("1"),
+        "{test}: {why} (HAIRLOOM_REQUIRE_MESH_SHADERS=1)"
+    );
+    eprintln!("skipped the mesh path: {test}: {why}");
+    false
+}
